@@ -1,0 +1,79 @@
+// erodem — the interface every compute backend (CPU reference, OpenCL) implements. The
+// simulation driver runs a backend through the step sequence of MODEL.md one process at a
+// time, so each process can be timed, switched off or compared on its own.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "erodem/fields.hpp"
+
+namespace erodem {
+
+/// The processes of one step, in the order they run (MODEL.md "One step").
+enum class Process {
+  boundary,     ///< ghost cells take the state the edge conditions give them
+  sources,      ///< rain and point/line inflows
+  flow,         ///< outflow fluxes (pipes or local_inertial)
+  water,        ///< depth and velocity update
+  erosion,      ///< erosion / deposition
+  transport,    ///< suspended sediment transport
+  thermal,      ///< slope collapse
+  evaporation,  ///< evaporation and the wetness running mean
+};
+const char* process_name(Process p);
+
+/// Water added at one cell in this step by a point or line inflow.
+struct PointSource {
+  std::int64_t cell = 0;  ///< row-major DEM cell index (row * nx + col)
+  double volume = 0.0;    ///< m^3 added this step
+};
+
+/// What a process needs to know about the current step.
+struct StepInputs {
+  double t = 0.0;                   ///< time at the start of the step (s)
+  double dt = 0.0;                  ///< step (s)
+  double rain_rate = 0.0;           ///< uniform rain rate this step (m/s), times the rain factor
+  std::vector<PointSource> points;  ///< inflows this step
+};
+
+/// Volumes (m^3) that crossed the model's boundaries during the processes run so far.
+struct StepTally {
+  double boundary_water_out = 0.0;  ///< net water out through open / fixed-level ghosts
+  double evaporated = 0.0;
+  double clipped = 0.0;             ///< water added to lift rounding-level negative depths
+  double sediment_out = 0.0;        ///< sediment carried out through the boundary
+  double transport_change = 0.0;    ///< change of sum(s * area) by the transport step
+};
+
+/// Reductions over the active cells, for the ledger and the stability check.
+struct FieldStats {
+  double water_volume = 0.0;     ///< sum d * area (m^3)
+  double material_volume = 0.0;  ///< sum (b + s) * area (m^3)
+  double sediment_volume = 0.0;  ///< sum s * area (m^3)
+  double max_depth = 0.0;        ///< m
+  std::int64_t max_depth_cell = -1;
+  double max_speed = 0.0;        ///< m/s
+  std::int64_t max_speed_cell = -1;
+  std::int64_t bad_cell = -1;    ///< first cell with NaN, infinite or negative state; -1: none
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  /// "cpu" or "opencl".
+  virtual std::string name() const = 0;
+  /// What runs the kernels, e.g. "CPU reference, float32, 2 threads".
+  virtual std::string device() const = 0;
+  /// Runs one process of the step sequence.
+  virtual void run(Process p, const StepInputs& in, StepTally& tally) = 0;
+  /// Reductions over the current state.
+  virtual FieldStats stats() = 0;
+  /// A field of the DEM grid, row-major (ny, nx), converted to double.
+  virtual std::vector<double> field(FieldId id) const = 0;
+  /// Replaces a field of the DEM grid (row-major (ny, nx)).
+  virtual void set_field(FieldId id, const std::vector<double>& values) = 0;
+};
+
+}  // namespace erodem

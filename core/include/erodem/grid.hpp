@@ -1,0 +1,62 @@
+// erodem — the raster grid: sizes, per-row cell sizes and areas, georeferencing.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace erodem {
+
+/// Georeferencing carried with the data (never a silent default: `has_transform`
+/// says whether the source file had one).
+struct Georef {
+  /// GDAL geotransform: x0, pixel width, row rotation, y0, column rotation, pixel height
+  /// (negative for north-up). Coordinates are of the top-left corner of cell (0, 0).
+  std::array<double, 6> transform{0.0, 1.0, 0.0, 0.0, 0.0, -1.0};
+  std::string crs_wkt;        ///< WKT of the CRS, empty when unknown
+  bool has_transform = false;  ///< the source carried a geotransform
+  bool is_geographic = false;  ///< lat/lon degrees (cell sizes from the ellipsoid)
+};
+
+/// A regular raster of `nx` columns by `ny` rows, row-major, row 0 at the north edge.
+/// Cell sizes are in metres and may vary by row (geographic grids).
+struct Grid {
+  int nx = 0;
+  int ny = 0;
+  std::vector<double> dx;    ///< east-west cell size of each row (m)
+  std::vector<double> dy;    ///< north-south cell size of each row (m)
+  std::vector<double> area;  ///< cell area of each row (m^2)
+  Georef georef;
+
+  /// A projected grid of square cells of `cell` metres, origin at (0, ny*cell).
+  static Grid uniform(int nx, int ny, double cell);
+
+  std::size_t cells() const { return static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny); }
+  double dx_min() const;  ///< smallest cell size in either direction (m)
+  /// Centre of cell (col, row) in the grid's CRS.
+  std::array<double, 2> cell_center(int col, int row) const;
+  /// The cell containing CRS point (x, y); false when it is outside the grid.
+  bool locate(double x, double y, int& col, int& row) const;
+  /// Throws erodem::Error when sizes are inconsistent or non-positive.
+  void validate() const;
+};
+
+/// Host-side inputs of a run, on one grid, all in SI units, row-major (ny, nx).
+/// Optional rasters are empty when the scalar parameter applies.
+struct Terrain {
+  Grid grid;
+  std::vector<double> bed;          ///< bed elevation (m)
+  std::vector<std::uint8_t> mask;   ///< 1 = active cell, 0 = nodata; empty = all active
+  std::vector<double> water_depth;  ///< initial depth (m)
+  std::vector<double> manning_n;    ///< Manning n (s m^-1/3)
+  std::vector<double> hardness;     ///< erodibility R in [0, 1]
+  std::vector<double> rain_factor;  ///< rain multiplier (1)
+  std::string source;               ///< DEM path or generator description
+  std::string source_sha256;        ///< checksum of the DEM file, when read from one
+
+  bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
+};
+
+}  // namespace erodem

@@ -1,0 +1,138 @@
+// erodem — the typed parameter set of one run. Names follow MODEL.md / INTERFACES.md.
+// Values are held in SI units (m, s, m/s, 1/s, degrees for angles). The schema that
+// fills and validates this structure from TOML, `--set` and Python keywords lives in
+// schema.hpp: it is the only place where keys, defaults, ranges and docs are written.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace erodem {
+
+enum class FlowScheme { pipes, local_inertial };
+enum class TransportScheme { conservative, semi_lagrangian };
+enum class BoundaryKind { closed, open, fixed_level };
+enum class NodataKind { wall, sea };
+enum class Precision { float32, float64 };
+
+/// A parameter given either as one number (SI units) or as a raster file path.
+struct ScalarOrRaster {
+  double value = 0.0;
+  std::string path;  ///< non-empty: a raster on the DEM grid (same size after window)
+  bool is_raster() const { return !path.empty(); }
+};
+
+/// One point of a piecewise-linear time series: time (s), value (SI).
+struct SeriesPoint {
+  double t = 0.0;
+  double value = 0.0;
+};
+using Series = std::vector<SeriesPoint>;
+
+/// A point (one vertex) or line (two or more vertices) inflow with a hydrograph.
+struct InflowSpec {
+  std::vector<std::array<double, 2>> vertices;  ///< x, y in the DEM's CRS
+  Series hydrograph;                            ///< time (s), discharge (m^3/s)
+};
+
+struct Params {
+  struct Dem {
+    std::string path;       ///< DEM file (GDAL raster); empty when `synthetic` is set
+    std::string synthetic;  ///< "", or a generator kind: fbm, ridged, diamond_square, hill, lake, valley, ridge
+    int size = 256;         ///< synthetic: grid size (cells per side)
+    int seed = 1;           ///< synthetic: random seed
+    double relief = 100.0;  ///< synthetic: elevation range (m)
+    std::optional<std::array<int, 4>> window;  ///< col, row, width, height (pixels)
+    double resample = 0.0;        ///< coarser cell size (m); 0 = none
+    int resample_factor = 0;      ///< integer averaging factor; 0 = none
+    double z_scale = 1.0;         ///< multiplier of stored values (1)
+    double cell_size = 0.0;       ///< m; for files without georeferencing (and synthetic)
+    std::string crs;              ///< CRS for files without georeferencing
+  } dem;
+
+  struct Initial {
+    std::optional<double> water_level;  ///< fill active cells up to this surface (m)
+    ScalarOrRaster water_depth;         ///< uniform depth (m) or raster
+  } initial;
+
+  struct Time {
+    long steps = 1000;      ///< number of steps (used when duration == 0)
+    double duration = 0.0;  ///< simulated time (s); 0 = use steps
+    double dt = 0.05;       ///< fixed step (s)
+    bool adaptive = false;  ///< CFL-adaptive step
+    double cfl = 0.7;       ///< Courant number alpha (1)
+    double dt_max = 5.0;    ///< upper bound of the adaptive step (s)
+  } time;
+
+  struct Flow {
+    FlowScheme scheme = FlowScheme::local_inertial;
+    ScalarOrRaster manning_n{0.03, {}};  ///< Manning n (s m^-1/3)
+    double theta = 0.8;                  ///< de Almeida weighting (1)
+    double pipe_area = 1.0;              ///< pipes: cross-section A (m^2)
+    double pipe_length = 0.0;            ///< pipes: length l (m); 0 = the cell size
+    double gravity = 9.81;               ///< g (m/s^2)
+  } flow;
+
+  struct Rain {
+    double rate = 0.0;   ///< uniform rate (m/s), used when `series` is empty
+    Series series;       ///< time (s), rate (m/s), linear in between, 0 outside
+    std::string raster;  ///< optional spatial multiplier raster (1)
+  } rain;
+
+  std::vector<InflowSpec> inflow;
+
+  struct Erosion {
+    bool enabled = false;
+    double sediment_capacity = 1.0;  ///< K_c (s): capacity per unit speed and tilt
+    double dissolving_rate = 0.5;    ///< K_s (1/s)
+    double deposition_rate = 1.0;    ///< K_d (1/s)
+    double min_tilt = 0.05;          ///< sin_min (1)
+    ScalarOrRaster hardness{1.0, {}};  ///< R in [0, 1]
+    double min_depth = 0.0;          ///< d_erosion_min (m): capacity ramps to 0 below; 0 = off
+    std::optional<double> bedrock_level;  ///< no erosion below this elevation (m)
+  } erosion;
+
+  struct Transport {
+    TransportScheme scheme = TransportScheme::conservative;
+  } transport;
+
+  struct Thermal {
+    bool enabled = false;
+    double talus_angle = 35.0;  ///< degrees
+    double rate = 0.15;         ///< K_t (1/s)
+  } thermal;
+
+  struct Evaporation {
+    double rate = 0.0;  ///< K_e (1/s)
+  } evaporation;
+
+  struct Boundary {
+    BoundaryKind north = BoundaryKind::closed;
+    BoundaryKind south = BoundaryKind::closed;
+    BoundaryKind east = BoundaryKind::closed;
+    BoundaryKind west = BoundaryKind::closed;
+    double sea_level = 0.0;  ///< level of fixed_level edges and sea nodata cells (m)
+    NodataKind nodata = NodataKind::wall;
+  } boundary;
+
+  struct Output {
+    std::string path = "run.h5";
+    long every = 100;        ///< steps between snapshots
+    double interval = 0.0;   ///< simulated seconds between snapshots; 0 = use `every`
+    std::vector<std::string> fields{"bed", "water_depth", "sediment", "velocity_x",
+                                    "velocity_y", "erosion"};
+    std::vector<std::array<double, 2>> gauges;  ///< x, y in the DEM's CRS
+  } output;
+
+  struct Numerics {
+    Precision precision = Precision::float32;
+    double dry_depth = 1e-6;        ///< m: faces shallower than this carry no flow (local_inertial)
+    double velocity_min_depth = 1e-3;  ///< d_min (m): velocity is 0 below this mean depth
+    double wetness_time = 3600.0;   ///< s: time constant of the wetness running mean
+    int threads = 0;                ///< CPU threads; 0 = all cores
+  } numerics;
+};
+
+}  // namespace erodem

@@ -1,0 +1,66 @@
+// erodem — seeded, reproducible synthetic terrain for controlled experiments
+// (`erodem generate`, `[dem] synthetic = "..."`).
+//
+// Reproducibility: the generators use their own PRNG (splitmix64) and integer hashing,
+// and only IEEE-754 correctly rounded operations (+, -, *, /, sqrt, floor, ldexp) with
+// floating-point contraction (FMA fusion) disabled in terrain_synth.cpp, so the same
+// arguments give bit-identical heights on every conforming machine and compiler.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "erodem/grid.hpp"
+#include "erodem/params.hpp"
+
+namespace erodem {
+
+/// The synthetic terrain generators.
+enum class SynthKind {
+  fbm,             ///< fractal Brownian motion of 2-D Perlin gradient noise
+  ridged,          ///< ridged multifractal: weighted octaves of (1 - |noise|)^2
+  diamond_square,  ///< midpoint displacement on the next 2^k + 1 grid, cropped
+  hill,            ///< one smooth Gaussian hill in the middle plus a little fbm
+  lake,            ///< a closed circular depression (bowl) inside a raised rim
+  valley,          ///< a valley sloping down towards +x (east) with a channel along its axis
+  ridge,           ///< a ridge line along the grid diagonal, top-left to bottom-right
+};
+
+/// The generator names, in enum order: "fbm", "ridged", "diamond_square", "hill", "lake",
+/// "valley", "ridge".
+const std::vector<std::string>& synth_kind_names();
+
+/// The name of `kind` (one of synth_kind_names()).
+std::string to_string(SynthKind kind);
+
+/// Parses a generator name (exact, lower case). Throws erodem::Error(ExitCode::usage)
+/// listing the accepted names when `name` is none of them.
+SynthKind synth_kind_from_string(const std::string& name);
+
+/// Generates a synthetic terrain.
+///
+/// @param kind         the generator
+/// @param nx           number of columns (cells, >= 1)
+/// @param ny           number of rows (cells, >= 1); row 0 is the north edge
+/// @param cell_size_m  horizontal cell size (m, finite, > 0). The shapes are defined
+///                     relative to the grid extent (in cells), so the heights do not depend
+///                     on it; it is validated so that callers cannot pass nonsense.
+/// @param relief_m     elevation range (m, finite, > 0): the output spans [0, relief_m]
+///                     (exactly 0 and relief_m at its minimum and maximum when nx*ny > 1)
+/// @param seed         random seed (any value); the same seed gives bit-identical output
+/// @return             nx * ny heights (m), row-major (index row * nx + col), in [0, relief_m]
+///
+/// Throws erodem::Error(ExitCode::usage) for non-positive sizes or a bad cell size or
+/// relief, and when nx * ny exceeds 2^30 cells.
+std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell_size_m,
+                                     double relief_m, std::uint64_t seed);
+
+/// Builds a Terrain from the `[dem]` synthetic settings: kind `dem.synthetic`, a square grid
+/// of `dem.size` cells per side (Grid::uniform, no CRS), cell size `dem.cell_size` (m; 10 m
+/// when 0), relief `dem.relief` (m), seed `dem.seed`. All cells active; `source` describes
+/// the generator, e.g. "synthetic:fbm size=256 seed=1 relief=100 m cell=10 m".
+/// Throws erodem::Error(ExitCode::config) naming the key for invalid settings.
+Terrain make_synthetic_terrain(const Params::Dem& dem);
+
+}  // namespace erodem

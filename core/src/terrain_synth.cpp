@@ -1,0 +1,391 @@
+// erodem — seeded, reproducible synthetic terrain. See terrain_synth.hpp.
+//
+// Bit-reproducibility rules followed in this file: no std:: random distributions, no libm
+// transcendental functions (exp, sin, pow, log, ... are not correctly rounded and differ
+// between C libraries); only +, -, *, /, sqrt, floor, fabs and ldexp, which IEEE-754 defines
+// exactly; and no contraction of a * b + c into a fused multiply-add (which some targets,
+// e.g. aarch64, would otherwise do), switched off below for this translation unit.
+// Do not build this file with -ffast-math or clang's -ffp-contract=fast (which ignores the
+// pragma); the golden digests in tests/test_terrain_raster.cpp catch such a build.
+#if defined(__clang__)
+#pragma clang fp contract(off)
+#elif defined(__GNUC__)
+#pragma GCC optimize("fp-contract=off")
+#endif
+
+#include "erodem/terrain_synth.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "erodem/error.hpp"
+
+namespace erodem {
+namespace {
+
+// ---- random numbers -------------------------------------------------------------------
+
+/// splitmix64 finaliser: a bijective 64-bit mixer.
+std::uint64_t mix64(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+/// splitmix64 generator (Steele, Lea & Flood 2014).
+class SplitMix64 {
+ public:
+  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() { return mix64(state_ += 0x9E3779B97F4A7C15ULL); }
+  /// Uniform in [0, 1) with 53 random bits.
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  /// Uniform in [-1, 1).
+  double symmetric() { return 2.0 * uniform() - 1.0; }
+
+ private:
+  std::uint64_t state_;
+};
+
+/// Hash of an integer lattice point and a seed.
+std::uint64_t hash2(std::int64_t ix, std::int64_t iy, std::uint64_t seed) {
+  std::uint64_t h = mix64(seed ^ (static_cast<std::uint64_t>(ix) * 0x9E3779B97F4A7C15ULL));
+  return mix64(h ^ (static_cast<std::uint64_t>(iy) * 0xC2B2AE3D27D4EB4FULL));
+}
+
+/// exp(x) from basic operations only (range reduction by ln 2 and a degree-13 Taylor
+/// polynomial, relative error ~1e-15), so that it is the same on every machine.
+double det_exp(double x) {
+  if (x < -700.0) return 0.0;
+  if (x > 700.0) return std::numeric_limits<double>::infinity();
+  const double ln2 = 0.6931471805599453;
+  const double k = std::floor(x / ln2 + 0.5);
+  const double r = x - k * ln2;  // |r| <= ~0.35
+  double p = 1.0;
+  for (int i = 13; i >= 1; --i) p = 1.0 + p * r / i;
+  return std::ldexp(p, static_cast<int>(k));
+}
+
+// ---- Perlin gradient noise ------------------------------------------------------------
+
+double fade(double t) {
+  return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+}
+double lerp(double a, double b, double t) {
+  return a + t * (b - a);
+}
+
+/// Dot product of one of 8 unit gradients (axes and diagonals) with (dx, dy).
+double grad(std::uint64_t h, double dx, double dy) {
+  const double k = 0.70710678118654752440;  // 1 / sqrt(2)
+  switch (static_cast<unsigned>(h >> 61)) {
+    case 0:
+      return dx;
+    case 1:
+      return -dx;
+    case 2:
+      return dy;
+    case 3:
+      return -dy;
+    case 4:
+      return (dx + dy) * k;
+    case 5:
+      return (dx - dy) * k;
+    case 6:
+      return (dy - dx) * k;
+    default:
+      return -(dx + dy) * k;
+  }
+}
+
+/// 2-D Perlin gradient noise at (x, y) in lattice units; roughly in [-1, 1], 0 at lattice
+/// points. The lattice gradients are hashed from the coordinates, so there is no period.
+double perlin(double x, double y, std::uint64_t seed) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const auto ix = static_cast<std::int64_t>(fx);
+  const auto iy = static_cast<std::int64_t>(fy);
+  const double tx = x - fx, ty = y - fy;
+  const double n00 = grad(hash2(ix, iy, seed), tx, ty);
+  const double n10 = grad(hash2(ix + 1, iy, seed), tx - 1.0, ty);
+  const double n01 = grad(hash2(ix, iy + 1, seed), tx, ty - 1.0);
+  const double n11 = grad(hash2(ix + 1, iy + 1, seed), tx - 1.0, ty - 1.0);
+  const double u = fade(tx), v = fade(ty);
+  return lerp(lerp(n00, n10, u), lerp(n01, n11, u), v);
+}
+
+/// floor(log2(n)) for n >= 1.
+int ilog2(int n) {
+  int k = 0;
+  while (n > 1) {
+    n >>= 1;
+    ++k;
+  }
+  return k;
+}
+
+/// A sum of Perlin octaves over the grid: lacunarity 2, gain 0.5, the first octave with a
+/// period of half the larger grid side, the last with a period of about 4 cells.
+/// `ridged` selects the ridged multifractal ((1 - |n|)^2 signals weighted by the previous
+/// octave, after Musgrave) instead of plain fbm.
+std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged) {
+  const int side = std::max(nx, ny);
+  const int octaves = std::max(1, ilog2(side) - 2);
+  SplitMix64 rng(seed ^ 0x5DEECE66DULL);
+  std::vector<double> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 0.0);
+  std::vector<double> weight(ridged ? out.size() : 0, 1.0);
+  double freq = 2.0 / side;  // lattice cells per grid cell
+  double amp = 1.0;
+  for (int o = 0; o < octaves; ++o) {
+    const std::uint64_t oseed = rng.next();
+    const double ox = 1024.0 * rng.uniform(), oy = 1024.0 * rng.uniform();
+    for (int r = 0; r < ny; ++r) {
+      for (int c = 0; c < nx; ++c) {
+        const std::size_t i = static_cast<std::size_t>(r) * nx + c;
+        const double n = perlin(ox + (c + 0.5) * freq, oy + (r + 0.5) * freq, oseed);
+        if (ridged) {
+          double s = 1.0 - std::fabs(n);
+          s = s * s * weight[i];
+          weight[i] = std::min(1.0, std::max(0.0, 2.0 * s));
+          out[i] += amp * s;
+        } else {
+          out[i] += amp * n;
+        }
+      }
+    }
+    freq *= 2.0;
+    amp *= 0.5;
+  }
+  return out;
+}
+
+/// Diamond-square midpoint displacement on an n x n grid, n = 2^k + 1 >= max(nx, ny),
+/// cropped to the top-left nx x ny cells. Displacements shrink by 0.55 per level
+/// (Hurst exponent ~0.86).
+std::vector<double> diamond_square(int nx, int ny, std::uint64_t seed) {
+  int n = 2;
+  while (n + 1 < std::max(nx, ny)) n *= 2;
+  const int size = n + 1;
+  std::vector<double> h(static_cast<std::size_t>(size) * size, 0.0);
+  auto at = [&](int c, int r) -> double& { return h[static_cast<std::size_t>(r) * size + c]; };
+  SplitMix64 rng(seed ^ 0x2545F4914F6CDD1DULL);
+  at(0, 0) = rng.symmetric();
+  at(n, 0) = rng.symmetric();
+  at(0, n) = rng.symmetric();
+  at(n, n) = rng.symmetric();
+  double scale = 1.0;
+  for (int step = n; step > 1; step /= 2) {
+    const int half = step / 2;
+    // Diamond step: centres of squares.
+    for (int r = half; r < size; r += step)
+      for (int c = half; c < size; c += step)
+        at(c, r) = 0.25 * (at(c - half, r - half) + at(c + half, r - half) +
+                           at(c - half, r + half) + at(c + half, r + half)) +
+                   scale * rng.symmetric();
+    // Square step: edge midpoints, averaging the neighbours that exist.
+    for (int r = 0; r < size; r += half) {
+      for (int c = (r / half) % 2 == 0 ? half : 0; c < size; c += step) {
+        double sum = 0.0;
+        int count = 0;
+        if (c >= half) sum += at(c - half, r), ++count;
+        if (c + half < size) sum += at(c + half, r), ++count;
+        if (r >= half) sum += at(c, r - half), ++count;
+        if (r + half < size) sum += at(c, r + half), ++count;
+        at(c, r) = sum / count + scale * rng.symmetric();
+      }
+    }
+    scale *= 0.55;
+  }
+  std::vector<double> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) out[static_cast<std::size_t>(r) * nx + c] = at(c, r);
+  return out;
+}
+
+/// Normalised cell-centre coordinates: u = x / width, v = y / height, both in (0, 1),
+/// v growing southwards (row order).
+struct Coords {
+  int nx, ny;
+  double u(int c) const { return (c + 0.5) / nx; }
+  double v(int r) const { return (r + 0.5) / ny; }
+};
+
+/// Adds `fraction` of unit-amplitude fbm (scaled to [-0.5, 0.5]) to `base`.
+void add_fbm(std::vector<double>& base, int nx, int ny, std::uint64_t seed, double fraction) {
+  const std::vector<double> n = octave_noise(nx, ny, seed, false);
+  const auto mm = std::minmax_element(n.begin(), n.end());
+  const double range = *mm.second - *mm.first;
+  if (!(range > 0.0)) return;
+  for (std::size_t i = 0; i < base.size(); ++i)
+    base[i] += fraction * ((n[i] - *mm.first) / range - 0.5);
+}
+
+std::vector<double> hill(int nx, int ny, std::uint64_t seed) {
+  const Coords g{nx, ny};
+  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  const double sigma = 0.2;  // of the grid extent
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
+      h[static_cast<std::size_t>(r) * nx + c] =
+          det_exp(-(du * du + dv * dv) / (2.0 * sigma * sigma));
+    }
+  add_fbm(h, nx, ny, seed, 0.05);
+  return h;
+}
+
+std::vector<double> lake(int nx, int ny, std::uint64_t seed) {
+  const Coords g{nx, ny};
+  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  const double rim = 0.3;  // rim radius, of the grid extent
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
+      const double d = std::sqrt(du * du + dv * dv) / rim;  // 1 on the rim crest
+      double z;
+      if (d <= 1.0) {
+        z = d * d;  // parabolic bowl, 0 at the centre, 1 on the crest
+      } else {
+        const double t = std::min(1.0, (d - 1.0) / 0.5);  // outer flank, then a plain
+        z = 1.0 - 0.5 * t * t * (3.0 - 2.0 * t);
+      }
+      h[static_cast<std::size_t>(r) * nx + c] = z;
+    }
+  add_fbm(h, nx, ny, seed, 0.04);
+  return h;
+}
+
+std::vector<double> valley(int nx, int ny, std::uint64_t seed) {
+  const Coords g{nx, ny};
+  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  const double width = 0.03;  // channel half-width, of the grid height
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const double u = g.u(c);
+      const double d = std::fabs(g.v(r) - 0.5) * 2.0;  // 0 on the axis, 1 at the edges
+      const double thalweg = 0.5 * (1.0 - u);          // down towards +x (east)
+      const double sides = 0.5 * d * std::sqrt(d);     // between a V (d) and a U (d^2)
+      const double channel = 0.03 * det_exp(-(d * d) / (width * width));
+      h[static_cast<std::size_t>(r) * nx + c] = thalweg + sides - channel;
+    }
+  add_fbm(h, nx, ny, seed, 0.02);
+  return h;
+}
+
+std::vector<double> ridge(int nx, int ny, std::uint64_t seed) {
+  const Coords g{nx, ny};
+  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      // Distance from the diagonal u = v, in units of its distance to the far corners.
+      const double d = std::fabs(g.u(c) - g.v(r));
+      const double t = std::max(0.0, 1.0 - d);
+      h[static_cast<std::size_t>(r) * nx + c] = t * std::sqrt(t);
+    }
+  add_fbm(h, nx, ny, seed, 0.05);
+  return h;
+}
+
+/// Maps `h` linearly onto [0, relief]; a constant field becomes 0.
+void normalise(std::vector<double>& h, double relief) {
+  const auto mm = std::minmax_element(h.begin(), h.end());
+  const double lo = *mm.first, range = *mm.second - lo;
+  for (double& z : h) {
+    z = range > 0.0 ? (z - lo) / range * relief : 0.0;
+    z = std::min(relief, std::max(0.0, z));
+  }
+}
+
+}  // namespace
+
+const std::vector<std::string>& synth_kind_names() {
+  static const std::vector<std::string> names{"fbm",  "ridged", "diamond_square", "hill",
+                                              "lake", "valley", "ridge"};
+  return names;
+}
+
+std::string to_string(SynthKind kind) {
+  return synth_kind_names().at(static_cast<std::size_t>(kind));
+}
+
+SynthKind synth_kind_from_string(const std::string& name) {
+  const auto& names = synth_kind_names();
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<SynthKind>(i);
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw Error(ExitCode::usage, "unknown terrain kind '" + name + "'; choose one of: " + list);
+}
+
+std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell_size_m,
+                                     double relief_m, std::uint64_t seed) {
+  if (nx < 1 || ny < 1)
+    throw Error(ExitCode::usage, "synthetic terrain: size " + std::to_string(nx) + " x " +
+                                     std::to_string(ny) + " must be at least 1 x 1");
+  if (static_cast<double>(nx) * ny > 1073741824.0)
+    throw Error(ExitCode::usage, "synthetic terrain: size " + std::to_string(nx) + " x " +
+                                     std::to_string(ny) + " exceeds 2^30 cells");
+  if (!(std::isfinite(cell_size_m) && cell_size_m > 0.0))
+    throw Error(ExitCode::usage, "synthetic terrain: cell size must be a positive number of m");
+  if (!(std::isfinite(relief_m) && relief_m > 0.0))
+    throw Error(ExitCode::usage, "synthetic terrain: relief must be a positive number of m");
+
+  std::vector<double> h;
+  switch (kind) {
+    case SynthKind::fbm:
+      h = octave_noise(nx, ny, seed, false);
+      break;
+    case SynthKind::ridged:
+      h = octave_noise(nx, ny, seed, true);
+      break;
+    case SynthKind::diamond_square:
+      h = diamond_square(nx, ny, seed);
+      break;
+    case SynthKind::hill:
+      h = hill(nx, ny, seed);
+      break;
+    case SynthKind::lake:
+      h = lake(nx, ny, seed);
+      break;
+    case SynthKind::valley:
+      h = valley(nx, ny, seed);
+      break;
+    case SynthKind::ridge:
+      h = ridge(nx, ny, seed);
+      break;
+    default:
+      throw Error(ExitCode::internal, "synthetic terrain: unknown kind");
+  }
+  normalise(h, relief_m);
+  return h;
+}
+
+Terrain make_synthetic_terrain(const Params::Dem& dem) {
+  SynthKind kind;
+  try {
+    kind = synth_kind_from_string(dem.synthetic);
+  } catch (const Error& e) {
+    throw config_error("dem.synthetic", e.what());
+  }
+  if (dem.size < 1 || dem.size > 32768)
+    throw config_error("dem.size",
+                       "must be between 1 and 32768 cells, got " + std::to_string(dem.size));
+  if (!(std::isfinite(dem.cell_size) && dem.cell_size >= 0.0))
+    throw config_error("dem.cell_size", "must be a positive length (m)");
+  if (!(std::isfinite(dem.relief) && dem.relief > 0.0))
+    throw config_error("dem.relief", "must be a positive length (m)");
+  const double cell = dem.cell_size > 0.0 ? dem.cell_size : 10.0;
+
+  Terrain t;
+  t.grid = Grid::uniform(dem.size, dem.size, cell);
+  // The seed is an int in the configuration; its two's-complement bits seed the PRNG.
+  const auto seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(dem.seed));
+  t.bed = generate_terrain(kind, dem.size, dem.size, cell, dem.relief, seed);
+  std::ostringstream src;
+  src << "synthetic:" << to_string(kind) << " size=" << dem.size << " seed=" << dem.seed
+      << " relief=" << dem.relief << " m cell=" << cell << " m";
+  t.source = src.str();
+  return t;
+}
+
+}  // namespace erodem

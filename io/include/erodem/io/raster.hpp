@@ -1,0 +1,90 @@
+// erodem — raster input and output through GDAL: DEMs, parameter rasters, GeoTIFF export.
+//
+// All functions are safe to call from several threads (GDAL is registered once, GDAL's own
+// messages are silenced per thread and turned into erodem::Error messages) and release
+// every GDAL handle on every path, errors included.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "erodem/grid.hpp"
+#include "erodem/params.hpp"
+
+namespace erodem::io {
+
+/// Reads a DEM with GDAL (any raster format GDAL reads: GeoTIFF, PNG, ESRI ASCII, ...).
+///
+/// Uses these `[dem]` settings:
+/// - `path`: the file; missing -> Error(ExitCode::no_input); not a raster GDAL can read or
+///   unreadable -> Error(ExitCode::data).
+/// - `window` (col, row, width, height; pixels): reads only that part; a window not inside
+///   the raster -> Error(ExitCode::data) naming the window and the raster size. The grid's
+///   geotransform is shifted to the window's top-left corner.
+/// - `z_scale` (1): multiplies the stored values, after the band's own scale and offset.
+/// - `cell_size` (m) and `crs`: only for files without georeferencing (see below).
+///
+/// Band 1 is read as double. Cells that are nodata (the band's nodata value, mask band or
+/// alpha) or not finite get mask 0 and bed NaN; `mask` is left empty when every cell is
+/// valid. A file without any valid cell -> Error(ExitCode::data).
+///
+/// Georeferencing: a file is georeferenced when it has a geotransform and a CRS (or was
+/// written by write_geotiff() from a grid without CRS, whose transform is in metres).
+/// - Projected (or local) CRS: the file's geotransform and CRS (WKT); dx = |pixel width|
+///   and dy = |pixel height| times the CRS's linear unit in metres. Rotated geotransforms
+///   -> Error(ExitCode::data).
+/// - Geographic (lat/lon) CRS: Error(ExitCode::data, "... not yet supported").
+/// - No geotransform, or no CRS: requires `dem.cell_size` > 0, else
+///   Error(ExitCode::config, "<path>: has no georeferencing; set dem.cell_size (and
+///   dem.crs)"). The grid is then Grid::uniform(width, height, cell_size) (origin (0, 0) at
+///   the bottom-left corner) with `has_transform` false. Alternatively, for a file with a
+///   geotransform but no CRS, `dem.crs` alone (a projected CRS) takes the file's transform
+///   as given in that CRS. `dem.crs`, when given, must be a projected CRS GDAL recognises
+///   ("EPSG:32610", WKT, PROJ string); it becomes `crs_wkt`.
+/// - `dem.cell_size` or `dem.crs` given for a file that is georeferenced already ->
+///   Error(ExitCode::config) (they never silently override the file).
+///
+/// `source` is the path and `source_sha256` the SHA-256 of the file's bytes (lower-case
+/// hex). Only `grid`, `bed`, `mask`, `source` and `source_sha256` are filled.
+Terrain read_dem(const Params::Dem& dem);
+
+/// Reads band 1 of a parameter raster (rain factor, Manning n, hardness, initial depth,
+/// ...) that must lie on `grid`: after applying `window` (col, row, width, height; pixels;
+/// the DEM's window), its size must be grid.nx x grid.ny, else Error(ExitCode::data) naming
+/// the key `what`, the file and both sizes. When both the raster and the grid carry a
+/// geotransform, they must agree (origin and pixel size within 1e-6 of a cell), else
+/// Error(ExitCode::data). Values are in the file's units (times the band's scale, plus its
+/// offset); nodata and non-finite cells are NaN. Missing file -> Error(ExitCode::no_input),
+/// unreadable -> Error(ExitCode::data); messages start with `what` and the path.
+std::vector<double> read_raster_on_grid(const std::string& path, const Grid& grid,
+                                        const std::optional<std::array<int, 4>>& window,
+                                        const std::string& what);
+
+/// Writes `values` (grid.nx * grid.ny, row-major, row 0 north) as a float32 GeoTIFF with
+/// the grid's geotransform and CRS (WKT), DEFLATE-compressed (floating-point predictor,
+/// tiled, BigTIFF when needed). `description` becomes the band description and the
+/// TIFF image description; `nodata` the band's nodata value (NaN by default: NaN cells are
+/// nodata). A grid without CRS is tagged so that read_dem() takes its transform as metres.
+///
+/// The file is written to a temporary file in the same directory and renamed into place
+/// only when complete, so `path` never holds partial output. On failure the temporary file
+/// is removed and Error(ExitCode::cant_create) (cannot create the file) or
+/// Error(ExitCode::io) (writing failed) naming `path` is thrown. A values size that does
+/// not match the grid -> Error(ExitCode::internal).
+void write_geotiff(const std::string& path, const Grid& grid, const std::vector<float>& values,
+                   const std::string& description,
+                   double nodata = std::numeric_limits<double>::quiet_NaN());
+
+/// SHA-256 of a file's bytes as 64 lower-case hex digits (GDAL /vsi paths work too).
+/// Throws Error(ExitCode::no_input) when the file cannot be opened, Error(ExitCode::io)
+/// when reading fails.
+std::string file_sha256(const std::string& path);
+
+/// SHA-256 of a byte string as 64 lower-case hex digits.
+std::string sha256_hex(const void* data, std::size_t size);
+
+}  // namespace erodem::io

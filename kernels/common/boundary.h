@@ -1,0 +1,42 @@
+/* erodem — boundary ghosts (MODEL.md "Boundaries"): the state of the halo cells. */
+#ifndef ERODEM_KERNELS_COMMON_BOUNDARY_H
+#define ERODEM_KERNELS_COMMON_BOUNDARY_H
+
+#include "compat.h"
+
+ERODEM_BEGIN_NAMESPACE
+
+/* Set bed and depth of halo cell (x, y) from the edge cell inside it:
+ *  - open: bed one cell of the local slope below the edge cell's bed, same depth (free,
+ *    zero-gradient outflow);
+ *  - fixed_level: water surface at sea_level (m) over a bed no higher than the edge's.
+ * Walls and corners keep what they have: no water crosses their faces. */
+ERODEM_FN void boundary_fill_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
+                                  GLOBAL real* bed, GLOBAL real* depth, real sea_level) {
+  const int i = x + y * W;
+  const int k = kind[i];
+  if (k != ERODEM_CELL_OPEN && k != ERODEM_CELL_FIXED) return;
+  int step = 0; /* index step from the ghost inwards */
+  if (x == 0) step = 1;
+  else if (x == W - 1) step = -1;
+  else if (y == 0) step = W;
+  else if (y == H - 1) step = -W;
+  else return; /* interior ghosts (nodata as sea) keep their state */
+  const int e = i + step;
+  const real b_e = bed[e];
+  if (k == ERODEM_CELL_OPEN) {
+    const int e2 = e + step; /* inside the padded raster, since W, H >= 3 */
+    const int has_inner = kind[e2] == ERODEM_CELL_ACTIVE;
+    const real slope_drop = has_inner ? fabs(b_e - bed[e2]) : (real)0;
+    bed[i] = b_e - slope_drop;
+    depth[i] = depth[e];
+  } else {
+    const real b_g = fmin(b_e, sea_level);
+    bed[i] = b_g;
+    depth[i] = sea_level - b_g;
+  }
+}
+
+ERODEM_END_NAMESPACE
+
+#endif

@@ -1,0 +1,74 @@
+/* erodem — suspended-sediment transport (MODEL.md step 5), two schemes. */
+#ifndef ERODEM_KERNELS_COMMON_TRANSPORT_H
+#define ERODEM_KERNELS_COMMON_TRANSPORT_H
+
+#include "compat.h"
+
+ERODEM_BEGIN_NAMESPACE
+
+/* Sediment carried per unit of water (m/m): suspended layer s over the water depth that the
+ * flow step moved, 0 for a dry cell. */
+ERODEM_FN real sediment_concentration(real sediment, real depth) {
+  return depth > 0 ? sediment / depth : (real)0;
+}
+
+/* Conservative (flux-form upwind) transport for active padded cell (x, y): sediment leaves
+ * with the water that leaves, using the same pipe fluxes as the water update. `depth_flow`
+ * is the depth the flow step limited its outflows by (before the water update), so a cell
+ * never gives more sediment than it holds:
+ *   s_i <- s_i + dt / area_i * (sum_n c_n f_{n->i} - c_i sum_n f_{i->n}),  c = s / d.
+ * Writes sediment_out; returns through *boundary_out the volume (m^3) carried out of the
+ * domain. Conserves sum(s * area) to rounding. */
+ERODEM_FN void transport_conservative_cell(
+    int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* sediment,
+    GLOBAL real* sediment_out, GLOBAL const real* depth_flow, GLOBAL const real* f_left,
+    GLOBAL const real* f_right, GLOBAL const real* f_top, GLOBAL const real* f_bottom,
+    GLOBAL const real* area, real dt, real* boundary_out) {
+  const int i = x + y * W;
+  const real c = sediment_concentration(sediment[i], depth_flow[i]);
+  const real gained = sediment_concentration(sediment[i - 1], depth_flow[i - 1]) * f_right[i - 1] +
+                      sediment_concentration(sediment[i + 1], depth_flow[i + 1]) * f_left[i + 1] +
+                      sediment_concentration(sediment[i - W], depth_flow[i - W]) * f_bottom[i - W] +
+                      sediment_concentration(sediment[i + W], depth_flow[i + W]) * f_top[i + W];
+  const real given = c * (f_left[i] + f_right[i] + f_top[i] + f_bottom[i]);
+  sediment_out[i] = sediment[i] + dt * (gained - given) / area[y];
+  real to_ghosts = 0;
+  if (kind[i - 1] != ERODEM_CELL_ACTIVE) to_ghosts += f_left[i];
+  if (kind[i + 1] != ERODEM_CELL_ACTIVE) to_ghosts += f_right[i];
+  if (kind[i - W] != ERODEM_CELL_ACTIVE) to_ghosts += f_top[i];
+  if (kind[i + W] != ERODEM_CELL_ACTIVE) to_ghosts += f_bottom[i];
+  *boundary_out = dt * c * to_ghosts;
+}
+
+/* Semi-Lagrangian transport (Mei et al. 2007) for active padded cell (x, y):
+ *   s(x) <- s(x - v dt), bilinear, the departure point clamped to the DEM.
+ * Fast and not conservative: the caller measures the change of sum(s * area). Velocity
+ * (m/s): velocity_x eastwards, velocity_y northwards (rows grow southwards). */
+ERODEM_FN real transport_semi_lagrangian_cell(int x, int y, int W, int H,
+                                              GLOBAL const real* sediment,
+                                              GLOBAL const real* velocity_x,
+                                              GLOBAL const real* velocity_y,
+                                              GLOBAL const real* dx, GLOBAL const real* dy,
+                                              real dt) {
+  const int i = x + y * W;
+  real px = (real)x - velocity_x[i] * dt / dx[y];
+  real py = (real)y + velocity_y[i] * dt / dy[y];
+  px = fmin(fmax(px, (real)1), (real)(W - 2));
+  py = fmin(fmax(py, (real)1), (real)(H - 2));
+  int x0 = (int)px;
+  int y0 = (int)py;
+  if (x0 > W - 3) x0 = W - 3;
+  if (y0 > H - 3) y0 = H - 3;
+  if (x0 < 1) x0 = 1;
+  if (y0 < 1) y0 = 1;
+  const real tx = px - (real)x0;
+  const real ty = py - (real)y0;
+  const int j = x0 + y0 * W;
+  const real top = sediment[j] * ((real)1 - tx) + sediment[j + 1] * tx;
+  const real bottom = sediment[j + W] * ((real)1 - tx) + sediment[j + W + 1] * tx;
+  return top * ((real)1 - ty) + bottom * ty;
+}
+
+ERODEM_END_NAMESPACE
+
+#endif

@@ -1,0 +1,66 @@
+/* erodem — water update and velocity (MODEL.md step 3). */
+#ifndef ERODEM_KERNELS_COMMON_WATER_H
+#define ERODEM_KERNELS_COMMON_WATER_H
+
+#include "flow.h"
+
+ERODEM_BEGIN_NAMESPACE
+
+/* Depth-averaged velocity (m/s) from the discharge through the two opposite faces of a cell:
+ * through_a, through_b (m^3/s, positive in the velocity's direction), the face width (m)
+ * and the mean depth (m); 0 where the mean depth is below min_depth (m). */
+ERODEM_FN real face_velocity(real through_a, real through_b, real width, real mean_depth,
+                             real min_depth) {
+  return mean_depth < min_depth || !(mean_depth > 0)
+             ? (real)0
+             : (through_a + through_b) * (real)0.5 / (width * mean_depth);
+}
+
+/* Water update of active padded cell (x, y):
+ *   d <- d + dt (sum inflow - sum outflow) / area,
+ * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the mean of the
+ * depths before and after. Writes depth_out; returns through *exchange the net discharge
+ * out of the domain through this cell's faces with ghosts (m^3/s) and through *clipped the
+ * volume (m^3) added to lift a rounding-level negative depth back to zero. */
+ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                 GLOBAL const real* depth, GLOBAL real* depth_out,
+                                 GLOBAL const real* f_left, GLOBAL const real* f_right,
+                                 GLOBAL const real* f_top, GLOBAL const real* f_bottom,
+                                 GLOBAL const real* dx, GLOBAL const real* dy,
+                                 GLOBAL const real* area, GLOBAL real* velocity_x,
+                                 GLOBAL real* velocity_y, real dt, real velocity_min_depth,
+                                 real* exchange, real* clipped) {
+  const int i = x + y * W;
+  /* what each neighbour gives to this cell */
+  const real in_left = f_right[i - 1];
+  const real in_right = f_left[i + 1];
+  const real in_top = f_bottom[i - W];
+  const real in_bottom = f_top[i + W];
+  const real inflow = in_left + in_right + in_top + in_bottom;
+  const real outflow = f_left[i] + f_right[i] + f_top[i] + f_bottom[i];
+  const real d_old = depth[i];
+  real d_new = d_old + dt * (inflow - outflow) / area[y];
+  *clipped = 0;
+  if (d_new < 0) {
+    *clipped = -d_new * area[y];
+    d_new = 0;
+  }
+  depth_out[i] = d_new;
+
+  real ex = 0;
+  if (kind[i - 1] != ERODEM_CELL_ACTIVE) ex += f_left[i] - in_left;
+  if (kind[i + 1] != ERODEM_CELL_ACTIVE) ex += f_right[i] - in_right;
+  if (kind[i - W] != ERODEM_CELL_ACTIVE) ex += f_top[i] - in_top;
+  if (kind[i + W] != ERODEM_CELL_ACTIVE) ex += f_bottom[i] - in_bottom;
+  *exchange = ex;
+
+  const real d_mean = (real)0.5 * (d_old + d_new);
+  velocity_x[i] = face_velocity(in_left - f_left[i], f_right[i] - in_right, dy[y], d_mean,
+                                velocity_min_depth);
+  velocity_y[i] = face_velocity(in_bottom - f_bottom[i], f_top[i] - in_top, dx[y], d_mean,
+                                velocity_min_depth);
+}
+
+ERODEM_END_NAMESPACE
+
+#endif
