@@ -1,0 +1,67 @@
+// erodem — reading configuration files (see config.hpp).
+#include "erodem/io/config.hpp"
+
+#include <toml++/toml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "erodem/error.hpp"
+#include "erodem/schema.hpp"
+
+namespace erodem {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// `path` made absolute against `base_dir` when it is relative and not empty.
+std::string resolve_against(const std::string& path, const fs::path& base_dir) {
+  if (path.empty()) return path;
+  const fs::path p(path);
+  if (p.is_absolute()) return path;
+  return (base_dir / p).lexically_normal().string();
+}
+
+/// The whole file as text; Error(no_input) when it does not exist or is not a file.
+std::string read_config_text(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    throw Error(ExitCode::no_input, path + ": no such config file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(ExitCode::no_input, path + ": cannot open config file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(ExitCode::io, path + ": cannot read config file");
+  return text.str();
+}
+
+}  // namespace
+
+void resolve_relative_paths(Params& p, const std::string& base_dir) {
+  const fs::path base(base_dir.empty() ? "." : base_dir);
+  p.dem.path = resolve_against(p.dem.path, base);
+  p.initial.water_depth.path = resolve_against(p.initial.water_depth.path, base);
+  p.flow.manning_n.path = resolve_against(p.flow.manning_n.path, base);
+  p.erosion.hardness.path = resolve_against(p.erosion.hardness.path, base);
+  p.rain.raster = resolve_against(p.rain.raster, base);
+}
+
+Params load_config(const std::string& path) {
+  const std::string text = read_config_text(path);
+  toml::table table;
+  try {
+    table = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    const auto& where = e.source().begin;
+    throw Error(ExitCode::config, path + ":" + std::to_string(where.line) + ":" +
+                                      std::to_string(where.column) + ": " +
+                                      std::string(e.description()));
+  }
+  Params p = params_from_toml(table, path);
+  resolve_relative_paths(p, fs::path(path).parent_path().string());
+  return p;
+}
+
+}  // namespace erodem
