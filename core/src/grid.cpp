@@ -46,16 +46,16 @@ bool Grid::locate(double x, double y, int& col, int& row) const {
 
 void Grid::validate() const {
   if (nx < 1 || ny < 1)
-    throw Error(ExitCode::data, "grid: size " + std::to_string(nx) + " x " +
-                                    std::to_string(ny) + " must be at least 1 x 1");
+    throw Error(ExitCode::data, "grid: size " + std::to_string(nx) + " x " + std::to_string(ny) +
+                                    " must be at least 1 x 1");
   const auto n = static_cast<std::size_t>(ny);
   if (dx.size() != n || dy.size() != n || area.size() != n)
     throw Error(ExitCode::internal, "grid: per-row cell sizes do not match the row count");
   for (int r = 0; r < ny; ++r)
     if (!(std::isfinite(dx[r]) && dx[r] > 0 && std::isfinite(dy[r]) && dy[r] > 0 &&
           std::isfinite(area[r]) && area[r] > 0))
-      throw Error(ExitCode::data, "grid: row " + std::to_string(r) +
-                                      " has a non-positive or non-finite cell size");
+      throw Error(ExitCode::data,
+                  "grid: row " + std::to_string(r) + " has a non-positive or non-finite cell size");
 }
 
 }  // namespace erodem

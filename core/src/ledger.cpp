@@ -29,10 +29,10 @@ std::string Ledger::format() const {
   s += fmt::format("           closure {:>18.9e}   relative {:>13.3e}\n", closure_error(),
                    relative_closure_error());
   s += fmt::format("  material initial {:>18.9e}   now {:>18.9e}\n", material_initial, material);
-  s += fmt::format("           sediment out {:>13.9e}   transport change {:>10.3e}\n",
-                   sediment_out, transport_change);
-  s += fmt::format("           closure {:>18.9e}   relative {:>13.3e}\n",
-                   material_closure_error(), relative_material_closure_error());
+  s += fmt::format("           sediment out {:>13.9e}   transport change {:>10.3e}\n", sediment_out,
+                   transport_change);
+  s += fmt::format("           closure {:>18.9e}   relative {:>13.3e}\n", material_closure_error(),
+                   relative_material_closure_error());
   return s;
 }
 

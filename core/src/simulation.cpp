@@ -13,14 +13,22 @@ namespace erodem {
 
 const char* process_name(Process p) {
   switch (p) {
-    case Process::boundary: return "boundary";
-    case Process::sources: return "sources";
-    case Process::flow: return "flow";
-    case Process::water: return "water";
-    case Process::erosion: return "erosion";
-    case Process::transport: return "transport";
-    case Process::thermal: return "thermal";
-    case Process::evaporation: return "evaporation";
+    case Process::boundary:
+      return "boundary";
+    case Process::sources:
+      return "sources";
+    case Process::flow:
+      return "flow";
+    case Process::water:
+      return "water";
+    case Process::erosion:
+      return "erosion";
+    case Process::transport:
+      return "transport";
+    case Process::thermal:
+      return "thermal";
+    case Process::evaporation:
+      return "evaporation";
   }
   return "?";
 }
@@ -92,8 +100,9 @@ void Simulation::resolve_inflows() {
       }
     }
     if (ic.cells.empty())
-      throw config_error(key, "no active DEM cell under its point/line (check the coordinates "
-                              "are in the DEM's CRS and inside the grid)");
+      throw config_error(key,
+                         "no active DEM cell under its point/line (check the coordinates "
+                         "are in the DEM's CRS and inside the grid)");
     inflows_.push_back(std::move(ic));
   }
 }
@@ -177,12 +186,12 @@ void Simulation::check_stability(double dt) const {
     const double courant =
         dt * std::sqrt(params_.flow.gravity * stats_.max_depth) / terrain_.grid.dx_min();
     if (courant > 1.0)
-      throw Error(ExitCode::unstable,
-                  fmt::format("CFL violated at step {} (t = {:.6g} s): cell {} with depth "
-                              "{:.6g} m has dt sqrt(g d) / dx = {:.4g} > 1; lower time.dt or "
-                              "set time.adaptive = true",
-                              steps_, time_, cell_name(stats_.max_depth_cell), stats_.max_depth,
-                              courant));
+      throw Error(
+          ExitCode::unstable,
+          fmt::format("CFL violated at step {} (t = {:.6g} s): cell {} with depth "
+                      "{:.6g} m has dt sqrt(g d) / dx = {:.4g} > 1; lower time.dt or "
+                      "set time.adaptive = true",
+                      steps_, time_, cell_name(stats_.max_depth_cell), stats_.max_depth, courant));
   }
 }
 

@@ -12,9 +12,8 @@ namespace erodem::io {
 namespace {
 
 /// Reads a parameter raster and checks its active cells hold finite values in [lo, hi].
-std::vector<double> parameter_raster(const std::string& path, const Terrain& t,
-                                     const Params& p, const std::string& key, double lo,
-                                     double hi) {
+std::vector<double> parameter_raster(const std::string& path, const Terrain& t, const Params& p,
+                                     const std::string& key, double lo, double hi) {
   auto v = read_raster_on_grid(path, t.grid, p.dem.window, key);
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!t.active(i)) continue;
@@ -37,8 +36,8 @@ Terrain load_terrain(const Params& p) {
     throw Error(ExitCode::data, t.source + ": every cell is nodata; nothing to simulate");
   const double inf = HUGE_VAL;
   if (p.initial.water_depth.is_raster())
-    t.water_depth = parameter_raster(p.initial.water_depth.path, t, p, "initial.water_depth",
-                                     0.0, inf);
+    t.water_depth =
+        parameter_raster(p.initial.water_depth.path, t, p, "initial.water_depth", 0.0, inf);
   if (p.flow.manning_n.is_raster())
     t.manning_n = parameter_raster(p.flow.manning_n.path, t, p, "flow.manning_n", 0.0, 1.0);
   if (p.erosion.hardness.is_raster())

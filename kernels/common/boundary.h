@@ -17,11 +17,16 @@ ERODEM_FN void boundary_fill_cell(int x, int y, int W, int H, GLOBAL const erode
   const int k = kind[i];
   if (k != ERODEM_CELL_OPEN && k != ERODEM_CELL_FIXED) return;
   int step = 0; /* index step from the ghost inwards */
-  if (x == 0) step = 1;
-  else if (x == W - 1) step = -1;
-  else if (y == 0) step = W;
-  else if (y == H - 1) step = -W;
-  else return; /* interior ghosts (nodata as sea) keep their state */
+  if (x == 0)
+    step = 1;
+  else if (x == W - 1)
+    step = -1;
+  else if (y == 0)
+    step = W;
+  else if (y == H - 1)
+    step = -W;
+  else
+    return; /* interior ghosts (nodata as sea) keep their state */
   const int e = i + step;
   const real b_e = bed[e];
   if (k == ERODEM_CELL_OPEN) {

@@ -1,7 +1,7 @@
 /* erodem — the common subset of C++ and OpenCL C in which per-cell formulas are written.
  *
- * Every process of MODEL.md is written once, as functions of one cell, in the headers of kernels/common.
- * The CPU reference (kernels/cpu) loops over cells calling them; the OpenCL kernels
+ * Every process of MODEL.md is written once, as functions of one cell, in the headers of
+ * kernels/common. The CPU reference (kernels/cpu) loops over cells calling them; the OpenCL kernels
  * (kernels/opencl) call the same functions from one work-item per cell. In C++ the
  * functions are templates on the floating-point type `real` (float or double); in OpenCL C
  * `real` is a typedef set by the build options.
@@ -30,12 +30,14 @@ using std::cbrt;
 using std::fabs;
 using std::fmax;
 using std::fmin;
-using std::sqrt;
 using std::isfinite;
+using std::sqrt;
 typedef std::uint8_t erodem_kind_t;
 }  // namespace cell
 }  // namespace erodem
-#define ERODEM_FN template <class real> inline
+#define ERODEM_FN       \
+  template <class real> \
+  inline
 #define ERODEM_INLINE inline
 #define GLOBAL
 #define ERODEM_BEGIN_NAMESPACE \

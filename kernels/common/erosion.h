@@ -45,9 +45,9 @@ ERODEM_FN void erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
                             GLOBAL const real* bed, GLOBAL real* bed_out, GLOBAL real* sediment,
                             GLOBAL const real* depth, GLOBAL const real* velocity_x,
                             GLOBAL const real* velocity_y, GLOBAL const real* hardness,
-                            GLOBAL const real* dx, GLOBAL const real* dy, real dt,
-                            real capacity_k, real dissolving_rate, real deposition_rate,
-                            real min_tilt, real min_depth, real bedrock) {
+                            GLOBAL const real* dx, GLOBAL const real* dy, real dt, real capacity_k,
+                            real dissolving_rate, real deposition_rate, real min_tilt,
+                            real min_depth, real bedrock) {
   const int i = x + y * W;
   const real u = velocity_x[i];
   const real v = velocity_y[i];

@@ -29,7 +29,9 @@ ERODEM_INLINE int gives_water(int from, int to) {
 }
 
 /* Whether any water crosses the face between kinds a and b. */
-ERODEM_INLINE int face_open(int a, int b) { return gives_water(a, b) || gives_water(b, a); }
+ERODEM_INLINE int face_open(int a, int b) {
+  return gives_water(a, b) || gives_water(b, a);
+}
 
 /* Scale factor K of Mei et al. (2007): a cell holding `depth` (m) over `cell_area` (m^2)
  * gives at most what it holds in one step of `dt` (s) at total outflow `total_out` (m^3/s). */
@@ -70,17 +72,16 @@ ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_k
       fl = pipe_flux_update(f_left[i], dt, pipe_area, gravity, eta - (bed[i - 1] + depth[i - 1]),
                             lx);
     if (gives_water(k, kind_at(kind, x + 1, y, W, H)))
-      fr = pipe_flux_update(f_right[i], dt, pipe_area, gravity,
-                            eta - (bed[i + 1] + depth[i + 1]), lx);
+      fr = pipe_flux_update(f_right[i], dt, pipe_area, gravity, eta - (bed[i + 1] + depth[i + 1]),
+                            lx);
     if (gives_water(k, kind_at(kind, x, y - 1, W, H))) {
       const real l = pipe_length > 0 ? pipe_length : (real)0.5 * (dy[y] + dy[y - 1]);
-      ft = pipe_flux_update(f_top[i], dt, pipe_area, gravity, eta - (bed[i - W] + depth[i - W]),
-                            l);
+      ft = pipe_flux_update(f_top[i], dt, pipe_area, gravity, eta - (bed[i - W] + depth[i - W]), l);
     }
     if (gives_water(k, kind_at(kind, x, y + 1, W, H))) {
       const real l = pipe_length > 0 ? pipe_length : (real)0.5 * (dy[y] + dy[y + 1]);
-      fb = pipe_flux_update(f_bottom[i], dt, pipe_area, gravity,
-                            eta - (bed[i + W] + depth[i + W]), l);
+      fb = pipe_flux_update(f_bottom[i], dt, pipe_area, gravity, eta - (bed[i + W] + depth[i + W]),
+                            l);
     }
     if (k == ERODEM_CELL_ACTIVE) {
       const real K = outflow_limit(depth[i], area[y], fl + fr + ft + fb, dt);
@@ -122,8 +123,8 @@ ERODEM_FN real local_inertial_face_x(int x, int y, int W, int H, GLOBAL const er
                                      GLOBAL const real* bed, GLOBAL const real* depth,
                                      GLOBAL const real* manning, GLOBAL const real* dx,
                                      GLOBAL const real* dy, GLOBAL const real* f_left,
-                                     GLOBAL const real* f_right, real dt, real gravity,
-                                     real theta, real dry_depth) {
+                                     GLOBAL const real* f_right, real dt, real gravity, real theta,
+                                     real dry_depth) {
   if (!face_open(kind_at(kind, x, y, W, H), kind_at(kind, x + 1, y, W, H))) return (real)0;
   const int a = x + y * W;
   const int b = a + 1;
@@ -143,8 +144,8 @@ ERODEM_FN real local_inertial_face_y(int x, int y, int W, int H, GLOBAL const er
                                      GLOBAL const real* bed, GLOBAL const real* depth,
                                      GLOBAL const real* manning, GLOBAL const real* dx,
                                      GLOBAL const real* dy, GLOBAL const real* f_top,
-                                     GLOBAL const real* f_bottom, real dt, real gravity,
-                                     real theta, real dry_depth) {
+                                     GLOBAL const real* f_bottom, real dt, real gravity, real theta,
+                                     real dry_depth) {
   if (!face_open(kind_at(kind, x, y, W, H), kind_at(kind, x, y + 1, W, H))) return (real)0;
   const int a = x + y * W;
   const int b = a + W;
@@ -185,8 +186,8 @@ ERODEM_FN void flow_local_inertial_cell(
       ft = fmax((real)0, -local_inertial_face_y(x, y - 1, W, H, kind, bed, depth, manning, dx, dy,
                                                 f_top, f_bottom, dt, gravity, theta, dry_depth));
     if (gives_water(k, kind_at(kind, x, y + 1, W, H)))
-      fb = fmax((real)0, local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, dx, dy,
-                                               f_top, f_bottom, dt, gravity, theta, dry_depth));
+      fb = fmax((real)0, local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, dx, dy, f_top,
+                                               f_bottom, dt, gravity, theta, dry_depth));
     if (k == ERODEM_CELL_ACTIVE) {
       const real K = outflow_limit(depth[i], area[y], fl + fr + ft + fb, dt);
       fl *= K;

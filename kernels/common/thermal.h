@@ -24,10 +24,14 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real b = bed[i];
   const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
   const real dist_b = (real)0.5 * (dy[y] + dy[y + 1]);
-  const real e_l = kind[i - 1] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i - 1], dx[y], tan_talus) : (real)0;
-  const real e_r = kind[i + 1] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i + 1], dx[y], tan_talus) : (real)0;
-  const real e_t = kind[i - W] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i - W], dist_t, tan_talus) : (real)0;
-  const real e_b = kind[i + W] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i + W], dist_b, tan_talus) : (real)0;
+  const real e_l =
+      kind[i - 1] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i - 1], dx[y], tan_talus) : (real)0;
+  const real e_r =
+      kind[i + 1] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i + 1], dx[y], tan_talus) : (real)0;
+  const real e_t =
+      kind[i - W] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i - W], dist_t, tan_talus) : (real)0;
+  const real e_b =
+      kind[i + W] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i + W], dist_b, tan_talus) : (real)0;
   const real total = e_l + e_r + e_t + e_b;
   if (!(total > 0)) return (real)0;
   const real e_max = fmax(fmax(e_l, e_r), fmax(e_t, e_b));

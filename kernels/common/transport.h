@@ -19,11 +19,12 @@ ERODEM_FN real sediment_concentration(real sediment, real depth) {
  *   s_i <- s_i + dt / area_i * (sum_n c_n f_{n->i} - c_i sum_n f_{i->n}),  c = s / d.
  * Writes sediment_out; returns through *boundary_out the volume (m^3) carried out of the
  * domain. Conserves sum(s * area) to rounding. */
-ERODEM_FN void transport_conservative_cell(
-    int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* sediment,
-    GLOBAL real* sediment_out, GLOBAL const real* depth_flow, GLOBAL const real* f_left,
-    GLOBAL const real* f_right, GLOBAL const real* f_top, GLOBAL const real* f_bottom,
-    GLOBAL const real* area, real dt, real* boundary_out) {
+ERODEM_FN void transport_conservative_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                           GLOBAL const real* sediment, GLOBAL real* sediment_out,
+                                           GLOBAL const real* depth_flow, GLOBAL const real* f_left,
+                                           GLOBAL const real* f_right, GLOBAL const real* f_top,
+                                           GLOBAL const real* f_bottom, GLOBAL const real* area,
+                                           real dt, real* boundary_out) {
   const int i = x + y * W;
   const real c = sediment_concentration(sediment[i], depth_flow[i]);
   const real gained = sediment_concentration(sediment[i - 1], depth_flow[i - 1]) * f_right[i - 1] +
@@ -47,9 +48,8 @@ ERODEM_FN void transport_conservative_cell(
 ERODEM_FN real transport_semi_lagrangian_cell(int x, int y, int W, int H,
                                               GLOBAL const real* sediment,
                                               GLOBAL const real* velocity_x,
-                                              GLOBAL const real* velocity_y,
-                                              GLOBAL const real* dx, GLOBAL const real* dy,
-                                              real dt) {
+                                              GLOBAL const real* velocity_y, GLOBAL const real* dx,
+                                              GLOBAL const real* dy, real dt) {
   const int i = x + y * W;
   real px = (real)x - velocity_x[i] * dt / dx[y];
   real py = (real)y + velocity_y[i] * dt / dy[y];

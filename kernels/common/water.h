@@ -55,10 +55,10 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   *exchange = ex;
 
   const real d_mean = (real)0.5 * (d_old + d_new);
-  velocity_x[i] = face_velocity(in_left - f_left[i], f_right[i] - in_right, dy[y], d_mean,
-                                velocity_min_depth);
-  velocity_y[i] = face_velocity(in_bottom - f_bottom[i], f_top[i] - in_top, dx[y], d_mean,
-                                velocity_min_depth);
+  velocity_x[i] =
+      face_velocity(in_left - f_left[i], f_right[i] - in_right, dy[y], d_mean, velocity_min_depth);
+  velocity_y[i] =
+      face_velocity(in_bottom - f_bottom[i], f_top[i] - in_top, dx[y], d_mean, velocity_min_depth);
 }
 
 ERODEM_END_NAMESPACE

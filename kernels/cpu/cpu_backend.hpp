@@ -40,7 +40,9 @@ class CpuBackend final : public Backend {
  private:
   using Kind = cell::erodem_kind_t;
   /// Index of padded cell (x, y).
-  std::size_t at(int x, int y) const { return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_; }
+  std::size_t at(int x, int y) const {
+    return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
+  }
   /// Index in the padded raster of DEM cell `cell` (row-major (ny, nx)).
   std::size_t padded(std::int64_t cell) const {
     return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1);

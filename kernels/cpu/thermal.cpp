@@ -15,21 +15,21 @@ void CpuBackend<Real>::run_thermal(Real dt) {
   for_rows(1, H_ - 1, [&](int y) {
     for (int x = 1; x < W_ - 1; ++x) {
       const auto i = at(x, y);
-      thermal_share_[i] = kind_[i] == ERODEM_CELL_ACTIVE
-                              ? cell::thermal_share_cell(x, y, W_, kind_.data(), bed_.data(),
-                                                         dx_.data(), dy_.data(), area_.data(), dt,
-                                                         rate, tan_talus)
-                              : Real(0);
+      thermal_share_[i] =
+          kind_[i] == ERODEM_CELL_ACTIVE
+              ? cell::thermal_share_cell(x, y, W_, kind_.data(), bed_.data(), dx_.data(),
+                                         dy_.data(), area_.data(), dt, rate, tan_talus)
+              : Real(0);
     }
   });
   for_rows(1, H_ - 1, [&](int y) {
     for (int x = 1; x < W_ - 1; ++x) {
       const auto i = at(x, y);
-      bed_next_[i] = kind_[i] == ERODEM_CELL_ACTIVE
-                         ? cell::thermal_apply_cell(x, y, W_, kind_.data(), bed_.data(),
-                                                    thermal_share_.data(), dx_.data(), dy_.data(),
-                                                    area_.data(), tan_talus)
-                         : bed_[i];
+      bed_next_[i] =
+          kind_[i] == ERODEM_CELL_ACTIVE
+              ? cell::thermal_apply_cell(x, y, W_, kind_.data(), bed_.data(), thermal_share_.data(),
+                                         dx_.data(), dy_.data(), area_.data(), tan_talus)
+              : bed_[i];
     }
   });
   std::swap(bed_, bed_next_);

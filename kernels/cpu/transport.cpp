@@ -28,9 +28,9 @@ void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
       for (int x = 1; x < W_ - 1; ++x) {
         const auto i = at(x, y);
         if (kind_[i] != ERODEM_CELL_ACTIVE) continue;
-        sediment_next_[i] = cell::transport_semi_lagrangian_cell(
-            x, y, W_, H_, sediment_.data(), velocity_x_.data(), velocity_y_.data(), dx_.data(),
-            dy_.data(), dt);
+        sediment_next_[i] =
+            cell::transport_semi_lagrangian_cell(x, y, W_, H_, sediment_.data(), velocity_x_.data(),
+                                                 velocity_y_.data(), dx_.data(), dy_.data(), dt);
         change_row += (static_cast<double>(sediment_next_[i]) - sediment_[i]) * area_[y];
       }
       row_sums_a_[y] = change_row;

@@ -42,9 +42,9 @@ struct StepInputs {
 struct StepTally {
   double boundary_water_out = 0.0;  ///< net water out through open / fixed-level ghosts
   double evaporated = 0.0;
-  double clipped = 0.0;             ///< water added to lift rounding-level negative depths
-  double sediment_out = 0.0;        ///< sediment carried out through the boundary
-  double transport_change = 0.0;    ///< change of sum(s * area) by the transport step
+  double clipped = 0.0;           ///< water added to lift rounding-level negative depths
+  double sediment_out = 0.0;      ///< sediment carried out through the boundary
+  double transport_change = 0.0;  ///< change of sum(s * area) by the transport step
 };
 
 /// Reductions over the active cells, for the ledger and the stability check.
@@ -54,9 +54,9 @@ struct FieldStats {
   double sediment_volume = 0.0;  ///< sum s * area (m^3)
   double max_depth = 0.0;        ///< m
   std::int64_t max_depth_cell = -1;
-  double max_speed = 0.0;        ///< m/s
+  double max_speed = 0.0;  ///< m/s
   std::int64_t max_speed_cell = -1;
-  std::int64_t bad_cell = -1;    ///< first cell with NaN, infinite or negative state; -1: none
+  std::int64_t bad_cell = -1;  ///< first cell with NaN, infinite or negative state; -1: none
 };
 
 class Backend {
@@ -70,6 +70,8 @@ class Backend {
   virtual void run(Process p, const StepInputs& in, StepTally& tally) = 0;
   /// Reductions over the current state.
   virtual FieldStats stats() = 0;
+  /// Waits until every process run so far has finished (for timing; a no-op on the CPU).
+  virtual void finish() {}
   /// A field of the DEM grid, row-major (ny, nx), converted to double.
   virtual std::vector<double> field(FieldId id) const = 0;
   /// Replaces a field of the DEM grid (row-major (ny, nx)).

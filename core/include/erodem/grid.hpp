@@ -15,7 +15,7 @@ struct Georef {
   /// GDAL geotransform: x0, pixel width, row rotation, y0, column rotation, pixel height
   /// (negative for north-up). Coordinates are of the top-left corner of cell (0, 0).
   std::array<double, 6> transform{0.0, 1.0, 0.0, 0.0, 0.0, -1.0};
-  std::string crs_wkt;        ///< WKT of the CRS, empty when unknown
+  std::string crs_wkt;         ///< WKT of the CRS, empty when unknown
   bool has_transform = false;  ///< the source carried a geotransform
   bool is_geographic = false;  ///< lat/lon degrees (cell sizes from the ellipsoid)
 };

@@ -40,16 +40,17 @@ struct InflowSpec {
 struct Params {
   struct Dem {
     std::string path;       ///< DEM file (GDAL raster); empty when `synthetic` is set
-    std::string synthetic;  ///< "", or a generator kind: fbm, ridged, diamond_square, hill, lake, valley, ridge
+    std::string synthetic;  ///< "", or a generator kind: fbm, ridged, diamond_square, hill, lake,
+                            ///< valley, ridge
     int size = 256;         ///< synthetic: grid size (cells per side)
     int seed = 1;           ///< synthetic: random seed
     double relief = 100.0;  ///< synthetic: elevation range (m)
     std::optional<std::array<int, 4>> window;  ///< col, row, width, height (pixels)
-    double resample = 0.0;        ///< coarser cell size (m); 0 = none
-    int resample_factor = 0;      ///< integer averaging factor; 0 = none
-    double z_scale = 1.0;         ///< multiplier of stored values (1)
-    double cell_size = 0.0;       ///< m; for files without georeferencing (and synthetic)
-    std::string crs;              ///< CRS for files without georeferencing
+    double resample = 0.0;                     ///< coarser cell size (m); 0 = none
+    int resample_factor = 0;                   ///< integer averaging factor; 0 = none
+    double z_scale = 1.0;                      ///< multiplier of stored values (1)
+    double cell_size = 0.0;  ///< m; for files without georeferencing (and synthetic)
+    std::string crs;         ///< CRS for files without georeferencing
   } dem;
 
   struct Initial {
@@ -85,12 +86,12 @@ struct Params {
 
   struct Erosion {
     bool enabled = false;
-    double sediment_capacity = 1.0;  ///< K_c (s): capacity per unit speed and tilt
-    double dissolving_rate = 0.5;    ///< K_s (1/s)
-    double deposition_rate = 1.0;    ///< K_d (1/s)
-    double min_tilt = 0.05;          ///< sin_min (1)
-    ScalarOrRaster hardness{1.0, {}};  ///< R in [0, 1]
-    double min_depth = 0.0;          ///< d_erosion_min (m): capacity ramps to 0 below; 0 = off
+    double sediment_capacity = 1.0;       ///< K_c (s): capacity per unit speed and tilt
+    double dissolving_rate = 0.5;         ///< K_s (1/s)
+    double deposition_rate = 1.0;         ///< K_d (1/s)
+    double min_tilt = 0.05;               ///< sin_min (1)
+    ScalarOrRaster hardness{1.0, {}};     ///< R in [0, 1]
+    double min_depth = 0.0;               ///< d_erosion_min (m): capacity ramps to 0 below; 0 = off
     std::optional<double> bedrock_level;  ///< no erosion below this elevation (m)
   } erosion;
 
@@ -119,19 +120,19 @@ struct Params {
 
   struct Output {
     std::string path = "run.h5";
-    long every = 100;        ///< steps between snapshots
-    double interval = 0.0;   ///< simulated seconds between snapshots; 0 = use `every`
-    std::vector<std::string> fields{"bed", "water_depth", "sediment", "velocity_x",
-                                    "velocity_y", "erosion"};
+    long every = 100;       ///< steps between snapshots
+    double interval = 0.0;  ///< simulated seconds between snapshots; 0 = use `every`
+    std::vector<std::string> fields{"bed",        "water_depth", "sediment",
+                                    "velocity_x", "velocity_y",  "erosion"};
     std::vector<std::array<double, 2>> gauges;  ///< x, y in the DEM's CRS
   } output;
 
   struct Numerics {
     Precision precision = Precision::float32;
-    double dry_depth = 1e-6;        ///< m: faces shallower than this carry no flow (local_inertial)
+    double dry_depth = 1e-6;  ///< m: faces shallower than this carry no flow (local_inertial)
     double velocity_min_depth = 1e-3;  ///< d_min (m): velocity is 0 below this mean depth
-    double wetness_time = 3600.0;   ///< s: time constant of the wetness running mean
-    int threads = 0;                ///< CPU threads; 0 = all cores
+    double wetness_time = 3600.0;      ///< s: time constant of the wetness running mean
+    int threads = 0;                   ///< CPU threads; 0 = all cores
   } numerics;
 };
 

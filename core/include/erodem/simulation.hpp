@@ -72,7 +72,7 @@ class Simulation {
  private:
   struct InflowCells {
     std::vector<std::int64_t> cells;  ///< DEM cells the inflow enters, equal shares
-    std::size_t spec = 0;  ///< index into params.inflow
+    std::size_t spec = 0;             ///< index into params.inflow
   };
   void resolve_inflows();
   void check_stability(double dt) const;

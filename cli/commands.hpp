@@ -1,0 +1,24 @@
+// erodem command line — one function per subcommand; each returns the process exit code
+// or throws erodem::Error (mapped to its exit code by main).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+
+namespace erodem::cli {
+
+/// Registers a subcommand on `app` and returns the action to run when it is chosen.
+using Action = std::function<int()>;
+Action add_run(CLI::App& app);
+Action add_generate(CLI::App& app);
+Action add_bench(CLI::App& app);
+
+/// Whether stderr is a terminal (progress bar) or a log (periodic lines).
+bool stderr_is_terminal();
+
+/// Fails with ExitCode::cant_create unless `path` can be created: its folder exists and is
+/// writable, and (without `overwrite`) no file of that name exists yet.
+void check_output_path(const std::string& path, bool overwrite);
+
+}  // namespace erodem::cli

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# erodem — installs everything a fresh Debian machine needs and builds the project.
+# Safe to run twice: installed packages are skipped and the build is incremental.
+# Usage: bash scripts/setup.sh [build-dir]   (default: build)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${1:-build}
+
+DEBIAN_PACKAGES=(
+  build-essential cmake ninja-build pkg-config git clang-format
+  libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
+  libgtest-dev googletest
+  libgdal-dev gdal-bin
+  ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
+)
+
+missing=()
+for p in "${DEBIAN_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# PoCL compiles kernels into a cache; keep it in a writable place.
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$PWD/$BUILD_DIR/pocl-cache}
+mkdir -p "$POCL_CACHE_DIR"
+
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release ${ERODEM_CMAKE_ARGS:-}
+cmake --build "$BUILD_DIR" --parallel "$(nproc)"
+echo "setup: built $BUILD_DIR/cli/erodem"

@@ -1,0 +1,179 @@
+// erodem — the command line end to end: exit codes, messages, no partial output.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "erodem/io/raster.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliResult {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CliResult run_cli(const std::string& args, const fs::path& cwd) {
+  const std::string cmd = "cd '" + cwd.string() + "' && '" ERODEM_CLI_PATH "' " + args + " 2>&1";
+  CliResult r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("erodem_cli_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+  }
+  std::size_t files_matching(const std::string& prefix) const {
+    std::size_t n = 0;
+    for (const auto& e : fs::directory_iterator(dir_))
+      if (e.path().filename().string().rfind(prefix, 0) == 0) ++n;
+    return n;
+  }
+  fs::path dir_;
+};
+
+const char* kConfig = R"([dem]
+path = "hill.tif"
+[initial]
+water_depth = 0.0
+[time]
+steps = 200
+dt = 0.5
+[rain]
+rate = "100 mm/h"
+[erosion]
+enabled = true
+[boundary]
+east = "open"
+[output]
+path = "out.h5"
+fields = ["bed", "water_depth", "erosion"]
+)";
+
+TEST_F(Cli, GenerateIsReproducible) {
+  auto a = run_cli("generate --kind fbm --size 64 --seed 3 a.tif", dir_);
+  auto b = run_cli("generate --kind fbm --size 64 --seed 3 b.tif", dir_);
+  auto c = run_cli("generate --kind fbm --size 64 --seed 4 c.tif", dir_);
+  ASSERT_EQ(a.code, 0) << a.output;
+  ASSERT_EQ(b.code, 0) << b.output;
+  ASSERT_EQ(c.code, 0) << c.output;
+  erodem::Params::Dem d;
+  d.path = (dir_ / "a.tif").string();
+  const auto ta = erodem::io::read_dem(d);
+  d.path = (dir_ / "b.tif").string();
+  const auto tb = erodem::io::read_dem(d);
+  d.path = (dir_ / "c.tif").string();
+  const auto tc = erodem::io::read_dem(d);
+  EXPECT_EQ(ta.grid.nx, 64);
+  EXPECT_EQ(ta.bed, tb.bed);
+  EXPECT_NE(ta.bed, tc.bed);
+  // An existing file is not overwritten.
+  const auto again = run_cli("generate --kind hill --size 32 a.tif", dir_);
+  EXPECT_EQ(again.code, 73) << again.output;
+  d.path = (dir_ / "a.tif").string();
+  EXPECT_EQ(erodem::io::read_dem(d).bed, ta.bed);
+}
+
+TEST_F(Cli, RunWritesFieldsAndPrintsLedger) {
+  ASSERT_EQ(run_cli("generate --kind hill --size 48 --relief 30 hill.tif", dir_).code, 0);
+  write("c.toml", kConfig);
+  const auto r = run_cli("run c.toml", dir_);
+  std::printf("%s", r.output.c_str());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("mass ledger"), std::string::npos);
+  EXPECT_NE(r.output.find("closure"), std::string::npos);
+  EXPECT_EQ(files_matching("out_"), 3u);
+  // A second run refuses to overwrite, and leaves the files as they were.
+  const auto before = fs::last_write_time(dir_ / "out_bed.tif");
+  const auto again = run_cli("run c.toml", dir_);
+  EXPECT_EQ(again.code, 73) << again.output;
+  EXPECT_NE(again.output.find("--overwrite"), std::string::npos);
+  EXPECT_EQ(fs::last_write_time(dir_ / "out_bed.tif"), before);
+  EXPECT_EQ(run_cli("run c.toml --overwrite --set time.steps=3", dir_).code, 0);
+}
+
+TEST_F(Cli, BadConfigValuesExit78WithoutOutput) {
+  ASSERT_EQ(run_cli("generate --kind hill --size 16 hill.tif", dir_).code, 0);
+  struct Case {
+    const char* what;
+    std::string config;
+    const char* args;
+    const char* must_name;
+  };
+  const Case cases[] = {
+      {"negative rain", std::string(kConfig) + "", "--set rain.rate=-5", "rain.rate"},
+      {"unknown key", std::string(kConfig) + "[thermal]\ntalus = 30\n", "", "thermal.talus"},
+      {"bad scheme", kConfig, "--set flow.scheme=upwind", "flow.scheme"},
+      {"negative capacity", kConfig, "--set erosion.sediment_capacity=-1",
+       "erosion.sediment_capacity"},
+      {"bad unit", kConfig, "--set 'rain.rate=20 kg'", "rain.rate"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    write("bad.toml", c.config);
+    const auto r = run_cli(std::string("run bad.toml ") + c.args, dir_);
+    std::printf("[bad config] %s -> exit %d: %s", c.what, r.code, r.output.c_str());
+    EXPECT_EQ(r.code, 78);
+    EXPECT_NE(r.output.find(c.must_name), std::string::npos) << r.output;
+    EXPECT_EQ(files_matching("out_"), 0u);
+  }
+}
+
+TEST_F(Cli, MissingFilesExit66) {
+  auto r = run_cli("run nowhere.toml", dir_);
+  std::printf("[missing config] exit %d: %s", r.code, r.output.c_str());
+  EXPECT_EQ(r.code, 66);
+  EXPECT_NE(r.output.find("nowhere.toml"), std::string::npos);
+  write("c.toml", kConfig);  // refers to hill.tif, which does not exist
+  r = run_cli("run c.toml", dir_);
+  std::printf("[missing DEM] exit %d: %s", r.code, r.output.c_str());
+  EXPECT_EQ(r.code, 66);
+  EXPECT_NE(r.output.find("hill.tif"), std::string::npos);
+  EXPECT_EQ(files_matching("out_"), 0u);
+}
+
+TEST_F(Cli, UnstableRunExit75NamesTheCell) {
+  ASSERT_EQ(run_cli("generate --kind lake --size 32 --relief 20 hill.tif", dir_).code, 0);
+  write("c.toml", kConfig);
+  const auto r = run_cli("run c.toml --set initial.water_depth=5 --set time.dt=30", dir_);
+  std::printf("[unstable] exit %d: %s", r.code, r.output.c_str());
+  EXPECT_EQ(r.code, 75);
+  EXPECT_NE(r.output.find("cell (col"), std::string::npos);
+  EXPECT_EQ(files_matching("out_"), 0u);
+}
+
+TEST_F(Cli, DumpConfigRoundTripsAndUsageErrors) {
+  write("c.toml", kConfig);
+  const auto r = run_cli("run c.toml --set flow.scheme=pipes --dump-config", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("scheme = \"pipes\""), std::string::npos) << r.output;
+  write("dumped.toml", r.output);
+  const auto again = run_cli("run dumped.toml --dump-config", dir_);
+  EXPECT_EQ(again.code, 0) << again.output;
+  EXPECT_EQ(again.output, r.output);
+  EXPECT_EQ(run_cli("frobnicate", dir_).code, 2);
+  EXPECT_EQ(run_cli("run", dir_).code, 2);
+}
+
+}  // namespace
