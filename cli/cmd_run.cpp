@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -91,6 +92,10 @@ int run(const RunOptions& o) {
     std::fputs(dump_toml(p).c_str(), stdout);
     return 0;
   }
+  if (!p.output.gauges.empty() || p.output.interval > 0 || p.output.every != Params{}.output.every)
+    spdlog::warn(
+        "output.every, output.interval and output.gauges take effect with the HDF5 "
+        "writer; this version writes the final fields only");
   // Check every output can be created before spending time on the run.
   for (const auto& f : p.output.fields)
     check_output_path(field_path(p.output.path, f), o.overwrite);
@@ -136,7 +141,9 @@ int run(const RunOptions& o) {
   for (const auto& name : p.output.fields) {
     const auto& info = field_info(name);
     const auto values = sim.field(info.id);
-    const std::vector<float> f32(values.begin(), values.end());
+    std::vector<float> f32(values.begin(), values.end());
+    for (std::size_t i = 0; i < f32.size(); ++i)
+      if (!sim.terrain().active(i)) f32[i] = std::nanf("");  // nodata stays nodata
     const std::string path = field_path(p.output.path, name);
     io::write_geotiff(path, g, f32, fmt::format("{} ({})", info.long_name, info.units));
     std::printf("wrote %s\n", path.c_str());

@@ -726,11 +726,11 @@ const std::vector<Descriptor>& descriptor_table() {
                                   {"valley", "valley"},
                                   {"ridge", "ridge"}},
              "synthetic terrain generator instead of a DEM file (\"\" = none)"),
-      integer(ERODEM_FIELD(dem.size), closed(2, 65536),
+      integer(ERODEM_FIELD(dem.size), closed(2, 32768),
               "synthetic terrain: grid size (cells per side)"),
       integer(ERODEM_FIELD(dem.seed), closed(-2147483648.0, 2147483647.0),
               "synthetic terrain: random seed"),
-      number(ERODEM_FIELD(dem.relief), D::length, at_least(0),
+      number(ERODEM_FIELD(dem.relief), D::length, above(0),
              "synthetic terrain: elevation range (m)"),
       window(ERODEM_FIELD(dem.window), "pixel window [col, row, width, height] of the DEM"),
       resample_descriptor("dem.resample",
@@ -774,7 +774,8 @@ const std::vector<Descriptor>& descriptor_table() {
       number(ERODEM_FIELD(rain.rate), D::speed, at_least(0),
              "uniform rain rate (m/s), used when rain.series is empty"),
       series(ERODEM_FIELD(rain.series), D::speed, at_least(0),
-             "rain rate series [[time (s), rate (m/s)], ...], linear in between, 0 outside"),
+             "rain rate series [[time (s), rate (m/s)], ...], linear in between, held at the end "
+             "values outside"),
       text(ERODEM_FIELD(rain.raster), "raster path of a spatial rain multiplier (1); \"\" = none"),
 
       inflow_descriptor("inflow",

@@ -415,6 +415,101 @@ Terrain read_dem(const Params::Dem& dem) {
 
   t.source = path;
   t.source_sha256 = file_sha256(path);
+  const int factor = resample_factor(dem, g);
+  return factor > 1 ? coarsen(t, factor) : t;
+}
+
+int resample_factor(const Params::Dem& dem, const Grid& grid) {
+  if (dem.resample_factor > 0) return dem.resample_factor;
+  if (!(dem.resample > 0.0)) return 1;
+  const double cell = grid.dx.empty() ? 0.0 : grid.dx[0];
+  const double f = dem.resample / cell;
+  const long n = std::lround(f);
+  if (n < 1 || std::fabs(f - static_cast<double>(n)) > 1e-6 * f)
+    throw config_error("dem.resample",
+                       std::to_string(dem.resample) + " m is not a whole multiple of the " +
+                           std::to_string(cell) + " m cell of " + dem.path + "; the nearest is " +
+                           std::to_string(std::max(1L, n) * cell) +
+                           " m (or give an integer factor)");
+  return static_cast<int>(n);
+}
+
+Terrain coarsen(const Terrain& fine, int factor) {
+  const Grid& g = fine.grid;
+  if (factor < 1) throw config_error("dem.resample", "the factor must be at least 1");
+  const int nx = g.nx / factor, ny = g.ny / factor;
+  if (nx < 1 || ny < 1)
+    throw config_error("dem.resample", "a factor of " + std::to_string(factor) +
+                                           " leaves no cell of the " + std::to_string(g.nx) +
+                                           " x " + std::to_string(g.ny) + " grid");
+  Terrain t;
+  t.source =
+      fine.source + " (averaged " + std::to_string(factor) + "x" + std::to_string(factor) + ")";
+  t.source_sha256 = fine.source_sha256;
+  Grid& c = t.grid;
+  c.nx = nx;
+  c.ny = ny;
+  c.georef = g.georef;
+  for (int k : {1, 2, 4, 5}) c.georef.transform[k] *= factor;
+  for (int r = 0; r < ny; ++r) {
+    double dx = 0, dy = 0, area = 0;
+    for (int k = 0; k < factor; ++k) {
+      dx += g.dx[r * factor + k] / factor;
+      dy += g.dy[r * factor + k];
+      area += g.area[r * factor + k] * factor;
+    }
+    c.dx.push_back(dx * factor);
+    c.dy.push_back(dy);
+    c.area.push_back(area);
+  }
+  // Block averages over the valid cells; a block with none stays nodata.
+  t.bed.assign(c.cells(), std::nan(""));
+  std::vector<std::uint8_t> mask(c.cells(), 0);
+  bool any_masked = false;
+  for (int r = 0; r < ny; ++r)
+    for (int col = 0; col < nx; ++col) {
+      double sum = 0;
+      int n = 0;
+      for (int i = 0; i < factor; ++i)
+        for (int j = 0; j < factor; ++j) {
+          const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
+          if (!fine.active(k)) continue;
+          sum += fine.bed[k];
+          ++n;
+        }
+      const auto o = static_cast<std::size_t>(r) * nx + col;
+      if (n > 0) {
+        t.bed[o] = sum / n;
+        mask[o] = 1;
+      } else {
+        any_masked = true;
+      }
+    }
+  if (any_masked) t.mask = std::move(mask);
+  // Parameter rasters on the fine grid are averaged over the same blocks.
+  auto average = [&](const std::vector<double>& v) {
+    std::vector<double> out;
+    if (v.empty()) return out;
+    out.assign(c.cells(), 0.0);
+    for (int r = 0; r < ny; ++r)
+      for (int col = 0; col < nx; ++col) {
+        double sum = 0;
+        int n = 0;
+        for (int i = 0; i < factor; ++i)
+          for (int j = 0; j < factor; ++j) {
+            const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
+            if (!fine.active(k)) continue;
+            sum += v[k];
+            ++n;
+          }
+        out[static_cast<std::size_t>(r) * nx + col] = n > 0 ? sum / n : 0.0;
+      }
+    return out;
+  };
+  t.water_depth = average(fine.water_depth);
+  t.manning_n = average(fine.manning_n);
+  t.hardness = average(fine.hardness);
+  t.rain_factor = average(fine.rain_factor);
   return t;
 }
 

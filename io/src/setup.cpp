@@ -29,7 +29,11 @@ std::vector<double> parameter_raster(const std::string& path, const Terrain& t, 
 }  // namespace
 
 Terrain load_terrain(const Params& p) {
-  Terrain t = p.dem.synthetic.empty() ? read_dem(p.dem) : make_synthetic_terrain(p.dem);
+  // Read at full resolution, with the parameter rasters, then average everything together.
+  Params::Dem full = p.dem;
+  full.resample = 0.0;
+  full.resample_factor = 0;
+  Terrain t = full.synthetic.empty() ? read_dem(full) : make_synthetic_terrain(full);
   bool any_active = false;
   for (std::size_t i = 0; i < t.grid.cells() && !any_active; ++i) any_active = t.active(i);
   if (!any_active)
@@ -44,7 +48,8 @@ Terrain load_terrain(const Params& p) {
     t.hardness = parameter_raster(p.erosion.hardness.path, t, p, "erosion.hardness", 0.0, 1.0);
   if (!p.rain.raster.empty())
     t.rain_factor = parameter_raster(p.rain.raster, t, p, "rain.raster", 0.0, inf);
-  return t;
+  const int factor = resample_factor(p.dem, t.grid);
+  return factor > 1 ? coarsen(t, factor) : t;
 }
 
 Simulation make_simulation(const Params& p, const std::string& backend) {

@@ -40,8 +40,11 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   const real outflow = f_left[i] + f_right[i] + f_top[i] + f_bottom[i];
   const real d_old = depth[i];
   real d_new = d_old + dt * (inflow - outflow) / area[y];
+  /* The outflow limit keeps d_new >= 0 up to rounding: lift such a rounding-level negative
+   * to 0 and book the volume; anything deeper is left for the stability check to stop. */
   *clipped = 0;
-  if (d_new < 0) {
+  const real rounding = (real)64 * ERODEM_EPSILON(real) * (d_old + dt * inflow / area[y]);
+  if (d_new < 0 && d_new >= -rounding) {
     *clipped = -d_new * area[y];
     d_new = 0;
   }

@@ -77,8 +77,8 @@ struct Params {
   } flow;
 
   struct Rain {
-    double rate = 0.0;   ///< uniform rate (m/s), used when `series` is empty
-    Series series;       ///< time (s), rate (m/s), linear in between, 0 outside
+    double rate = 0.0;  ///< uniform rate (m/s), used when `series` is empty
+    Series series;      ///< time (s), rate (m/s), linear in between, held at the end values outside
     std::string raster;  ///< optional spatial multiplier raster (1)
   } rain;
 

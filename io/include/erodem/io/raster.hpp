@@ -52,6 +52,15 @@ namespace erodem::io {
 /// hex). Only `grid`, `bed`, `mask`, `source` and `source_sha256` are filled.
 Terrain read_dem(const Params::Dem& dem);
 
+/// The averaging factor that `dem.resample` / `dem.resample_factor` ask for on `grid`
+/// (1 = none). A cell size that is not a whole multiple of the grid's is a config error.
+int resample_factor(const Params::Dem& dem, const Grid& grid);
+
+/// Averages `factor` x `factor` blocks of valid cells into one coarser cell (a block with no
+/// valid cell is nodata); cell sizes and areas grow accordingly, partial blocks at the east
+/// and south edges are dropped.
+Terrain coarsen(const Terrain& fine, int factor);
+
 /// Reads band 1 of a parameter raster (rain factor, Manning n, hardness, initial depth,
 /// ...) that must lie on `grid`: after applying `window` (col, row, width, height; pixels;
 /// the DEM's window), its size must be grid.nx x grid.ny, else Error(ExitCode::data) naming
