@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <memory>
+#include <ostream>
 #include <string>
 
 #include "erodem/backends.hpp"
@@ -18,6 +19,11 @@ struct Target {
   bool f64() const { return precision == Precision::float64; }
   std::string label() const { return backend + (f64() ? "_float64" : "_float32"); }
 };
+
+/// gtest prints a Target by its label (test names and failure messages).
+inline void PrintTo(const Target& t, std::ostream* os) {
+  *os << t.label();
+}
 
 inline Simulation make_simulation(Terrain terrain, Params params, const Target& target) {
   params.numerics.precision = target.precision;

@@ -61,11 +61,16 @@ std::vector<double> middle_row(const Simulation& sim, FieldId id) {
   return std::vector<double>(f.begin() + nx, f.begin() + 2 * nx);
 }
 
-const char* scheme_name(FlowScheme s) { return s == FlowScheme::pipes ? "pipes" : "local_inertial"; }
+const char* scheme_name(FlowScheme s) {
+  return s == FlowScheme::pipes ? "pipes" : "local_inertial";
+}
 
 class Analytical : public ::testing::TestWithParam<Target> {
  protected:
   const Target& target() const { return GetParam(); }
+  void SetUp() override {
+    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  }
 };
 
 TEST_P(Analytical, StokerWetDamBreak) {
@@ -86,10 +91,11 @@ TEST_P(Analytical, StokerWetDamBreak) {
       norm += h;
     }
     const double rel = err / norm;
-    std::printf("[Stoker] %s %s: relative L1 depth error %.4f at t = %.1f s (h2 = %.4f m, "
-                "shock %.3f m/s)%s\n",
-                target().label().c_str(), scheme_name(scheme), rel, sim.time(), exact.h2,
-                exact.shock, scheme == FlowScheme::local_inertial ? " (bound 0.10)" : " (reported)");
+    std::printf(
+        "[Stoker] %s %s: relative L1 depth error %.4f at t = %.1f s (h2 = %.4f m, "
+        "shock %.3f m/s)%s\n",
+        target().label().c_str(), scheme_name(scheme), rel, sim.time(), exact.h2, exact.shock,
+        scheme == FlowScheme::local_inertial ? " (bound 0.10)" : " (reported)");
     if (scheme == FlowScheme::local_inertial) {
       EXPECT_LT(rel, 0.10);
     }
@@ -110,9 +116,10 @@ TEST_P(Analytical, RitterDryDamBreakFront) {
       if (d[c] > 1e-3 * h0) last = c;
     const double front = (last + 1) * dx - x0;
     const double rel = (front - ritter) / ritter;
-    std::printf("[Ritter] %s %s: front travelled %.1f m, Ritter 2 sqrt(g h0) t = %.1f m, "
-                "error %+.1f %%\n",
-                target().label().c_str(), scheme_name(scheme), front, ritter, 100 * rel);
+    std::printf(
+        "[Ritter] %s %s: front travelled %.1f m, Ritter 2 sqrt(g h0) t = %.1f m, "
+        "error %+.1f %%\n",
+        target().label().c_str(), scheme_name(scheme), front, ritter, 100 * rel);
     // The local-inertial scheme drops advection, and near a dry front the flow is
     // supercritical, where that term dominates: its front lags Ritter's (measured -56 % at
     // 2 m cells, 2026-11-22). Bound with margin; a front that did not move or overtook the
@@ -150,9 +157,10 @@ TEST_P(Analytical, ManningPlaneNormalDepth) {
     worst = std::max(worst, std::abs(d[c] - normal) / normal);
     mean += d[c] / (n / 2);
   }
-  std::printf("[Manning plane] %s: normal depth %.4f m, simulated mean %.4f m, worst relative "
-              "deviation %.4f (bound 0.02) after %ld steps\n",
-              target().label().c_str(), normal, mean, worst, sim.steps_done());
+  std::printf(
+      "[Manning plane] %s: normal depth %.4f m, simulated mean %.4f m, worst relative "
+      "deviation %.4f (bound 0.02) after %ld steps\n",
+      target().label().c_str(), normal, mean, worst, sim.steps_done());
   EXPECT_LT(worst, 0.02);
 }
 
@@ -177,10 +185,11 @@ TEST_P(Analytical, RainOnTiltedPlaneReachesEquilibrium) {
     const double outflow = (sim.ledger().boundary_out - out0) / (sim.time() - t0);
     const double expected = rain * n * n * dx * dx;
     const double ratio = outflow / expected;
-    std::printf("[rain on plane] %s %s: outflow %.5f m^3/s, rain x area %.5f m^3/s, ratio %.4f "
-                "(bound |1 - ratio| < 0.02); closure %.2e\n",
-                target().label().c_str(), scheme_name(scheme), outflow, expected, ratio,
-                sim.ledger().relative_closure_error());
+    std::printf(
+        "[rain on plane] %s %s: outflow %.5f m^3/s, rain x area %.5f m^3/s, ratio %.4f "
+        "(bound |1 - ratio| < 0.02); closure %.2e\n",
+        target().label().c_str(), scheme_name(scheme), outflow, expected, ratio,
+        sim.ledger().relative_closure_error());
     EXPECT_NEAR(ratio, 1.0, 0.02);
   }
 }
@@ -209,10 +218,11 @@ TEST_P(Analytical, ThermalRelaxesToTalusAngle) {
   const auto& L = sim.ledger();
   const double drift = std::abs(L.material - L.material_initial) / L.material_initial;
   const double peak = *std::max_element(b.begin(), b.end());
-  std::printf("[thermal] %s: steepest slope %.5f, tan(talus) %.5f, ratio %.5f (bound 1.01); "
-              "peak %.2f m; material drift %.2e (bound %.0e)\n",
-              target().label().c_str(), worst, tan_talus, worst / tan_talus, peak, drift,
-              target().f64() ? 1e-12 : 1e-5);
+  std::printf(
+      "[thermal] %s: steepest slope %.5f, tan(talus) %.5f, ratio %.5f (bound 1.01); "
+      "peak %.2f m; material drift %.2e (bound %.0e)\n",
+      target().label().c_str(), worst, tan_talus, worst / tan_talus, peak, drift,
+      target().f64() ? 1e-12 : 1e-5);
   EXPECT_LT(worst, 1.01 * tan_talus);
   EXPECT_LT(peak, 19.0) << "the block must have collapsed";
   EXPECT_LT(drift, target().f64() ? 1e-12 : 1e-5);
@@ -224,5 +234,10 @@ INSTANTIATE_TEST_SUITE_P(Cpu, Analytical,
                          ::testing::Values(Target{"cpu", Precision::float32},
                                            Target{"cpu", Precision::float64}),
                          [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
+#ifdef ERODEM_HAVE_OPENCL
+INSTANTIATE_TEST_SUITE_P(OpenCl, Analytical,
+                         ::testing::Values(Target{"opencl", Precision::float32}),
+                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
+#endif
 
 }  // namespace erodem::test

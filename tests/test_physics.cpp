@@ -16,6 +16,9 @@ namespace {
 class Physics : public ::testing::TestWithParam<Target> {
  protected:
   const Target& target() const { return GetParam(); }
+  void SetUp() override {
+    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  }
   /// Rounding-level bound: `f64` in float64, `f32` in float32.
   double bound(double f64, double f32) const { return target().f64() ? f64 : f32; }
 };
@@ -89,10 +92,10 @@ TEST_P(Physics, ClosedBoxConservesWaterAndMaterial) {
     const double material_drift = std::abs(L.material - L.material_initial) / L.material_initial;
     const double limit = bound(1e-12, 1e-5);
     const double moved = max_abs(sim.field(FieldId::erosion));
-    std::printf("[closed box] %s %s: water drift %.3e, material drift %.3e (bound %.0e); "
-                "max |erosion| %.3e m, clipped %.3e m^3\n",
-                target().label().c_str(), name, water_drift, material_drift, limit, moved,
-                L.clipped);
+    std::printf(
+        "[closed box] %s %s: water drift %.3e, material drift %.3e (bound %.0e); "
+        "max |erosion| %.3e m, clipped %.3e m^3\n",
+        target().label().c_str(), name, water_drift, material_drift, limit, moved, L.clipped);
     EXPECT_LT(water_drift, limit);
     EXPECT_LT(material_drift, limit);
     EXPECT_GT(moved, 1e-4) << "erosion must have moved material for the test to mean anything";
@@ -110,9 +113,10 @@ TEST_P(Physics, SemiLagrangianLossIsMeasured) {
   const auto& L = sim.ledger();
   const double loss = -L.transport_change / L.material_initial;
   const double closure = std::abs(L.relative_material_closure_error());
-  std::printf("[semi-Lagrangian] %s: material changed by transport %.3e m^3 (%.3e relative); "
-              "ledger closure with it %.3e (bound %.0e)\n",
-              target().label().c_str(), -L.transport_change, loss, closure, bound(1e-12, 1e-5));
+  std::printf(
+      "[semi-Lagrangian] %s: material changed by transport %.3e m^3 (%.3e relative); "
+      "ledger closure with it %.3e (bound %.0e)\n",
+      target().label().c_str(), -L.transport_change, loss, closure, bound(1e-12, 1e-5));
   EXPECT_NE(L.transport_change, 0.0) << "semi-Lagrangian advection is not conservative";
   EXPECT_LT(closure, bound(1e-12, 1e-5)) << "the ledger must account for the change";
 }
@@ -138,10 +142,11 @@ TEST_P(Physics, DepthNeverNegativeWhileDraining) {
       min_depth = std::min(min_depth, *std::min_element(d.begin(), d.end()));
     }
     const auto& L = sim.ledger();
-    std::printf("[no negative depth] %s: min depth %.3e m, clipped %.3e m^3 of %.3e m^3, "
-                "drained %.3e m^3, closure %.3e\n",
-                target().label().c_str(), min_depth, L.clipped, L.water_initial, L.boundary_out,
-                L.relative_closure_error());
+    std::printf(
+        "[no negative depth] %s %s: min depth %.3e m, clipped %.3e m^3 of %.3e m^3, "
+        "drained %.3e m^3, closure %.3e\n",
+        target().label().c_str(), scheme == FlowScheme::pipes ? "pipes" : "local_inertial",
+        min_depth, L.clipped, L.water_initial, L.boundary_out, L.relative_closure_error());
     EXPECT_GE(min_depth, 0.0);
     EXPECT_GT(L.boundary_out, 0.1 * L.water_initial) << "the slope must drain";
     EXPECT_LT(L.clipped, bound(1e-12, 1e-5) * L.water_initial);
@@ -187,5 +192,9 @@ INSTANTIATE_TEST_SUITE_P(Cpu, Physics,
                          ::testing::Values(Target{"cpu", Precision::float32},
                                            Target{"cpu", Precision::float64}),
                          [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
+#ifdef ERODEM_HAVE_OPENCL
+INSTANTIATE_TEST_SUITE_P(OpenCl, Physics, ::testing::Values(Target{"opencl", Precision::float32}),
+                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
+#endif
 
 }  // namespace erodem::test

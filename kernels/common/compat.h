@@ -18,12 +18,15 @@
 #define ERODEM_FN static inline
 #define ERODEM_INLINE static inline
 #define GLOBAL __global
+#define ERODEM_EPSILON(T) ((T)FLT_EPSILON)
 #define ERODEM_BEGIN_NAMESPACE
 #define ERODEM_END_NAMESPACE
 typedef uchar erodem_kind_t;
 #else
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 namespace erodem {
 namespace cell {
 using std::cbrt;
@@ -40,12 +43,81 @@ typedef std::uint8_t erodem_kind_t;
   inline
 #define ERODEM_INLINE inline
 #define GLOBAL
+#define ERODEM_EPSILON(T) std::numeric_limits<T>::epsilon()
 #define ERODEM_BEGIN_NAMESPACE \
   namespace erodem {           \
   namespace cell {
 #define ERODEM_END_NAMESPACE \
   }                          \
   }
+#endif
+
+/* Cube root with the same bits on the CPU and every OpenCL device (float32). The C library's
+ * cbrtf and OpenCL's cbrt may differ by an ulp, and the thresholds of the flow schemes (dry
+ * faces, clipping) turn one ulp into visible differences after many steps. This one uses
+ * only correctly rounded +, -, *, / (FP_CONTRACT off in the kernels): a bit-level first
+ * guess and three Halley steps, about 1 ulp from the exact root. erodem_cbrt(x) is this
+ * function for float and the C library's cbrt for double (the CPU float64 reference). */
+#ifdef __OPENCL_C_VERSION__
+ERODEM_INLINE unsigned int erodem_float_bits(float x) {
+  return as_uint(x);
+}
+ERODEM_INLINE float erodem_bits_float(unsigned int b) {
+  return as_float(b);
+}
+#else
+namespace erodem {
+namespace cell {
+inline unsigned int erodem_float_bits(float x) {
+  std::uint32_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+}
+inline float erodem_bits_float(unsigned int b) {
+  const std::uint32_t u = b;
+  float x;
+  std::memcpy(&x, &u, sizeof x);
+  return x;
+}
+}  // namespace cell
+}  // namespace erodem
+#endif
+
+ERODEM_BEGIN_NAMESPACE
+ERODEM_INLINE float cbrt_f32(float a) {
+  const float x = fabs(a);
+  if (!(x > 0.0f) || !isfinite(x)) return a; /* 0, inf and NaN as they are */
+  float xs = x, scale = 1.0f;
+  if (xs < 1.0e-30f) { /* keep y^3 clear of underflow: x by 2^72, the root by 2^-24 */
+    xs = xs * 4722366482869645213696.0f;
+    scale = 5.9604644775390625e-08f;
+  } else if (xs > 1.0e30f) { /* and of overflow: x by 2^-72, the root by 2^24 */
+    xs = xs * 2.1175823681357508e-22f;
+    scale = 16777216.0f;
+  }
+  float y = erodem_bits_float(erodem_float_bits(xs) / 3u + 709958130u); /* within ~3 % */
+  for (int k = 0; k < 3; ++k) {
+    const float y3 = y * y * y;
+    y = y - y * ((y3 - xs) / (y3 + y3 + xs));
+  }
+  y = y * scale;
+  return a < 0.0f ? -y : y;
+}
+ERODEM_END_NAMESPACE
+
+#ifdef __OPENCL_C_VERSION__
+#define erodem_cbrt(x) cbrt_f32(x)
+#else
+namespace erodem {
+namespace cell {
+inline float erodem_cbrt(float x) {
+  return cbrt_f32(x);
+}
+inline double erodem_cbrt(double x) {
+  return std::cbrt(x);
+}
+}  // namespace cell
+}  // namespace erodem
 #endif
 
 /* Cell kinds (the `kind` field). */

@@ -113,7 +113,7 @@ ERODEM_FN real local_inertial_q(real q, real q_up, real q_down, real eta_a, real
   if (!(h_f > dry_depth)) return (real)0;
   const real numerator = theta * q + ((real)1 - theta) * (real)0.5 * (q_up + q_down) -
                          gravity * h_f * dt * (eta_b - eta_a) / dist;
-  const real h_f_7_3 = h_f * h_f * cbrt(h_f);
+  const real h_f_7_3 = h_f * h_f * erodem_cbrt(h_f);
   const real denominator = (real)1 + gravity * dt * n * n * fabs(q) / h_f_7_3;
   return numerator / denominator;
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #ifdef _OPENMP
@@ -29,8 +30,8 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   const std::size_t cells = g.cells();
   auto check_size = [&](const std::vector<double>& v, const char* what) {
     if (!v.empty() && v.size() != cells)
-      throw Error(ExitCode::data, fmt::format("{}: {} values for a grid of {} x {}", what,
-                                              v.size(), g.nx, g.ny));
+      throw Error(ExitCode::data,
+                  fmt::format("{}: {} values for a grid of {} x {}", what, v.size(), g.nx, g.ny));
   };
   check_size(terrain.bed, "bed");
   if (terrain.bed.size() != cells) throw Error(ExitCode::data, "bed: missing");
@@ -61,15 +62,18 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c) {
       const auto i = static_cast<std::size_t>(r) * nx_ + c;
-      kind_[at(c + 1, r + 1)] = terrain.active(i) ? ERODEM_CELL_ACTIVE
+      kind_[at(c + 1, r + 1)] = terrain.active(i)                           ? ERODEM_CELL_ACTIVE
                                 : params.boundary.nodata == NodataKind::sea ? ERODEM_CELL_FIXED
                                                                             : ERODEM_CELL_WALL;
     }
   auto edge_kind = [](BoundaryKind b) {
     switch (b) {
-      case BoundaryKind::open: return Kind{ERODEM_CELL_OPEN};
-      case BoundaryKind::fixed_level: return Kind{ERODEM_CELL_FIXED};
-      case BoundaryKind::closed: break;
+      case BoundaryKind::open:
+        return Kind{ERODEM_CELL_OPEN};
+      case BoundaryKind::fixed_level:
+        return Kind{ERODEM_CELL_FIXED};
+      case BoundaryKind::closed:
+        break;
     }
     return Kind{ERODEM_CELL_WALL};
   };
@@ -148,8 +152,8 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
 
 template <class Real>
 std::string CpuBackend<Real>::device() const {
-  return fmt::format("CPU reference, {}, {} thread{}",
-                     sizeof(Real) == 4 ? "float32" : "float64", threads_, threads_ == 1 ? "" : "s");
+  return fmt::format("CPU reference, {}, {} thread{}", sizeof(Real) == 4 ? "float32" : "float64",
+                     threads_, threads_ == 1 ? "" : "s");
 }
 
 template <class Real>
@@ -163,14 +167,30 @@ template <class Real>
 void CpuBackend<Real>::run(Process p, const StepInputs& in, StepTally& tally) {
   const Real dt = static_cast<Real>(in.dt);
   switch (p) {
-    case Process::boundary: run_boundary(); break;
-    case Process::sources: run_sources(in); break;
-    case Process::flow: run_flow(dt); break;
-    case Process::water: run_water(dt, tally); break;
-    case Process::erosion: run_erosion(dt); break;
-    case Process::transport: run_transport(dt, tally); break;
-    case Process::thermal: run_thermal(dt); break;
-    case Process::evaporation: run_evaporation(dt, tally); break;
+    case Process::boundary:
+      run_boundary();
+      break;
+    case Process::sources:
+      run_sources(in);
+      break;
+    case Process::flow:
+      run_flow(dt);
+      break;
+    case Process::water:
+      run_water(dt, tally);
+      break;
+    case Process::erosion:
+      run_erosion(dt);
+      break;
+    case Process::transport:
+      run_transport(dt, tally);
+      break;
+    case Process::thermal:
+      run_thermal(dt);
+      break;
+    case Process::evaporation:
+      run_evaporation(dt, tally);
+      break;
   }
 }
 
@@ -197,8 +217,8 @@ FieldStats CpuBackend<Real>::stats() {
         row.max_d = d;
         row.arg_d = cell;
       }
-      const double v = std::hypot(static_cast<double>(velocity_x_[i]),
-                                  static_cast<double>(velocity_y_[i]));
+      const double v =
+          std::hypot(static_cast<double>(velocity_x_[i]), static_cast<double>(velocity_y_[i]));
       if (v > row.max_v) {
         row.max_v = v;
         row.arg_v = cell;
@@ -229,19 +249,32 @@ FieldStats CpuBackend<Real>::stats() {
 template <class Real>
 std::vector<Real>* CpuBackend<Real>::field_storage(FieldId id) {
   switch (id) {
-    case FieldId::bed: return &bed_;
-    case FieldId::water_depth: return &depth_;
-    case FieldId::sediment: return &sediment_;
-    case FieldId::velocity_x: return &velocity_x_;
-    case FieldId::velocity_y: return &velocity_y_;
-    case FieldId::flux_left: return &flux_[ERODEM_LEFT];
-    case FieldId::flux_right: return &flux_[ERODEM_RIGHT];
-    case FieldId::flux_top: return &flux_[ERODEM_TOP];
-    case FieldId::flux_bottom: return &flux_[ERODEM_BOTTOM];
-    case FieldId::hardness: return &hardness_;
-    case FieldId::wetness: return &wetness_;
-    case FieldId::manning_n: return &manning_;
-    case FieldId::erosion: return nullptr;
+    case FieldId::bed:
+      return &bed_;
+    case FieldId::water_depth:
+      return &depth_;
+    case FieldId::sediment:
+      return &sediment_;
+    case FieldId::velocity_x:
+      return &velocity_x_;
+    case FieldId::velocity_y:
+      return &velocity_y_;
+    case FieldId::flux_left:
+      return &flux_[ERODEM_LEFT];
+    case FieldId::flux_right:
+      return &flux_[ERODEM_RIGHT];
+    case FieldId::flux_top:
+      return &flux_[ERODEM_TOP];
+    case FieldId::flux_bottom:
+      return &flux_[ERODEM_BOTTOM];
+    case FieldId::hardness:
+      return &hardness_;
+    case FieldId::wetness:
+      return &wetness_;
+    case FieldId::manning_n:
+      return &manning_;
+    case FieldId::erosion:
+      return nullptr;
   }
   return nullptr;
 }
@@ -293,9 +326,27 @@ std::unique_ptr<Backend> make_cpu_backend(const Terrain& terrain, const Params& 
 
 std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& terrain,
                                       const Params& params) {
-  if (name == "cpu" || name == "auto") return make_cpu_backend(terrain, params);
-  throw Error(ExitCode::usage,
-              "backend '" + name + "': expected auto or cpu (the OpenCL backend is not built)");
+  if (name == "cpu") return make_cpu_backend(terrain, params);
+  if (name == "opencl") return make_opencl_backend(terrain, params);
+  if (name == "auto") {
+    // A GPU OpenCL device, else OpenCL on PoCL, else the CPU reference. The OpenCL backend
+    // runs float32 only; ERODEM_OPENCL_DEVICE, when set, chooses the OpenCL device.
+    if (params.numerics.precision == Precision::float32) {
+      const auto devices = list_opencl_devices();
+      const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
+      const bool any_gpu = std::any_of(devices.begin(), devices.end(),
+                                       [](const ClDeviceInfo& d) { return d.gpu(); });
+      const bool pocl = std::any_of(devices.begin(), devices.end(), [](const ClDeviceInfo& d) {
+        return d.platform.find("Portable Computing Language") != std::string::npos ||
+               d.vendor.find("pocl") != std::string::npos;
+      });
+      if ((env && *env && !devices.empty()) || any_gpu || pocl)
+        return make_opencl_backend(terrain, params);
+    }
+    return make_cpu_backend(terrain, params);
+  }
+  throw Error(ExitCode::usage, "backend '" + name + "': expected auto, cpu or opencl" +
+                                   (opencl_available() ? "" : " (no OpenCL device here)"));
 }
 
 }  // namespace erodem

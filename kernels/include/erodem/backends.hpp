@@ -1,8 +1,10 @@
 // erodem — building compute backends.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "erodem/backend.hpp"
 #include "erodem/grid.hpp"
@@ -14,9 +16,36 @@ namespace erodem {
 /// state built from `terrain` (bed, initial water, rasters, mask) and `params`.
 std::unique_ptr<Backend> make_cpu_backend(const Terrain& terrain, const Params& params);
 
-/// A backend by name: "cpu", or "auto" (the best available; the CPU reference until the
-/// OpenCL backend exists). Throws erodem::Error(usage) on an unknown name.
+/// A backend by name: "cpu", "opencl", or "auto" (the best available: an OpenCL GPU, else
+/// OpenCL on PoCL, else the CPU reference; the CPU reference for float64). Throws
+/// erodem::Error(usage) on an unknown name.
 std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& terrain,
                                       const Params& params);
+
+/// An OpenCL device as list_opencl_devices() reports it.
+struct ClDeviceInfo {
+  std::string platform;             ///< platform name, e.g. "Portable Computing Language"
+  std::string vendor;               ///< platform vendor, e.g. "The pocl project"
+  std::string device;               ///< device name
+  std::string type;                 ///< "GPU", "CPU", "accelerator" or "other"
+  std::uint64_t global_memory = 0;  ///< bytes
+  unsigned compute_units = 0;
+  bool fp64 = false;  ///< cl_khr_fp64: the ledger reductions run in double
+  bool gpu() const { return type == "GPU"; }
+};
+
+/// Every OpenCL device of every platform; empty when there is none or the backend is not
+/// built (ERODEM_OPENCL=OFF).
+std::vector<ClDeviceInfo> list_opencl_devices();
+
+/// Whether the OpenCL backend is built and at least one device is present.
+bool opencl_available();
+
+/// The OpenCL backend (float32), on the device chosen by ERODEM_OPENCL_DEVICE
+/// ("<platform substring>:<device substring>", case-insensitive, either part may be empty),
+/// else the first GPU, else the first device. Throws Error(usage) when there is no OpenCL
+/// device or the backend is not built, Error(config) for params.numerics.precision float64,
+/// Error(internal) with the build log when the kernels fail to build.
+std::unique_ptr<Backend> make_opencl_backend(const Terrain& terrain, const Params& params);
 
 }  // namespace erodem

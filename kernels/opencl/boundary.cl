@@ -1,0 +1,29 @@
+/* erodem OpenCL — boundary process: kernels/common/boundary.h on the halo cells (the CPU loop
+ * of kernels/cpu/boundary.cpp). Only indexing here; the formulas live in the common header. */
+#pragma OPENCL FP_CONTRACT OFF
+#include "boundary.h"
+
+/* One work-item per halo cell, corners excluded: ids [0, W-2) the north row, then the south
+ * row, the west column and the east column (the cells the CPU loops visit). */
+__kernel void boundary_fill(int W, int H, __global const uchar* kind, __global real* bed,
+                            __global real* depth, real sea_level) {
+  const int id = (int)get_global_id(0);
+  const int nxi = W - 2, nyi = H - 2;
+  int x, y;
+  if (id < nxi) {
+    x = 1 + id;
+    y = 0;
+  } else if (id < 2 * nxi) {
+    x = 1 + id - nxi;
+    y = H - 1;
+  } else if (id < 2 * nxi + nyi) {
+    x = 0;
+    y = 1 + id - 2 * nxi;
+  } else if (id < 2 * (nxi + nyi)) {
+    x = W - 1;
+    y = 1 + id - 2 * nxi - nyi;
+  } else {
+    return;
+  }
+  boundary_fill_cell(x, y, W, H, kind, bed, depth, sea_level);
+}

@@ -1,0 +1,162 @@
+// erodem — the OpenCL backend (private to erodem::kernels): RAII handles of the OpenCL C API,
+// the program assembled from the embedded sources, the per-device runtime shared by backends,
+// and the backend class. The per-cell formulas are those of kernels/common/*.h; the kernels
+// of kernels/opencl/*.cl only index cells and call them, mirroring the CPU loops.
+#pragma once
+
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#include <CL/cl.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "erodem/backend.hpp"
+#include "erodem/backends.hpp"
+#include "erodem/grid.hpp"
+#include "erodem/params.hpp"
+
+namespace erodem::opencl {
+
+/// Name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES".
+const char* error_name(cl_int code);
+/// Throws Error(ExitCode::internal) naming `what` and the error when code != CL_SUCCESS.
+void check(cl_int code, const char* what);
+
+/// Owns one OpenCL object and releases it once (move-only).
+template <class T, cl_int(CL_API_CALL* Release)(T)>
+class Handle {
+ public:
+  Handle() = default;
+  explicit Handle(T h) : h_(h) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& o) noexcept : h_(std::exchange(o.h_, nullptr)) {}
+  Handle& operator=(Handle&& o) noexcept {
+    if (this != &o) {
+      reset();
+      h_ = std::exchange(o.h_, nullptr);
+    }
+    return *this;
+  }
+  ~Handle() { reset(); }
+  void reset() {
+    if (h_) Release(h_);
+    h_ = nullptr;
+  }
+  T get() const { return h_; }
+  explicit operator bool() const { return h_ != nullptr; }
+  friend void swap(Handle& a, Handle& b) noexcept { std::swap(a.h_, b.h_); }
+
+ private:
+  T h_ = nullptr;
+};
+
+using Context = Handle<cl_context, clReleaseContext>;
+using Queue = Handle<cl_command_queue, clReleaseCommandQueue>;
+using Program = Handle<cl_program, clReleaseProgram>;
+using Kernel = Handle<cl_kernel, clReleaseKernel>;
+using Buffer = Handle<cl_mem, clReleaseMemObject>;
+
+/// Where a line of the assembled program came from.
+struct SourceOrigin {
+  std::string file;  ///< embedded file name, e.g. "flow.h"
+  int line = 0;      ///< 1-based line in that file
+};
+
+/// The program text: every kernels/opencl/*.cl with its #include "x.h" lines replaced by the
+/// embedded headers (each header once), and the origin of every line.
+struct ProgramSource {
+  std::string text;
+  std::vector<SourceOrigin> origin;  ///< origin[k]: line k + 1 of text
+};
+
+/// Assembles the program from the embedded sources. Throws Error(internal) on an #include
+/// of a file that is not embedded.
+ProgramSource assemble_program();
+
+/// The build log with every "<file>:<line>:<col>:" mapped back to the original file and
+/// line, followed by that line of source.
+std::string annotate_build_log(const std::string& log, const ProgramSource& src);
+
+/// One device with its context and built program, shared by the backends that run on it.
+struct Runtime {
+  ClDeviceInfo info;
+  cl_platform_id platform = nullptr;
+  cl_device_id device = nullptr;
+  Context context;
+  Program program;
+  bool fp64 = false;
+  std::size_t max_work_group = 1;
+  std::string options;  ///< the build options
+};
+
+/// The runtime of the device chosen by ERODEM_OPENCL_DEVICE ("<platform>:<device>"
+/// substrings, case-insensitive; either may be empty), else the first GPU, else the first
+/// device; built once per process and device. Throws Error(usage) when there is none.
+std::shared_ptr<Runtime> runtime_for(const std::string& selector);
+
+/// The CPU reference's algorithms on an OpenCL device, float32 only. State stays on the
+/// device; field() reads back, set_field() uploads, stats() reduces on the device.
+class OpenClBackend final : public Backend {
+ public:
+  OpenClBackend(const Terrain& terrain, const Params& params, const std::string& selector = "");
+
+  std::string name() const override { return "opencl"; }
+  std::string device() const override;
+  void run(Process p, const StepInputs& in, StepTally& tally) override;
+  FieldStats stats() override;
+  std::vector<double> field(FieldId id) const override;
+  void set_field(FieldId id, const std::vector<double>& values) override;
+
+ private:
+  using Real = float;
+  // One function per process, each the mirror of kernels/cpu/<process>.cpp.
+  void run_boundary();
+  void run_sources(const StepInputs& in);
+  void run_flow(Real dt);
+  void run_water(Real dt, StepTally& tally);
+  void run_erosion(Real dt);
+  void run_transport(Real dt, StepTally& tally);
+  void run_thermal(Real dt);
+  void run_evaporation(Real dt, StepTally& tally);
+
+  Buffer make_buffer(std::size_t bytes, const void* data = nullptr);
+  template <class T>
+  Buffer upload(const std::vector<T>& v) {
+    return make_buffer(v.size() * sizeof(T), v.data());
+  }
+  cl_kernel kernel(const char* name);
+  /// Runs a cell kernel over the padded raster (W x H, rounded up; the kernels bound-check).
+  void launch_cells(cl_kernel k);
+  /// Runs a reduction kernel with reduce_groups_ groups of reduce_local_ work-items.
+  void launch_reduction(cl_kernel k);
+  /// Sum over the padded raster `values` (real), in double, combined in group order.
+  double reduce_sum(const Buffer& values);
+  /// Reads `count` accumulator values (double or float on the device) as doubles.
+  std::vector<double> read_acc(const Buffer& b, std::size_t count);
+  Buffer* field_buffer(FieldId id);
+
+  Params params_;
+  std::shared_ptr<Runtime> rt_;
+  Queue queue_;
+  std::vector<std::pair<std::string, Kernel>> kernels_;
+  int nx_, ny_, W_, H_;
+  std::size_t n_;
+  std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
+  std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
+  Buffer kind_, dx_, dy_, area_;
+  Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;
+  std::array<Buffer, 4> flux_, flux_next_;
+  Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
+  Buffer tally_a_, tally_b_, partial_a_, partial_b_, partial_cells_;
+  Buffer point_cells_, point_amounts_;
+  std::size_t point_capacity_ = 0;
+};
+
+}  // namespace erodem::opencl

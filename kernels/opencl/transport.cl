@@ -1,0 +1,36 @@
+/* erodem OpenCL — transport process: kernels/common/transport.h over the active cells (the
+ * CPU loops of kernels/cpu/transport.cpp); the host swaps the sediment buffers. */
+#pragma OPENCL FP_CONTRACT OFF
+#include "transport.h"
+
+/* One work-item per padded cell (the global size may be rounded up); the sediment carried out
+ * of the domain goes to a scratch raster (0 where nothing runs) that stats.cl reduces. */
+__kernel void transport_conservative(int W, int H, __global const uchar* kind,
+                                     __global const real* sediment, __global real* sediment_out,
+                                     __global const real* depth_flow, __global const real* f_left,
+                                     __global const real* f_right, __global const real* f_top,
+                                     __global const real* f_bottom, __global const real* area,
+                                     real dt, __global real* tally_out) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (x >= W || y >= H) return;
+  const int i = x + y * W;
+  real out = 0;
+  if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[i] == ERODEM_CELL_ACTIVE)
+    transport_conservative_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left, f_right,
+                                f_top, f_bottom, area, dt, &out);
+  tally_out[i] = out;
+}
+
+/* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */
+__kernel void transport_semi_lagrangian(int W, int H, __global const uchar* kind,
+                                        __global const real* sediment, __global real* sediment_out,
+                                        __global const real* velocity_x,
+                                        __global const real* velocity_y, __global const real* dx,
+                                        __global const real* dy, real dt) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (x < 1 || y < 1 || x > W - 2 || y > H - 2) return;
+  const int i = x + y * W;
+  if (kind[i] != ERODEM_CELL_ACTIVE) return;
+  sediment_out[i] =
+      transport_semi_lagrangian_cell(x, y, W, H, sediment, velocity_x, velocity_y, dx, dy, dt);
+}

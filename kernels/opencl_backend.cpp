@@ -1,0 +1,972 @@
+// erodem — the OpenCL backend: the kernels of kernels/opencl/*.cl (each calling the per-cell
+// functions of kernels/common/*.h) run over the padded raster, with the same buffers, swaps
+// and process order as the CPU reference (kernels/cpu). Built when ERODEM_HAVE_OPENCL is
+// defined; otherwise only the functions that say the backend is not built.
+#include "erodem/backends.hpp"
+#include "erodem/error.hpp"
+
+#ifndef ERODEM_HAVE_OPENCL
+
+namespace erodem {
+
+std::vector<ClDeviceInfo> list_opencl_devices() {
+  return {};
+}
+bool opencl_available() {
+  return false;
+}
+std::unique_ptr<Backend> make_opencl_backend(const Terrain&, const Params&) {
+  throw Error(ExitCode::usage,
+              "backend 'opencl': this build has no OpenCL backend (configure with "
+              "-DERODEM_OPENCL=ON and an OpenCL SDK, e.g. ocl-icd-opencl-dev + opencl-headers)");
+}
+
+}  // namespace erodem
+
+#else
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "common/compat.h"
+#include "opencl/embedded_sources.hpp"
+#include "opencl/opencl_backend.hpp"
+
+namespace erodem {
+namespace opencl {
+
+// ---- errors ---------------------------------------------------------------------------
+
+const char* error_name(cl_int code) {
+  switch (code) {
+#define ERODEM_CL_CASE(c) \
+  case c:                 \
+    return #c;
+    ERODEM_CL_CASE(CL_SUCCESS)
+    ERODEM_CL_CASE(CL_DEVICE_NOT_FOUND)
+    ERODEM_CL_CASE(CL_DEVICE_NOT_AVAILABLE)
+    ERODEM_CL_CASE(CL_COMPILER_NOT_AVAILABLE)
+    ERODEM_CL_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    ERODEM_CL_CASE(CL_OUT_OF_RESOURCES)
+    ERODEM_CL_CASE(CL_OUT_OF_HOST_MEMORY)
+    ERODEM_CL_CASE(CL_PROFILING_INFO_NOT_AVAILABLE)
+    ERODEM_CL_CASE(CL_MEM_COPY_OVERLAP)
+    ERODEM_CL_CASE(CL_IMAGE_FORMAT_MISMATCH)
+    ERODEM_CL_CASE(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    ERODEM_CL_CASE(CL_BUILD_PROGRAM_FAILURE)
+    ERODEM_CL_CASE(CL_MAP_FAILURE)
+    ERODEM_CL_CASE(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    ERODEM_CL_CASE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    ERODEM_CL_CASE(CL_COMPILE_PROGRAM_FAILURE)
+    ERODEM_CL_CASE(CL_LINKER_NOT_AVAILABLE)
+    ERODEM_CL_CASE(CL_LINK_PROGRAM_FAILURE)
+    ERODEM_CL_CASE(CL_DEVICE_PARTITION_FAILED)
+    ERODEM_CL_CASE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    ERODEM_CL_CASE(CL_INVALID_VALUE)
+    ERODEM_CL_CASE(CL_INVALID_DEVICE_TYPE)
+    ERODEM_CL_CASE(CL_INVALID_PLATFORM)
+    ERODEM_CL_CASE(CL_INVALID_DEVICE)
+    ERODEM_CL_CASE(CL_INVALID_CONTEXT)
+    ERODEM_CL_CASE(CL_INVALID_QUEUE_PROPERTIES)
+    ERODEM_CL_CASE(CL_INVALID_COMMAND_QUEUE)
+    ERODEM_CL_CASE(CL_INVALID_HOST_PTR)
+    ERODEM_CL_CASE(CL_INVALID_MEM_OBJECT)
+    ERODEM_CL_CASE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+    ERODEM_CL_CASE(CL_INVALID_IMAGE_SIZE)
+    ERODEM_CL_CASE(CL_INVALID_SAMPLER)
+    ERODEM_CL_CASE(CL_INVALID_BINARY)
+    ERODEM_CL_CASE(CL_INVALID_BUILD_OPTIONS)
+    ERODEM_CL_CASE(CL_INVALID_PROGRAM)
+    ERODEM_CL_CASE(CL_INVALID_PROGRAM_EXECUTABLE)
+    ERODEM_CL_CASE(CL_INVALID_KERNEL_NAME)
+    ERODEM_CL_CASE(CL_INVALID_KERNEL_DEFINITION)
+    ERODEM_CL_CASE(CL_INVALID_KERNEL)
+    ERODEM_CL_CASE(CL_INVALID_ARG_INDEX)
+    ERODEM_CL_CASE(CL_INVALID_ARG_VALUE)
+    ERODEM_CL_CASE(CL_INVALID_ARG_SIZE)
+    ERODEM_CL_CASE(CL_INVALID_KERNEL_ARGS)
+    ERODEM_CL_CASE(CL_INVALID_WORK_DIMENSION)
+    ERODEM_CL_CASE(CL_INVALID_WORK_GROUP_SIZE)
+    ERODEM_CL_CASE(CL_INVALID_WORK_ITEM_SIZE)
+    ERODEM_CL_CASE(CL_INVALID_GLOBAL_OFFSET)
+    ERODEM_CL_CASE(CL_INVALID_EVENT_WAIT_LIST)
+    ERODEM_CL_CASE(CL_INVALID_EVENT)
+    ERODEM_CL_CASE(CL_INVALID_OPERATION)
+    ERODEM_CL_CASE(CL_INVALID_GL_OBJECT)
+    ERODEM_CL_CASE(CL_INVALID_BUFFER_SIZE)
+    ERODEM_CL_CASE(CL_INVALID_MIP_LEVEL)
+    ERODEM_CL_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
+    ERODEM_CL_CASE(CL_INVALID_PROPERTY)
+    ERODEM_CL_CASE(CL_INVALID_IMAGE_DESCRIPTOR)
+    ERODEM_CL_CASE(CL_INVALID_COMPILER_OPTIONS)
+    ERODEM_CL_CASE(CL_INVALID_LINKER_OPTIONS)
+    ERODEM_CL_CASE(CL_INVALID_DEVICE_PARTITION_COUNT)
+#undef ERODEM_CL_CASE
+    case -1001:
+      return "CL_PLATFORM_NOT_FOUND_KHR";
+    default:
+      return "unknown OpenCL error";
+  }
+}
+
+void check(cl_int code, const char* what) {
+  if (code != CL_SUCCESS)
+    throw Error(ExitCode::internal,
+                fmt::format("OpenCL: {} failed: {} ({})", what, error_name(code), code));
+}
+
+namespace {
+
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string platform_string(cl_platform_id p, cl_platform_info what) {
+  std::size_t size = 0;
+  if (clGetPlatformInfo(p, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
+  std::string s(size, '\0');
+  if (clGetPlatformInfo(p, what, size, s.data(), nullptr) != CL_SUCCESS) return {};
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+
+std::string device_string(cl_device_id d, cl_device_info what) {
+  std::size_t size = 0;
+  if (clGetDeviceInfo(d, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
+  std::string s(size, '\0');
+  if (clGetDeviceInfo(d, what, size, s.data(), nullptr) != CL_SUCCESS) return {};
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+
+template <class T>
+T device_value(cl_device_id d, cl_device_info what) {
+  T v{};
+  check(clGetDeviceInfo(d, what, sizeof(T), &v, nullptr), "clGetDeviceInfo");
+  return v;
+}
+
+struct DeviceEntry {
+  cl_platform_id platform;
+  cl_device_id device;
+  ClDeviceInfo info;
+};
+
+/// Every device of every platform, in platform then device order; empty when none.
+std::vector<DeviceEntry> enumerate_devices() {
+  std::vector<DeviceEntry> out;
+  cl_uint np = 0;
+  if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) return out;
+  std::vector<cl_platform_id> platforms(np);
+  if (clGetPlatformIDs(np, platforms.data(), nullptr) != CL_SUCCESS) return out;
+  for (cl_platform_id p : platforms) {
+    cl_uint nd = 0;
+    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS || nd == 0) continue;
+    std::vector<cl_device_id> devices(nd);
+    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, nd, devices.data(), nullptr) != CL_SUCCESS) continue;
+    for (cl_device_id d : devices) {
+      DeviceEntry e{p, d, {}};
+      e.info.platform = platform_string(p, CL_PLATFORM_NAME);
+      e.info.vendor = platform_string(p, CL_PLATFORM_VENDOR);
+      e.info.device = device_string(d, CL_DEVICE_NAME);
+      const auto type = device_value<cl_device_type>(d, CL_DEVICE_TYPE);
+      e.info.type = (type & CL_DEVICE_TYPE_GPU)           ? "GPU"
+                    : (type & CL_DEVICE_TYPE_CPU)         ? "CPU"
+                    : (type & CL_DEVICE_TYPE_ACCELERATOR) ? "accelerator"
+                                                          : "other";
+      e.info.global_memory = device_value<cl_ulong>(d, CL_DEVICE_GLOBAL_MEM_SIZE);
+      e.info.compute_units = device_value<cl_uint>(d, CL_DEVICE_MAX_COMPUTE_UNITS);
+      const std::string ext = " " + device_string(d, CL_DEVICE_EXTENSIONS) + " ";
+      e.info.fp64 = ext.find(" cl_khr_fp64 ") != std::string::npos;
+      out.push_back(std::move(e));
+    }
+  }
+  return out;
+}
+
+std::string describe(const std::vector<DeviceEntry>& devices) {
+  std::string s;
+  for (const auto& d : devices)
+    s += fmt::format("{}'{}:{}' ({})", s.empty() ? "" : ", ", d.info.platform, d.info.device,
+                     d.info.type);
+  return s.empty() ? "none" : s;
+}
+
+/// Whether `entry` matches "<platform>:<device>" (substrings, case-insensitive; the platform
+/// part matches the platform's name or vendor). Without ':' the selector names the device.
+bool matches(const DeviceEntry& entry, const std::string& selector) {
+  const auto colon = selector.find(':');
+  const std::string plat = colon == std::string::npos ? "" : lower(selector.substr(0, colon));
+  const std::string dev = lower(colon == std::string::npos ? selector : selector.substr(colon + 1));
+  const bool plat_ok = plat.empty() || lower(entry.info.platform).find(plat) != std::string::npos ||
+                       lower(entry.info.vendor).find(plat) != std::string::npos;
+  const bool dev_ok = dev.empty() || lower(entry.info.device).find(dev) != std::string::npos;
+  return plat_ok && dev_ok;
+}
+
+const EmbeddedSource* find_embedded(const std::string& name) {
+  for (std::size_t k = 0; k < kEmbeddedSourceCount; ++k)
+    if (name == kEmbeddedSources[k].name) return &kEmbeddedSources[k];
+  return nullptr;
+}
+
+/// Appends `name` to `out`, expanding #include "x.h" lines (each file once: all carry
+/// include guards).
+void expand(const std::string& name, ProgramSource& out, std::set<std::string>& included,
+            int depth) {
+  const EmbeddedSource* src = find_embedded(name);
+  if (!src) throw Error(ExitCode::internal, "OpenCL sources: '" + name + "' is not embedded");
+  if (depth > 16) throw Error(ExitCode::internal, "OpenCL sources: #include nesting too deep");
+  static const std::regex include_re(R"(^\s*#\s*include\s*"([^"]+)\"\s*$)");
+  std::istringstream in(src->text);
+  std::string line;
+  int number = 0;
+  auto emit = [&](const std::string& text, int at) {
+    out.text += text;
+    out.text += '\n';
+    out.origin.push_back({name, at});
+  };
+  while (std::getline(in, line)) {
+    ++number;
+    std::smatch m;
+    if (std::regex_match(line, m, include_re)) {
+      const std::string header = m[1].str();
+      if (!included.insert(header).second) {
+        emit("/* " + header + ": already included */", number);
+        continue;
+      }
+      emit("/* ---- begin " + header + " (included from " + name + ") ---- */", number);
+      expand(header, out, included, depth + 1);
+      emit("/* ---- end " + header + " ---- */", number);
+    } else {
+      emit(line, number);
+    }
+  }
+}
+
+}  // namespace
+
+ProgramSource assemble_program() {
+  // The process files in step order, then the reductions; every other embedded .cl after.
+  std::vector<std::string> order = {"boundary.cl", "sources.cl",     "flow.cl",
+                                    "water.cl",    "erosion.cl",     "transport.cl",
+                                    "thermal.cl",  "evaporation.cl", "stats.cl"};
+  for (std::size_t k = 0; k < kEmbeddedSourceCount; ++k) {
+    const std::string name = kEmbeddedSources[k].name;
+    if (name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0 &&
+        std::find(order.begin(), order.end(), name) == order.end())
+      order.push_back(name);
+  }
+  ProgramSource out;
+  std::set<std::string> included;
+  for (const auto& name : order) {
+    out.text += "/* ==== " + name + " ==== */\n";
+    out.origin.push_back({name, 0});
+    expand(name, out, included, 0);
+  }
+  return out;
+}
+
+std::string annotate_build_log(const std::string& log, const ProgramSource& src) {
+  static const std::regex loc_re(R"(:(\d+):(\d+):)");
+  std::istringstream in(log);
+  std::ostringstream out;
+  std::string line;
+  while (std::getline(in, line)) {
+    out << line << '\n';
+    std::smatch m;
+    if (!std::regex_search(line, m, loc_re)) continue;
+    const long n = std::stol(m[1].str());
+    if (n < 1 || n > static_cast<long>(src.origin.size())) continue;
+    const auto& o = src.origin[static_cast<std::size_t>(n - 1)];
+    // The offending line, from the assembled text.
+    std::size_t begin = 0;
+    for (long k = 1; k < n && begin != std::string::npos; ++k) {
+      begin = src.text.find('\n', begin);
+      if (begin != std::string::npos) ++begin;
+    }
+    std::string text;
+    if (begin != std::string::npos) {
+      const auto end = src.text.find('\n', begin);
+      text = src.text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+    }
+    out << "    --> " << o.file << ':' << o.line << ':' << m[2].str() << ": " << text << '\n';
+  }
+  return out.str();
+}
+
+namespace {
+
+/// Builds the program on the runtime's device; throws Error(internal) with the annotated
+/// build log on failure. ERODEM_OPENCL_DUMP=dir writes the source and options there.
+void build_program(Runtime& rt) {
+  const ProgramSource src = assemble_program();
+  if (const char* dir = std::getenv("ERODEM_OPENCL_DUMP"); dir && *dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    std::ofstream(std::filesystem::path(dir) / "erodem_program.cl") << src.text;
+    std::ofstream(std::filesystem::path(dir) / "erodem_build_options.txt") << rt.options << '\n';
+  }
+  const char* text = src.text.c_str();
+  const std::size_t length = src.text.size();
+  cl_int err = CL_SUCCESS;
+  rt.program = Program(clCreateProgramWithSource(rt.context.get(), 1, &text, &length, &err));
+  check(err, "clCreateProgramWithSource");
+  cl_device_id device = rt.device;
+  err = clBuildProgram(rt.program.get(), 1, &device, rt.options.c_str(), nullptr, nullptr);
+  if (err != CL_SUCCESS) {
+    std::size_t size = 0;
+    std::string log;
+    if (clGetProgramBuildInfo(rt.program.get(), device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size) ==
+            CL_SUCCESS &&
+        size > 0) {
+      log.resize(size);
+      clGetProgramBuildInfo(rt.program.get(), device, CL_PROGRAM_BUILD_LOG, size, log.data(),
+                            nullptr);
+      while (!log.empty() && log.back() == '\0') log.pop_back();
+    }
+    rt.program.reset();
+    throw Error(ExitCode::internal,
+                fmt::format("OpenCL: building the kernels for '{} / {}' failed: {} ({}); options "
+                            "'{}'; CL_PROGRAM_BUILD_LOG:\n{}",
+                            rt.info.platform, rt.info.device, error_name(err), err, rt.options,
+                            annotate_build_log(log, src)));
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<Runtime> runtime_for(const std::string& selector) {
+  static std::mutex mutex;
+  static std::map<cl_device_id, std::shared_ptr<Runtime> > cache;
+  const auto devices = enumerate_devices();
+  if (devices.empty())
+    throw Error(ExitCode::usage,
+                "backend 'opencl': no OpenCL platform or device found (install an OpenCL "
+                "driver, e.g. pocl-opencl-icd or the GPU vendor's, or use --backend cpu)");
+  const DeviceEntry* chosen = nullptr;
+  if (!selector.empty()) {
+    for (const auto& d : devices)
+      if (matches(d, selector)) {
+        chosen = &d;
+        break;
+      }
+    if (!chosen)
+      throw Error(ExitCode::usage,
+                  fmt::format("ERODEM_OPENCL_DEVICE='{}': no OpenCL device matches "
+                              "'<platform>:<device>'; devices: {}",
+                              selector, describe(devices)));
+  } else {
+    for (const auto& d : devices)
+      if (d.info.gpu()) {
+        chosen = &d;
+        break;
+      }
+    if (!chosen) chosen = &devices.front();
+  }
+
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[chosen->device];
+  if (slot) return slot;
+  auto rt = std::make_shared<Runtime>();
+  rt->info = chosen->info;
+  rt->platform = chosen->platform;
+  rt->device = chosen->device;
+  rt->fp64 = chosen->info.fp64;
+  rt->max_work_group = device_value<std::size_t>(rt->device, CL_DEVICE_MAX_WORK_GROUP_SIZE);
+  const cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
+                                         reinterpret_cast<cl_context_properties>(rt->platform), 0};
+  cl_int err = CL_SUCCESS;
+  cl_device_id device = rt->device;
+  rt->context = Context(clCreateContext(props, 1, &device, nullptr, nullptr, &err));
+  check(err, "clCreateContext");
+  // IEEE float32 as on the CPU: no fast-math options; correctly rounded divide and sqrt
+  // where the device offers them; the kernels switch FP_CONTRACT off.
+  rt->options = "-cl-std=CL1.2 -D real=float";
+  if (rt->fp64) rt->options += " -D ERODEM_HAVE_FP64=1";
+  const auto fp = device_value<cl_device_fp_config>(rt->device, CL_DEVICE_SINGLE_FP_CONFIG);
+  if (fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
+    rt->options += " -cl-fp32-correctly-rounded-divide-sqrt";
+  build_program(*rt);
+  slot = rt;
+  return rt;
+}
+
+// ---- the backend ----------------------------------------------------------------------
+
+namespace {
+
+/// Sets kernel arguments in order.
+inline void set_arg(cl_kernel k, cl_uint index, const Buffer& b) {
+  cl_mem m = b.get();
+  check(clSetKernelArg(k, index, sizeof(cl_mem), &m), "clSetKernelArg");
+}
+template <class T>
+inline void set_arg(cl_kernel k, cl_uint index, const T& v) {
+  static_assert(std::is_arithmetic_v<T>, "kernel arguments: buffers or numbers");
+  check(clSetKernelArg(k, index, sizeof(T), &v), "clSetKernelArg");
+}
+template <class... Args>
+void set_args(cl_kernel k, const Args&... args) {
+  cl_uint index = 0;
+  (set_arg(k, index++, args), ...);
+}
+
+constexpr std::size_t kReduceMax = 256;  // ERODEM_REDUCE_MAX of stats.cl
+constexpr std::size_t kReduceGroupsMax = 1024;
+
+}  // namespace
+
+OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
+                             const std::string& selector)
+    : params_(params),
+      nx_(terrain.grid.nx),
+      ny_(terrain.grid.ny),
+      W_(terrain.grid.nx + 2),
+      H_(terrain.grid.ny + 2) {
+  if (params.numerics.precision == Precision::float64)
+    throw Error(ExitCode::config,
+                "numerics.precision: the opencl backend runs float32 (the float64 reference "
+                "runs on the cpu backend: --backend cpu)");
+  const auto& g = terrain.grid;
+  g.validate();
+  n_ = static_cast<std::size_t>(W_) * H_;
+  if (n_ > static_cast<std::size_t>(std::numeric_limits<cl_int>::max()))
+    throw Error(ExitCode::data, fmt::format("backend 'opencl': a grid of {} x {} is too large "
+                                            "(at most 2^31 padded cells)",
+                                            nx_, ny_));
+  const std::size_t cells = g.cells();
+  auto check_size = [&](const std::vector<double>& v, const char* what) {
+    if (!v.empty() && v.size() != cells)
+      throw Error(ExitCode::data,
+                  fmt::format("{}: {} values for a grid of {} x {}", what, v.size(), g.nx, g.ny));
+  };
+  check_size(terrain.bed, "bed");
+  if (terrain.bed.size() != cells) throw Error(ExitCode::data, "bed: missing");
+  check_size(terrain.water_depth, "initial water depth");
+  check_size(terrain.manning_n, "flow.manning_n");
+  check_size(terrain.hardness, "erosion.hardness");
+  check_size(terrain.rain_factor, "rain.raster");
+
+  rt_ = runtime_for(selector);
+  cl_int err = CL_SUCCESS;
+  queue_ = Queue(clCreateCommandQueue(rt_->context.get(), rt_->device, 0, &err));
+  check(err, "clCreateCommandQueue");
+  acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
+
+  // ---- the host state, built exactly as the CPU reference builds it ----
+  auto at = [&](int x, int y) {
+    return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
+  };
+  std::vector<Real> dx(H_), dy(H_), area(H_);
+  area_host_.resize(H_);
+  for (int y = 0; y < H_; ++y) {
+    const int r = std::clamp(y - 1, 0, ny_ - 1);
+    dx[y] = static_cast<Real>(g.dx[r]);
+    dy[y] = static_cast<Real>(g.dy[r]);
+    area[y] = static_cast<Real>(g.area[r]);
+    area_host_[y] = area[y];
+  }
+  using Kind = cl_uchar;
+  const double sea = params.boundary.sea_level;
+  std::vector<Kind> kind(n_, ERODEM_CELL_WALL);
+  for (int r = 0; r < ny_; ++r)
+    for (int c = 0; c < nx_; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx_ + c;
+      kind[at(c + 1, r + 1)] = terrain.active(i)                           ? ERODEM_CELL_ACTIVE
+                               : params.boundary.nodata == NodataKind::sea ? ERODEM_CELL_FIXED
+                                                                           : ERODEM_CELL_WALL;
+    }
+  auto edge_kind = [](BoundaryKind b) {
+    switch (b) {
+      case BoundaryKind::open:
+        return Kind{ERODEM_CELL_OPEN};
+      case BoundaryKind::fixed_level:
+        return Kind{ERODEM_CELL_FIXED};
+      case BoundaryKind::closed:
+        break;
+    }
+    return Kind{ERODEM_CELL_WALL};
+  };
+  for (int y = 1; y <= ny_; ++y) {
+    if (kind[at(1, y)] == ERODEM_CELL_ACTIVE) kind[at(0, y)] = edge_kind(params.boundary.west);
+    if (kind[at(nx_, y)] == ERODEM_CELL_ACTIVE)
+      kind[at(nx_ + 1, y)] = edge_kind(params.boundary.east);
+  }
+  for (int x = 1; x <= nx_; ++x) {
+    if (kind[at(x, 1)] == ERODEM_CELL_ACTIVE) kind[at(x, 0)] = edge_kind(params.boundary.north);
+    if (kind[at(x, ny_)] == ERODEM_CELL_ACTIVE)
+      kind[at(x, ny_ + 1)] = edge_kind(params.boundary.south);
+  }
+  std::vector<double> bed(n_, 0.0), depth(n_, 0.0);
+  for (int r = 0; r < ny_; ++r)
+    for (int c = 0; c < nx_; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx_ + c;
+      const auto p = at(c + 1, r + 1);
+      if (kind[p] != ERODEM_CELL_ACTIVE) continue;
+      bed[p] = terrain.bed[i];
+      if (!terrain.water_depth.empty())
+        depth[p] = terrain.water_depth[i];
+      else if (params.initial.water_level)
+        depth[p] = std::max(0.0, *params.initial.water_level - bed[p]);
+      else
+        depth[p] = params.initial.water_depth.value;
+    }
+  for (int y = 1; y <= ny_; ++y)
+    for (int x = 1; x <= nx_; ++x) {
+      const auto p = at(x, y);
+      if (kind[p] == ERODEM_CELL_ACTIVE) continue;
+      double low = sea;
+      for (auto q : {p - 1, p + 1, p - W_, p + W_})
+        if (kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, bed[q]);
+      bed[p] = kind[p] == ERODEM_CELL_FIXED ? low : 0.0;
+      depth[p] = kind[p] == ERODEM_CELL_FIXED ? sea - low : 0.0;
+    }
+  auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
+  auto raster_or = [&](const std::vector<double>& raster, double scalar) {
+    std::vector<Real> out(n_, static_cast<Real>(scalar));
+    if (raster.empty()) return out;
+    for (int y = 0; y < H_; ++y)
+      for (int x = 0; x < W_; ++x) {
+        const int r = std::clamp(y - 1, 0, ny_ - 1), c = std::clamp(x - 1, 0, nx_ - 1);
+        out[at(x, y)] = static_cast<Real>(raster[static_cast<std::size_t>(r) * nx_ + c]);
+      }
+    return out;
+  };
+  const std::vector<Real> bed_r = to_real(bed), depth_r = to_real(depth), zeros(n_, Real(0));
+
+  // ---- the device state ----
+  kind_ = upload(kind);
+  dx_ = upload(dx);
+  dy_ = upload(dy);
+  area_ = upload(area);
+  bed_ = upload(bed_r);
+  bed_next_ = upload(bed_r);
+  bed0_ = upload(bed_r);
+  depth_ = upload(depth_r);
+  depth_next_ = upload(depth_r);
+  sediment_ = upload(zeros);
+  sediment_next_ = upload(zeros);
+  for (int k = 0; k < 4; ++k) {
+    flux_[k] = upload(zeros);
+    flux_next_[k] = upload(zeros);
+  }
+  velocity_x_ = upload(zeros);
+  velocity_y_ = upload(zeros);
+  thermal_share_ = upload(zeros);
+  wetness_ = upload(depth_r);
+  manning_ = upload(raster_or(terrain.manning_n, params.flow.manning_n.value));
+  hardness_ = upload(raster_or(terrain.hardness, params.erosion.hardness.value));
+  rain_factor_ = upload(raster_or(terrain.rain_factor, 1.0));
+  tally_a_ = upload(zeros);
+  tally_b_ = upload(zeros);
+
+  // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
+  // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
+  std::size_t limit = std::min(kReduceMax, rt_->max_work_group);
+  for (const char* name : {"reduce_sum", "reduce_change", "field_stats"}) {
+    std::size_t wg = 0;
+    check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
+                                   &wg, nullptr),
+          "clGetKernelWorkGroupInfo");
+    limit = std::min(limit, wg);
+  }
+  reduce_local_ = 1;
+  while (reduce_local_ * 2 <= limit) reduce_local_ *= 2;
+  reduce_groups_ =
+      std::clamp<std::size_t>((n_ + reduce_local_ - 1) / reduce_local_, 1, kReduceGroupsMax);
+  partial_a_ = make_buffer(reduce_groups_ * 5 * acc_size_);
+  partial_b_ = make_buffer(reduce_groups_ * acc_size_);
+  partial_cells_ = make_buffer(reduce_groups_ * 3 * sizeof(cl_long));
+  run_boundary();
+}
+
+std::string OpenClBackend::device() const {
+  return rt_->info.platform + " / " + rt_->info.device;
+}
+
+Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
+  cl_int err = CL_SUCCESS;
+  const cl_mem_flags flags = CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0);
+  Buffer b(clCreateBuffer(rt_->context.get(), flags, std::max<std::size_t>(bytes, 1),
+                          const_cast<void*>(data), &err));
+  check(err, "clCreateBuffer");
+  return b;
+}
+
+cl_kernel OpenClBackend::kernel(const char* name) {
+  for (auto& [n, k] : kernels_)
+    if (n == name) return k.get();
+  cl_int err = CL_SUCCESS;
+  Kernel k(clCreateKernel(rt_->program.get(), name, &err));
+  check(err, fmt::format("clCreateKernel({})", name).c_str());
+  kernels_.emplace_back(name, std::move(k));
+  return kernels_.back().second.get();
+}
+
+void OpenClBackend::launch_cells(cl_kernel k) {
+  auto round_up = [](std::size_t v, std::size_t m) { return (v + m - 1) / m * m; };
+  const std::size_t global[2] = {round_up(static_cast<std::size_t>(W_), 16),
+                                 round_up(static_cast<std::size_t>(H_), 4)};
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, nullptr, global, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel");
+}
+
+void OpenClBackend::launch_reduction(cl_kernel k) {
+  const std::size_t global = reduce_groups_ * reduce_local_, local = reduce_local_;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel");
+}
+
+std::vector<double> OpenClBackend::read_acc(const Buffer& b, std::size_t count) {
+  std::vector<double> out(count);
+  if (acc_size_ == sizeof(double)) {
+    check(clEnqueueReadBuffer(queue_.get(), b.get(), CL_TRUE, 0, count * sizeof(double), out.data(),
+                              0, nullptr, nullptr),
+          "clEnqueueReadBuffer");
+  } else {
+    std::vector<float> f(count);
+    check(clEnqueueReadBuffer(queue_.get(), b.get(), CL_TRUE, 0, count * sizeof(float), f.data(), 0,
+                              nullptr, nullptr),
+          "clEnqueueReadBuffer");
+    std::copy(f.begin(), f.end(), out.begin());
+  }
+  return out;
+}
+
+double OpenClBackend::reduce_sum(const Buffer& values) {
+  cl_kernel k = kernel("reduce_sum");
+  set_args(k, static_cast<cl_int>(n_), values, partial_b_);
+  launch_reduction(k);
+  double s = 0.0;
+  for (double v : read_acc(partial_b_, reduce_groups_)) s += v;
+  return s;
+}
+
+void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
+  const Real dt = static_cast<Real>(in.dt);
+  switch (p) {
+    case Process::boundary:
+      run_boundary();
+      break;
+    case Process::sources:
+      run_sources(in);
+      break;
+    case Process::flow:
+      run_flow(dt);
+      break;
+    case Process::water:
+      run_water(dt, tally);
+      break;
+    case Process::erosion:
+      run_erosion(dt);
+      break;
+    case Process::transport:
+      run_transport(dt, tally);
+      break;
+    case Process::thermal:
+      run_thermal(dt);
+      break;
+    case Process::evaporation:
+      run_evaporation(dt, tally);
+      break;
+  }
+}
+
+void OpenClBackend::run_boundary() {
+  cl_kernel k = kernel("boundary_fill");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_,
+           static_cast<Real>(params_.boundary.sea_level));
+  const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(boundary_fill)");
+}
+
+void OpenClBackend::run_sources(const StepInputs& in) {
+  const Real dt = static_cast<Real>(in.dt);
+  const Real rate = static_cast<Real>(in.rain_rate);
+  if (rate != Real(0)) {
+    cl_kernel k = kernel("sources_rain");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, rain_factor_, dt, rate);
+    launch_cells(k);
+  }
+  if (in.points.empty()) return;
+  std::vector<cl_int> cells;
+  std::vector<Real> amounts;
+  for (const auto& p : in.points) {
+    const int x = static_cast<int>(p.cell % nx_) + 1, y = static_cast<int>(p.cell / nx_) + 1;
+    cells.push_back(x + y * W_);
+    amounts.push_back(static_cast<Real>(p.volume / area_host_[y]));
+  }
+  if (cells.size() > point_capacity_) {
+    point_capacity_ = std::max<std::size_t>(cells.size(), 2 * point_capacity_);
+    point_cells_ = make_buffer(point_capacity_ * sizeof(cl_int));
+    point_amounts_ = make_buffer(point_capacity_ * sizeof(Real));
+  }
+  check(clEnqueueWriteBuffer(queue_.get(), point_cells_.get(), CL_TRUE, 0,
+                             cells.size() * sizeof(cl_int), cells.data(), 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer");
+  check(clEnqueueWriteBuffer(queue_.get(), point_amounts_.get(), CL_TRUE, 0,
+                             amounts.size() * sizeof(Real), amounts.data(), 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer");
+  cl_kernel k = kernel("sources_points");
+  set_args(k, depth_, point_cells_, point_amounts_, static_cast<cl_int>(cells.size()));
+  const std::size_t one = 1;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &one, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(sources_points)");
+}
+
+void OpenClBackend::run_flow(Real dt) {
+  const auto& f = params_.flow;
+  const Real g = static_cast<Real>(f.gravity);
+  if (f.scheme == FlowScheme::pipes) {
+    cl_kernel k = kernel("flow_pipes");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, dx_, dy_, area_, flux_[0], flux_[1],
+             flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], dt, g,
+             static_cast<Real>(f.pipe_area), static_cast<Real>(f.pipe_length));
+    launch_cells(k);
+  } else {
+    cl_kernel k = kernel("flow_local_inertial");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_, area_, flux_[0],
+             flux_[1], flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2],
+             flux_next_[3], dt, g, static_cast<Real>(f.theta),
+             static_cast<Real>(params_.numerics.dry_depth));
+    launch_cells(k);
+  }
+  std::swap(flux_, flux_next_);
+}
+
+void OpenClBackend::run_water(Real dt, StepTally& tally) {
+  cl_kernel k = kernel("water_update");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, depth_next_, flux_[0], flux_[1], flux_[2],
+           flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
+           static_cast<Real>(params_.numerics.velocity_min_depth), tally_a_, tally_b_);
+  launch_cells(k);
+  tally.boundary_water_out += static_cast<double>(dt) * reduce_sum(tally_a_);
+  tally.clipped += reduce_sum(tally_b_);
+  // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
+  std::swap(depth_, depth_next_);
+}
+
+void OpenClBackend::run_erosion(Real dt) {
+  const auto& e = params_.erosion;
+  const Real bedrock = e.bedrock_level ? static_cast<Real>(*e.bedrock_level)
+                                       : -std::numeric_limits<Real>::infinity();
+  cl_kernel k = kernel("erosion");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, sediment_, depth_, velocity_x_,
+           velocity_y_, hardness_, dx_, dy_, dt, static_cast<Real>(e.sediment_capacity),
+           static_cast<Real>(e.dissolving_rate), static_cast<Real>(e.deposition_rate),
+           static_cast<Real>(e.min_tilt), static_cast<Real>(e.min_depth), bedrock);
+  launch_cells(k);
+  std::swap(bed_, bed_next_);
+}
+
+void OpenClBackend::run_transport(Real dt, StepTally& tally) {
+  if (params_.transport.scheme == TransportScheme::conservative) {
+    cl_kernel k = kernel("transport_conservative");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
+             flux_[1], flux_[2], flux_[3], area_, dt, tally_a_);
+    launch_cells(k);
+    tally.sediment_out += reduce_sum(tally_a_);
+  } else {
+    cl_kernel k = kernel("transport_semi_lagrangian");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
+             dx_, dy_, dt);
+    launch_cells(k);
+    cl_kernel r = kernel("reduce_change");
+    set_args(r, cl_int{W_}, cl_int{H_}, kind_, sediment_next_, sediment_, area_, partial_b_);
+    launch_reduction(r);
+    double change = 0.0;
+    for (double v : read_acc(partial_b_, reduce_groups_)) change += v;
+    tally.transport_change += change;
+  }
+  std::swap(sediment_, sediment_next_);
+}
+
+void OpenClBackend::run_thermal(Real dt) {
+  const double pi = 3.14159265358979323846;
+  const Real tan_talus = static_cast<Real>(std::tan(params_.thermal.talus_angle * pi / 180.0));
+  const Real rate = static_cast<Real>(params_.thermal.rate);
+  cl_kernel share = kernel("thermal_share");
+  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, dx_, dy_, area_, thermal_share_, dt, rate,
+           tan_talus);
+  launch_cells(share);
+  cl_kernel apply = kernel("thermal_apply");
+  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, thermal_share_, dx_, dy_, area_, bed_next_,
+           tan_talus);
+  launch_cells(apply);
+  std::swap(bed_, bed_next_);
+}
+
+void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
+  const Real rate = static_cast<Real>(params_.evaporation.rate);
+  const Real tau = static_cast<Real>(params_.numerics.wetness_time);
+  cl_kernel k = kernel("evaporation");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, rate, tau,
+           cl_int{rate > Real(0) ? 1 : 0}, tally_a_);
+  launch_cells(k);
+  tally.evaporated += reduce_sum(tally_a_);
+}
+
+FieldStats OpenClBackend::stats() {
+  cl_kernel k = kernel("field_stats");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, velocity_x_, velocity_y_,
+           area_, partial_a_, partial_cells_);
+  launch_reduction(k);
+  const auto sums = read_acc(partial_a_, reduce_groups_ * 5);
+  std::vector<cl_long> cells(reduce_groups_ * 3);
+  check(clEnqueueReadBuffer(queue_.get(), partial_cells_.get(), CL_TRUE, 0,
+                            cells.size() * sizeof(cl_long), cells.data(), 0, nullptr, nullptr),
+        "clEnqueueReadBuffer");
+  // Groups in order; the maxima keep the first cell of the largest value (as the CPU's
+  // row-order scan does), whatever group holds it.
+  FieldStats st;
+  double max_d = -1, max_v = -1;
+  for (std::size_t g = 0; g < reduce_groups_; ++g) {
+    st.water_volume += sums[5 * g + 0];
+    st.material_volume += sums[5 * g + 1];
+    st.sediment_volume += sums[5 * g + 2];
+    auto take = [](double v, std::int64_t c, double& best, std::int64_t& best_c) {
+      if (c < 0) return;
+      if (best_c < 0 || v > best || (v == best && c < best_c)) {
+        best = v;
+        best_c = c;
+      }
+    };
+    take(sums[5 * g + 3], cells[3 * g + 0], max_d, st.max_depth_cell);
+    take(sums[5 * g + 4], cells[3 * g + 1], max_v, st.max_speed_cell);
+    const std::int64_t bad = cells[3 * g + 2];
+    if (bad >= 0 && (st.bad_cell < 0 || bad < st.bad_cell)) st.bad_cell = bad;
+  }
+  st.max_depth = std::max(0.0, max_d);
+  st.max_speed = std::max(0.0, max_v);
+  return st;
+}
+
+Buffer* OpenClBackend::field_buffer(FieldId id) {
+  switch (id) {
+    case FieldId::bed:
+      return &bed_;
+    case FieldId::water_depth:
+      return &depth_;
+    case FieldId::sediment:
+      return &sediment_;
+    case FieldId::velocity_x:
+      return &velocity_x_;
+    case FieldId::velocity_y:
+      return &velocity_y_;
+    case FieldId::flux_left:
+      return &flux_[ERODEM_LEFT];
+    case FieldId::flux_right:
+      return &flux_[ERODEM_RIGHT];
+    case FieldId::flux_top:
+      return &flux_[ERODEM_TOP];
+    case FieldId::flux_bottom:
+      return &flux_[ERODEM_BOTTOM];
+    case FieldId::hardness:
+      return &hardness_;
+    case FieldId::wetness:
+      return &wetness_;
+    case FieldId::manning_n:
+      return &manning_;
+    case FieldId::erosion:
+      return nullptr;
+  }
+  return nullptr;
+}
+
+namespace {
+
+/// The DEM cells (the padded raster without its halo) of a buffer, row-major (ny, nx).
+std::vector<float> read_interior(cl_command_queue q, cl_mem b, int nx, int ny) {
+  std::vector<float> out(static_cast<std::size_t>(nx) * ny);
+  const std::size_t origin[3] = {sizeof(float), 1, 0};
+  const std::size_t region[3] = {static_cast<std::size_t>(nx) * sizeof(float),
+                                 static_cast<std::size_t>(ny), 1};
+  check(clEnqueueReadBufferRect(q, b, CL_TRUE, origin, std::array<std::size_t, 3>{0, 0, 0}.data(),
+                                region, (static_cast<std::size_t>(nx) + 2) * sizeof(float), 0,
+                                static_cast<std::size_t>(nx) * sizeof(float), 0, out.data(), 0,
+                                nullptr, nullptr),
+        "clEnqueueReadBufferRect");
+  return out;
+}
+
+void write_interior(cl_command_queue q, cl_mem b, int nx, int ny, const std::vector<float>& v) {
+  const std::size_t origin[3] = {sizeof(float), 1, 0};
+  const std::size_t host_origin[3] = {0, 0, 0};
+  const std::size_t region[3] = {static_cast<std::size_t>(nx) * sizeof(float),
+                                 static_cast<std::size_t>(ny), 1};
+  check(clEnqueueWriteBufferRect(q, b, CL_TRUE, origin, host_origin, region,
+                                 (static_cast<std::size_t>(nx) + 2) * sizeof(float), 0,
+                                 static_cast<std::size_t>(nx) * sizeof(float), 0, v.data(), 0,
+                                 nullptr, nullptr),
+        "clEnqueueWriteBufferRect");
+}
+
+}  // namespace
+
+std::vector<double> OpenClBackend::field(FieldId id) const {
+  auto* self = const_cast<OpenClBackend*>(this);
+  if (id == FieldId::erosion) {
+    const auto b0 = read_interior(queue_.get(), bed0_.get(), nx_, ny_);
+    const auto b = read_interior(queue_.get(), bed_.get(), nx_, ny_);
+    std::vector<double> out(b.size());
+    for (std::size_t i = 0; i < b.size(); ++i)
+      out[i] = static_cast<double>(b0[i]) - static_cast<double>(b[i]);
+    return out;
+  }
+  const auto v = read_interior(queue_.get(), self->field_buffer(id)->get(), nx_, ny_);
+  return std::vector<double>(v.begin(), v.end());
+}
+
+void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
+  if (values.size() != static_cast<std::size_t>(nx_) * ny_)
+    throw Error(ExitCode::data, fmt::format("field '{}': {} values for a grid of {} x {}",
+                                            field_info(id).name, values.size(), nx_, ny_));
+  Buffer* dst = field_buffer(id);
+  if (!dst) throw Error(ExitCode::usage, "field 'erosion' is derived and cannot be set");
+  // Fields kept in two buffers get both, so the next step starts from the new values.
+  Buffer* twin = id == FieldId::bed           ? &bed_next_
+                 : id == FieldId::water_depth ? &depth_next_
+                 : id == FieldId::sediment    ? &sediment_next_
+                                              : nullptr;
+  const std::vector<float> v(values.begin(), values.end());
+  write_interior(queue_.get(), dst->get(), nx_, ny_, v);
+  if (twin) write_interior(queue_.get(), twin->get(), nx_, ny_, v);
+}
+
+}  // namespace opencl
+
+// ---- the public functions -----------------------------------------------------------------
+
+std::vector<ClDeviceInfo> list_opencl_devices() {
+  std::vector<ClDeviceInfo> out;
+  for (auto& e : opencl::enumerate_devices()) out.push_back(std::move(e.info));
+  return out;
+}
+
+bool opencl_available() {
+  return !opencl::enumerate_devices().empty();
+}
+
+std::unique_ptr<Backend> make_opencl_backend(const Terrain& terrain, const Params& params) {
+  const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
+  return std::make_unique<opencl::OpenClBackend>(terrain, params, env ? env : "");
+}
+
+}  // namespace erodem
+
+#endif

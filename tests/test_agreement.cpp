@@ -1,0 +1,120 @@
+// erodem — agreement of the OpenCL backend with the CPU reference (MODEL.md "Precision and
+// agreement between backends"): 1,000 steps of a full erosion run on a crop of a real DEM,
+// in float32 on both, every field compared by relative L2 difference (bound 1e-5).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "erodem/backends.hpp"
+#include "erodem/io/raster.hpp"
+#include "erodem/simulation.hpp"
+
+namespace erodem::test {
+namespace {
+
+const std::string kTujunga =
+    std::string(ERODEM_SHARED_DIR) + "/data/dem/big_tujunga/srtm_bigtujunga30m_utm11.tif";
+
+struct AgreementCase {
+  std::string name;
+  FlowScheme flow;
+  TransportScheme transport;
+  bool adaptive;
+  double dt;  ///< s: the fixed step, or the upper bound of the adaptive one
+};
+
+Params agreement_params(const AgreementCase& c) {
+  Params p;
+  p.dem.path = kTujunga;
+  p.dem.window = std::array<int, 4>{420, 180, 256, 256};
+  p.flow.scheme = c.flow;
+  p.flow.manning_n.value = 0.035;
+  p.time.adaptive = c.adaptive;
+  p.time.dt = c.dt;
+  p.time.dt_max = c.dt;
+  p.rain.rate = 2e-4;  // 720 mm/h: a storm that makes channels flow within 1,000 steps
+  p.erosion.enabled = true;
+  p.erosion.sediment_capacity = 0.5;
+  p.transport.scheme = c.transport;
+  p.thermal.enabled = true;
+  p.thermal.talus_angle = 35.0;
+  p.evaporation.rate = 1e-6;
+  p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
+  p.numerics.precision = Precision::float32;
+  p.numerics.wetness_time = 600.0;
+  return p;
+}
+
+/// ||a - b|| / ||b||, 0 when both vanish.
+double relative_l2(const std::vector<double>& a, const std::vector<double>& b) {
+  double diff = 0, norm = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff += (a[i] - b[i]) * (a[i] - b[i]);
+    norm += b[i] * b[i];
+  }
+  if (norm == 0) return diff == 0 ? 0.0 : INFINITY;
+  return std::sqrt(diff / norm);
+}
+
+class Agreement : public ::testing::TestWithParam<AgreementCase> {};
+
+TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
+  if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  const AgreementCase& c = GetParam();
+  const Params params = agreement_params(c);
+  const Terrain terrain = io::read_dem(params.dem);
+  Simulation cpu(terrain, params, make_backend("cpu", terrain, params));
+  Simulation ocl(terrain, params, make_backend("opencl", terrain, params));
+  std::printf("[agreement] %s: %d x %d cells of %s, on '%s' and '%s'\n", c.name.c_str(),
+              terrain.grid.nx, terrain.grid.ny, kTujunga.c_str(), cpu.backend().device().c_str(),
+              ocl.backend().device().c_str());
+  for (int k = 0; k < 10; ++k) {
+    cpu.step(100);
+    ocl.step(100);
+  }
+  EXPECT_EQ(cpu.steps_done(), 1000);
+  EXPECT_EQ(ocl.steps_done(), 1000);
+  std::printf(
+      "[agreement] %s: time %.6g s (cpu) %.6g s (opencl); max depth %.4g m, max speed "
+      "%.4g m/s, water %.6g m^3, rain %.6g m^3, out %.6g m^3\n",
+      c.name.c_str(), cpu.time(), ocl.time(), cpu.last_stats().max_depth,
+      cpu.last_stats().max_speed, cpu.ledger().water, cpu.ledger().rain, cpu.ledger().boundary_out);
+  EXPECT_NEAR(ocl.time(), cpu.time(), 1e-5 * cpu.time());
+  const double bound = 1e-5;
+  for (FieldId id : {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
+                     FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right,
+                     FieldId::flux_top, FieldId::flux_bottom, FieldId::wetness, FieldId::erosion}) {
+    const auto a = ocl.field(id), b = cpu.field(id);
+    ASSERT_EQ(a.size(), b.size());
+    const double rel = relative_l2(a, b);
+    std::printf("[agreement] %s %-12s relative L2 %.3e (bound %.0e)\n", c.name.c_str(),
+                field_info(id).name, rel, bound);
+    EXPECT_LT(rel, bound) << field_info(id).name;
+  }
+  // The ledgers agree too.
+  const auto& L = cpu.ledger();
+  const auto& M = ocl.ledger();
+  std::printf(
+      "[agreement] %s ledger: water %.9g / %.9g, material %.12g / %.12g, "
+      "boundary out %.6g / %.6g, closure %.3e / %.3e\n",
+      c.name.c_str(), L.water, M.water, L.material, M.material, L.boundary_out, M.boundary_out,
+      L.relative_closure_error(), M.relative_closure_error());
+  EXPECT_NEAR(M.water, L.water, 1e-5 * L.water);
+  EXPECT_NEAR(M.material, L.material, 1e-6 * std::abs(L.material));
+  EXPECT_NEAR(M.boundary_out, L.boundary_out, 1e-5 * std::abs(L.boundary_out) + 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Tujunga, Agreement,
+    ::testing::Values(AgreementCase{"local_inertial_conservative", FlowScheme::local_inertial,
+                                    TransportScheme::conservative, true, 2.0},
+                      AgreementCase{"pipes_semi_lagrangian", FlowScheme::pipes,
+                                    TransportScheme::semi_lagrangian, false, 0.5}),
+    [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
+
+}  // namespace
+}  // namespace erodem::test
