@@ -31,6 +31,7 @@ std::unique_ptr<Backend> make_opencl_backend(const Terrain&, const Params&) {
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -260,10 +261,11 @@ void expand(const std::string& name, ProgramSource& out, std::set<std::string>& 
 }  // namespace
 
 ProgramSource assemble_program() {
-  // The process files in step order, then the reductions; every other embedded .cl after.
-  std::vector<std::string> order = {"boundary.cl", "sources.cl",     "flow.cl",
-                                    "water.cl",    "erosion.cl",     "transport.cl",
-                                    "thermal.cl",  "evaporation.cl", "stats.cl"};
+  // What the reductions share, the process files in step order, then the reductions; every
+  // other embedded .cl after.
+  std::vector<std::string> order = {"reduce.cl",      "boundary.cl", "sources.cl",   "flow.cl",
+                                    "water.cl",       "erosion.cl",  "transport.cl", "thermal.cl",
+                                    "evaporation.cl", "stats.cl"};
   for (std::size_t k = 0; k < kEmbeddedSourceCount; ++k) {
     const std::string name = kEmbeddedSources[k].name;
     if (name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0 &&
@@ -425,8 +427,23 @@ void set_args(cl_kernel k, const Args&... args) {
   (set_arg(k, index++, args), ...);
 }
 
-constexpr std::size_t kReduceMax = 256;  // ERODEM_REDUCE_MAX of stats.cl
+constexpr std::size_t kReduceMax = 256;      // ERODEM_REDUCE_MAX of stats.cl
+constexpr std::size_t kCellGroupMax = 1024;  // ERODEM_CELL_GROUP_MAX of reduce.cl
 constexpr std::size_t kReduceGroupsMax = 1024;
+constexpr std::size_t kTallySlots = 4;  // ERODEM_TALLY_SLOTS of reduce.cl
+constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
+                   kEvaporatedBit = 1u << 3, kTallyBits = 0xfu, kChangeBit = 1u << 4;
+
+/// The cell kernels' work-group shape (powers of two): ERODEM_OPENCL_WG / ERODEM_OPENCL_WG_Y
+/// if set (tuning), else (64, 1) on CPU devices (PoCL vectorises across the work-items of a
+/// row; (64, 4), (256, 4), (64, 16) measured no better at 1024^2) and (128, 1) on others.
+std::size_t env_size(const char* name, std::size_t fallback) {
+  if (const char* env = std::getenv(name); env && *env) {
+    const long v = std::strtol(env, nullptr, 10);
+    if (v >= 1) return static_cast<std::size_t>(v);
+  }
+  return fallback;
+}
 
 }  // namespace
 
@@ -571,13 +588,11 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   manning_ = upload(raster_or(terrain.manning_n, params.flow.manning_n.value));
   hardness_ = upload(raster_or(terrain.hardness, params.erosion.hardness.value));
   rain_factor_ = upload(raster_or(terrain.rain_factor, 1.0));
-  tally_a_ = upload(zeros);
-  tally_b_ = upload(zeros);
 
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
   // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
   std::size_t limit = std::min(kReduceMax, rt_->max_work_group);
-  for (const char* name : {"reduce_sum", "reduce_change", "field_stats"}) {
+  for (const char* name : {"reduce_tallies", "reduce_change", "field_stats"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -591,6 +606,33 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   partial_a_ = make_buffer(reduce_groups_ * 5 * acc_size_);
   partial_b_ = make_buffer(reduce_groups_ * acc_size_);
   partial_cells_ = make_buffer(reduce_groups_ * 3 * sizeof(cl_long));
+
+  // Cell kernels: work-groups of (local_x_, local_y_), powers of two every cell kernel
+  // accepts; a fixed number of groups for this grid (the tallies' partials, summed in a
+  // fixed order).
+  const bool cpu = rt_->info.type == "CPU";
+  std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
+  for (const char* name : {"sources_rain", "flow_pipes", "flow_local_inertial", "water_update",
+                           "erosion", "transport_conservative", "transport_semi_lagrangian",
+                           "thermal_share", "thermal_apply", "evaporation"}) {
+    std::size_t wg = 0;
+    check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
+                                   &wg, nullptr),
+          "clGetKernelWorkGroupInfo");
+    cell_limit = std::min(cell_limit, wg);
+  }
+  auto pow2_at_most = [](std::size_t v) {
+    std::size_t p = 1;
+    while (p * 2 <= v) p *= 2;
+    return p;
+  };
+  local_x_ = pow2_at_most(std::min(cell_limit, env_size("ERODEM_OPENCL_WG", cpu ? 64 : 128)));
+  local_y_ = pow2_at_most(std::min(cell_limit / local_x_, env_size("ERODEM_OPENCL_WG_Y", 1)));
+  groups_x_ = (static_cast<std::size_t>(W_) + local_x_ - 1) / local_x_;
+  groups_y_ = (static_cast<std::size_t>(H_) + local_y_ - 1) / local_y_;
+  cell_groups_ = groups_x_ * groups_y_;
+  tally_partials_ = make_buffer(kTallySlots * cell_groups_ * acc_size_);
+  tally_sums_ = make_buffer(kTallySlots * acc_size_);
   run_boundary();
 }
 
@@ -618,42 +660,85 @@ cl_kernel OpenClBackend::kernel(const char* name) {
 }
 
 void OpenClBackend::launch_cells(cl_kernel k) {
-  auto round_up = [](std::size_t v, std::size_t m) { return (v + m - 1) / m * m; };
-  const std::size_t global[2] = {round_up(static_cast<std::size_t>(W_), 16),
-                                 round_up(static_cast<std::size_t>(H_), 4)};
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, nullptr, global, nullptr, 0, nullptr, nullptr),
+  const std::size_t global[2] = {groups_x_ * local_x_, groups_y_ * local_y_};
+  const std::size_t local[2] = {local_x_, local_y_};
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, nullptr, global, local, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel");
 }
 
-void OpenClBackend::launch_reduction(cl_kernel k) {
-  const std::size_t global = reduce_groups_ * reduce_local_, local = reduce_local_;
+void OpenClBackend::launch_reduction(cl_kernel k, std::size_t groups) {
+  const std::size_t global = groups * reduce_local_, local = reduce_local_;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel");
 }
 
-std::vector<double> OpenClBackend::read_acc(const Buffer& b, std::size_t count) {
+void OpenClBackend::read(const Buffer& b, std::size_t bytes, void* dst, bool blocking) {
+  check(clEnqueueReadBuffer(queue_.get(), b.get(), blocking ? CL_TRUE : CL_FALSE, 0, bytes, dst, 0,
+                            nullptr, nullptr),
+        "clEnqueueReadBuffer");
+}
+
+std::vector<double> OpenClBackend::acc_values(const std::vector<unsigned char>& raw,
+                                              std::size_t count) const {
   std::vector<double> out(count);
-  if (acc_size_ == sizeof(double)) {
-    check(clEnqueueReadBuffer(queue_.get(), b.get(), CL_TRUE, 0, count * sizeof(double), out.data(),
-                              0, nullptr, nullptr),
-          "clEnqueueReadBuffer");
-  } else {
-    std::vector<float> f(count);
-    check(clEnqueueReadBuffer(queue_.get(), b.get(), CL_TRUE, 0, count * sizeof(float), f.data(), 0,
-                              nullptr, nullptr),
-          "clEnqueueReadBuffer");
-    std::copy(f.begin(), f.end(), out.begin());
+  for (std::size_t k = 0; k < count; ++k) {
+    if (acc_size_ == sizeof(double)) {
+      std::memcpy(&out[k], raw.data() + k * sizeof(double), sizeof(double));
+    } else {
+      float f;
+      std::memcpy(&f, raw.data() + k * sizeof(float), sizeof(float));
+      out[k] = f;
+    }
   }
   return out;
 }
 
-double OpenClBackend::reduce_sum(const Buffer& values) {
-  cl_kernel k = kernel("reduce_sum");
-  set_args(k, static_cast<cl_int>(n_), values, partial_b_);
-  launch_reduction(k);
-  double s = 0.0;
-  for (double v : read_acc(partial_b_, reduce_groups_)) s += v;
-  return s;
+void OpenClBackend::defer(StepTally& tally, unsigned bits) {
+  // A tally for another StepTally, or one whose slot is still pending: deliver first.
+  if (pending_ && (pending_tally_ != &tally || (pending_ & bits))) flush_tallies();
+  pending_tally_ = &tally;
+  pending_ |= bits;
+}
+
+void OpenClBackend::enqueue_tally_reduction() {
+  if (!(pending_ & kTallyBits)) return;
+  cl_kernel k = kernel("reduce_tallies");
+  set_args(k, static_cast<cl_int>(cell_groups_), tally_partials_, tally_sums_);
+  launch_reduction(k, kTallySlots);
+}
+
+void OpenClBackend::deliver_tallies() {
+  if (!pending_ || !pending_tally_) {
+    pending_ = 0;
+    return;
+  }
+  StepTally& t = *pending_tally_;
+  if (pending_ & kTallyBits) {
+    const auto v = acc_values(tally_raw_, kTallySlots);
+    if (pending_ & kExchangeBit)
+      t.boundary_water_out += static_cast<double>(pending_water_dt_) * v[0];
+    if (pending_ & kClippedBit) t.clipped += v[1];
+    if (pending_ & kSedimentBit) t.sediment_out += v[2];
+    if (pending_ & kEvaporatedBit) t.evaporated += v[3];
+  }
+  if (pending_ & kChangeBit) {
+    double change = 0.0;
+    for (double v : acc_values(change_raw_, reduce_groups_)) change += v;
+    t.transport_change += change;
+  }
+  pending_ = 0;
+  pending_tally_ = nullptr;
+}
+
+void OpenClBackend::flush_tallies() {
+  if (!pending_) return;
+  enqueue_tally_reduction();
+  tally_raw_.resize(kTallySlots * acc_size_);
+  change_raw_.resize(reduce_groups_ * acc_size_);
+  if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
+  if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  check(clFinish(queue_.get()), "clFinish");
+  deliver_tallies();
 }
 
 void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
@@ -711,19 +796,33 @@ void OpenClBackend::run_sources(const StepInputs& in) {
     cells.push_back(x + y * W_);
     amounts.push_back(static_cast<Real>(p.volume / area_host_[y]));
   }
-  if (cells.size() > point_capacity_) {
-    point_capacity_ = std::max<std::size_t>(cells.size(), 2 * point_capacity_);
+  // The previous upload (if any) may still read the host vectors.
+  if (points_written_) {
+    cl_event e = points_written_.get();
+    check(clWaitForEvents(1, &e), "clWaitForEvents");
+    points_written_.reset();
+  }
+  point_cells_host_ = std::move(cells);
+  point_amounts_host_ = std::move(amounts);
+  const auto& cells_h = point_cells_host_;
+  const auto& amounts_h = point_amounts_host_;
+  if (cells_h.size() > point_capacity_) {
+    point_capacity_ = std::max<std::size_t>(cells_h.size(), 2 * point_capacity_);
     point_cells_ = make_buffer(point_capacity_ * sizeof(cl_int));
     point_amounts_ = make_buffer(point_capacity_ * sizeof(Real));
   }
-  check(clEnqueueWriteBuffer(queue_.get(), point_cells_.get(), CL_TRUE, 0,
-                             cells.size() * sizeof(cl_int), cells.data(), 0, nullptr, nullptr),
+  // Non-blocking uploads (the queue is in order): the step does not wait for the device.
+  check(clEnqueueWriteBuffer(queue_.get(), point_cells_.get(), CL_FALSE, 0,
+                             cells_h.size() * sizeof(cl_int), cells_h.data(), 0, nullptr, nullptr),
         "clEnqueueWriteBuffer");
-  check(clEnqueueWriteBuffer(queue_.get(), point_amounts_.get(), CL_TRUE, 0,
-                             amounts.size() * sizeof(Real), amounts.data(), 0, nullptr, nullptr),
-        "clEnqueueWriteBuffer");
+  cl_event written = nullptr;
+  check(
+      clEnqueueWriteBuffer(queue_.get(), point_amounts_.get(), CL_FALSE, 0,
+                           amounts_h.size() * sizeof(Real), amounts_h.data(), 0, nullptr, &written),
+      "clEnqueueWriteBuffer");
+  points_written_ = Event(written);
   cl_kernel k = kernel("sources_points");
-  set_args(k, depth_, point_cells_, point_amounts_, static_cast<cl_int>(cells.size()));
+  set_args(k, depth_, point_cells_, point_amounts_, static_cast<cl_int>(cells_h.size()));
   const std::size_t one = 1;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &one, nullptr, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel(sources_points)");
@@ -753,10 +852,11 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
   cl_kernel k = kernel("water_update");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, depth_next_, flux_[0], flux_[1], flux_[2],
            flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
-           static_cast<Real>(params_.numerics.velocity_min_depth), tally_a_, tally_b_);
+           static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
+           static_cast<cl_int>(cell_groups_));
+  defer(tally, kExchangeBit | kClippedBit);
+  pending_water_dt_ = dt;
   launch_cells(k);
-  tally.boundary_water_out += static_cast<double>(dt) * reduce_sum(tally_a_);
-  tally.clipped += reduce_sum(tally_b_);
   // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
   std::swap(depth_, depth_next_);
 }
@@ -778,9 +878,10 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
   if (params_.transport.scheme == TransportScheme::conservative) {
     cl_kernel k = kernel("transport_conservative");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
-             flux_[1], flux_[2], flux_[3], area_, dt, tally_a_);
+             flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
+             static_cast<cl_int>(cell_groups_));
+    defer(tally, kSedimentBit);
     launch_cells(k);
-    tally.sediment_out += reduce_sum(tally_a_);
   } else {
     cl_kernel k = kernel("transport_semi_lagrangian");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
@@ -788,10 +889,8 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
     launch_cells(k);
     cl_kernel r = kernel("reduce_change");
     set_args(r, cl_int{W_}, cl_int{H_}, kind_, sediment_next_, sediment_, area_, partial_b_);
-    launch_reduction(r);
-    double change = 0.0;
-    for (double v : read_acc(partial_b_, reduce_groups_)) change += v;
-    tally.transport_change += change;
+    defer(tally, kChangeBit);
+    launch_reduction(r, reduce_groups_);
   }
   std::swap(sediment_, sediment_next_);
 }
@@ -816,21 +915,33 @@ void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
   const Real tau = static_cast<Real>(params_.numerics.wetness_time);
   cl_kernel k = kernel("evaporation");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, rate, tau,
-           cl_int{rate > Real(0) ? 1 : 0}, tally_a_);
+           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(cell_groups_));
+  defer(tally, kEvaporatedBit);
   launch_cells(k);
-  tally.evaporated += reduce_sum(tally_a_);
+}
+
+void OpenClBackend::finish() {
+  flush_tallies();
+  check(clFinish(queue_.get()), "clFinish");
 }
 
 FieldStats OpenClBackend::stats() {
   cl_kernel k = kernel("field_stats");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, velocity_x_, velocity_y_,
            area_, partial_a_, partial_cells_);
-  launch_reduction(k);
-  const auto sums = read_acc(partial_a_, reduce_groups_ * 5);
+  launch_reduction(k, reduce_groups_);
+  // The step's tallies with the statistics: one wait per step (the queue is in order).
+  enqueue_tally_reduction();
+  tally_raw_.resize(kTallySlots * acc_size_);
+  change_raw_.resize(reduce_groups_ * acc_size_);
+  if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
+  if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
   std::vector<cl_long> cells(reduce_groups_ * 3);
-  check(clEnqueueReadBuffer(queue_.get(), partial_cells_.get(), CL_TRUE, 0,
-                            cells.size() * sizeof(cl_long), cells.data(), 0, nullptr, nullptr),
-        "clEnqueueReadBuffer");
+  read(partial_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
+  stats_sums_raw_.resize(reduce_groups_ * 5 * acc_size_);
+  read(partial_a_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
+  deliver_tallies();
+  const auto sums = acc_values(stats_sums_raw_, reduce_groups_ * 5);
   // Groups in order; the maxima keep the first cell of the largest value (as the CPU's
   // row-order scan does), whatever group holds it.
   FieldStats st;

@@ -8,20 +8,22 @@ ERODEM_BEGIN_NAMESPACE
 
 /* Depth-averaged velocity (m/s) from the discharge through the two opposite faces of a cell:
  * through_a, through_b (m^3/s, positive in the velocity's direction), the face width (m)
- * and the mean depth (m); 0 where the mean depth is below min_depth (m). */
+ * and the mean depth (m); 0 where the mean depth is below min_depth (m). Branch-free, so
+ * loops over cells vectorise. */
 ERODEM_FN real face_velocity(real through_a, real through_b, real width, real mean_depth,
                              real min_depth) {
-  return mean_depth < min_depth || !(mean_depth > 0)
-             ? (real)0
-             : (through_a + through_b) * (real)0.5 / (width * mean_depth);
+  const int flowing = mean_depth >= min_depth && mean_depth > 0;
+  const real safe_depth = flowing ? mean_depth : (real)1;
+  const real v = (through_a + through_b) * (real)0.5 / (width * safe_depth);
+  return flowing ? v : (real)0;
 }
 
-/* Water update of active padded cell (x, y):
+/* Water update of padded cell (x, y) (active cells change; others keep their depth):
  *   d <- d + dt (sum inflow - sum outflow) / area,
  * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the mean of the
  * depths before and after. Writes depth_out; returns through *exchange the net discharge
  * out of the domain through this cell's faces with ghosts (m^3/s) and through *clipped the
- * volume (m^3) added to lift a rounding-level negative depth back to zero. */
+ * volume (m^3) added to lift a rounding-level negative depth back to zero. Branch-free. */
 ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                  GLOBAL const real* depth, GLOBAL real* depth_out,
                                  GLOBAL const real* f_left, GLOBAL const real* f_right,
@@ -31,6 +33,7 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
                                  GLOBAL real* velocity_y, real dt, real velocity_min_depth,
                                  real* exchange, real* clipped) {
   const int i = x + y * W;
+  const int active = kind[i] == ERODEM_CELL_ACTIVE;
   /* what each neighbour gives to this cell */
   const real in_left = f_right[i - 1];
   const real in_right = f_left[i + 1];
@@ -39,29 +42,29 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   const real inflow = in_left + in_right + in_top + in_bottom;
   const real outflow = f_left[i] + f_right[i] + f_top[i] + f_bottom[i];
   const real d_old = depth[i];
-  real d_new = d_old + dt * (inflow - outflow) / area[y];
-  /* The outflow limit keeps d_new >= 0 up to rounding: lift such a rounding-level negative
+  const real d_raw = d_old + dt * (inflow - outflow) / area[y];
+  /* The outflow limit keeps d_raw >= 0 up to rounding: lift such a rounding-level negative
    * to 0 and book the volume; anything deeper is left for the stability check to stop. */
-  *clipped = 0;
   const real rounding = (real)64 * ERODEM_EPSILON(real) * (d_old + dt * inflow / area[y]);
-  if (d_new < 0 && d_new >= -rounding) {
-    *clipped = -d_new * area[y];
-    d_new = 0;
-  }
-  depth_out[i] = d_new;
+  const int lift = d_raw < 0 && d_raw >= -rounding;
+  const real d_new = lift ? (real)0 : d_raw;
+  *clipped = active && lift ? -d_raw * area[y] : (real)0;
+  depth_out[i] = active ? d_new : d_old;
 
-  real ex = 0;
-  if (kind[i - 1] != ERODEM_CELL_ACTIVE) ex += f_left[i] - in_left;
-  if (kind[i + 1] != ERODEM_CELL_ACTIVE) ex += f_right[i] - in_right;
-  if (kind[i - W] != ERODEM_CELL_ACTIVE) ex += f_top[i] - in_top;
-  if (kind[i + W] != ERODEM_CELL_ACTIVE) ex += f_bottom[i] - in_bottom;
-  *exchange = ex;
+  /* net outflow through faces shared with ghosts (walls carry nothing) */
+  const real ex = (kind[i - 1] != ERODEM_CELL_ACTIVE ? f_left[i] - in_left : (real)0) +
+                  (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] - in_right : (real)0) +
+                  (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] - in_top : (real)0) +
+                  (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] - in_bottom : (real)0);
+  *exchange = active ? ex : (real)0;
 
   const real d_mean = (real)0.5 * (d_old + d_new);
-  velocity_x[i] =
+  const real u =
       face_velocity(in_left - f_left[i], f_right[i] - in_right, dy[y], d_mean, velocity_min_depth);
-  velocity_y[i] =
+  const real v =
       face_velocity(in_bottom - f_bottom[i], f_top[i] - in_top, dx[y], d_mean, velocity_min_depth);
+  velocity_x[i] = active ? u : (real)0;
+  velocity_y[i] = active ? v : (real)0;
 }
 
 ERODEM_END_NAMESPACE

@@ -55,6 +55,12 @@ class CpuBackend final : public Backend {
   }
   /// Sums per-row partial sums in row order (deterministic for any thread count).
   static double sum_rows(const std::vector<double>& rows);
+  /// Sums a row of per-cell values in double, in order.
+  static double sum_row(const std::vector<Real>& row) {
+    double s = 0.0;
+    for (Real v : row) s += static_cast<double>(v);
+    return s;
+  }
   std::vector<Real>* field_storage(FieldId id);
 
   Params params_;

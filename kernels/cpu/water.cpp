@@ -1,4 +1,6 @@
-// CPU loop of the water process: kernels/common/water.h over the active cells.
+// CPU loop of the water process: kernels/common/water.h over the interior cells (the cell
+// function leaves non-active cells as they are). Per-cell tallies go to a row buffer summed
+// after the row, so the cell loop itself vectorises.
 #include "common/water.h"
 
 #include "cpu/cpu_backend.hpp"
@@ -8,20 +10,23 @@ namespace erodem {
 template <class Real>
 void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
   const Real d_min = static_cast<Real>(params_.numerics.velocity_min_depth);
-  for_rows(1, H_ - 1, [&](int y) {
-    double exchange_row = 0.0, clipped_row = 0.0;
-    for (int x = 1; x < W_ - 1; ++x) {
-      if (kind_[at(x, y)] != ERODEM_CELL_ACTIVE) continue;
-      Real exchange = 0, clipped = 0;
-      cell::water_update_cell(x, y, W_, kind_.data(), depth_.data(), depth_next_.data(),
-                              flux_[0].data(), flux_[1].data(), flux_[2].data(), flux_[3].data(),
-                              dx_.data(), dy_.data(), area_.data(), velocity_x_.data(),
-                              velocity_y_.data(), dt, d_min, &exchange, &clipped);
-      exchange_row += exchange;
-      clipped_row += clipped;
-    }
-    row_sums_a_[y] = exchange_row;
-    row_sums_b_[y] = clipped_row;
+  const Kind* kind = kind_.data();
+  const Real *depth = depth_.data(), *fl = flux_[0].data(), *fr = flux_[1].data(),
+             *ft = flux_[2].data(), *fb = flux_[3].data();
+  const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
+  Real *depth_out = depth_next_.data(), *u = velocity_x_.data(), *v = velocity_y_.data();
+  const int W = W_;
+  for_rows(1, H_ - 1, [=](int y) {
+    // Locals, not closure members: stores to Real arrays could alias those.
+    const Real step = dt, min_depth = d_min;
+    std::vector<Real> exchange(W), clipped(W);
+    Real* ex = exchange.data();
+    Real* cl = clipped.data();
+    for (int x = 1; x < W - 1; ++x)
+      cell::water_update_cell(x, y, W, kind, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u, v,
+                              step, min_depth, ex + x, cl + x);
+    row_sums_a_[y] = sum_row(exchange);
+    row_sums_b_[y] = sum_row(clipped);
   });
   tally.boundary_water_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
   tally.clipped += sum_rows(row_sums_b_);

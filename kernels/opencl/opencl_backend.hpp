@@ -62,6 +62,7 @@ using Queue = Handle<cl_command_queue, clReleaseCommandQueue>;
 using Program = Handle<cl_program, clReleaseProgram>;
 using Kernel = Handle<cl_kernel, clReleaseKernel>;
 using Buffer = Handle<cl_mem, clReleaseMemObject>;
+using Event = Handle<cl_event, clReleaseEvent>;
 
 /// Where a line of the assembled program came from.
 struct SourceOrigin {
@@ -111,6 +112,7 @@ class OpenClBackend final : public Backend {
   std::string device() const override;
   void run(Process p, const StepInputs& in, StepTally& tally) override;
   FieldStats stats() override;
+  void finish() override;
   std::vector<double> field(FieldId id) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
 
@@ -132,14 +134,28 @@ class OpenClBackend final : public Backend {
     return make_buffer(v.size() * sizeof(T), v.data());
   }
   cl_kernel kernel(const char* name);
-  /// Runs a cell kernel over the padded raster (W x H, rounded up; the kernels bound-check).
+  /// Runs a cell kernel over the padded raster: work-groups of (local_x_, local_y_), the global
+  /// size rounded up to whole groups (the kernels bound-check).
   void launch_cells(cl_kernel k);
-  /// Runs a reduction kernel with reduce_groups_ groups of reduce_local_ work-items.
-  void launch_reduction(cl_kernel k);
-  /// Sum over the padded raster `values` (real), in double, combined in group order.
-  double reduce_sum(const Buffer& values);
-  /// Reads `count` accumulator values (double or float on the device) as doubles.
-  std::vector<double> read_acc(const Buffer& b, std::size_t count);
+  /// Runs a reduction kernel with `groups` groups of reduce_local_ work-items.
+  void launch_reduction(cl_kernel k, std::size_t groups);
+  /// Enqueues a read of `bytes` of `b` into `dst`; blocking or not.
+  void read(const Buffer& b, std::size_t bytes, void* dst, bool blocking);
+  /// `count` accumulator values (double or float on the device, as read) as doubles.
+  std::vector<double> acc_values(const std::vector<unsigned char>& raw, std::size_t count) const;
+
+  // The ledger's tallies stay on the device until stats() or finish() (or a run() that would
+  // overwrite them): one read per step instead of one blocking reduction per process. They
+  // are then added to the StepTally the processes were run with, which the caller keeps
+  // alive until then (the driver's step does).
+  /// Marks the tallies of `bits` as pending for `tally` (delivering earlier ones first).
+  void defer(StepTally& tally, unsigned bits);
+  /// Enqueues the reduction of the pending tally slots (no read).
+  void enqueue_tally_reduction();
+  /// Adds the pending tallies, read into tally_raw_ / change_raw_, to the pending StepTally.
+  void deliver_tallies();
+  /// Reads and delivers the pending tallies now (blocking).
+  void flush_tallies();
   Buffer* field_buffer(FieldId id);
 
   Params params_;
@@ -149,14 +165,24 @@ class OpenClBackend final : public Backend {
   int nx_, ny_, W_, H_;
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
+  // The cell kernels' groups: (local_x_, local_y_) work-items, groups_x_ * groups_y_ of them.
+  std::size_t local_x_ = 1, local_y_ = 1, groups_x_ = 1, groups_y_ = 1, cell_groups_ = 1;
   std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
   Buffer kind_, dx_, dy_, area_;
   Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;
   std::array<Buffer, 4> flux_, flux_next_;
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
-  Buffer tally_a_, tally_b_, partial_a_, partial_b_, partial_cells_;
+  Buffer partial_a_, partial_b_, partial_cells_;
+  Buffer tally_partials_, tally_sums_;  // [slot][cell group] partials, [slot] sums
+  StepTally* pending_tally_ = nullptr;
+  unsigned pending_ = 0;       // bits: 1 << tally slot; kChangeBit: the transport change
+  Real pending_water_dt_ = 0;  // the exchange tally is a discharge: times the step
+  std::vector<unsigned char> stats_sums_raw_, stats_cells_raw_, tally_raw_, change_raw_;
   Buffer point_cells_, point_amounts_;
   std::size_t point_capacity_ = 0;
+  std::vector<cl_int> point_cells_host_;  // the sources of an upload that may be in flight
+  std::vector<Real> point_amounts_host_;
+  Event points_written_;
 };
 
 }  // namespace erodem::opencl

@@ -3,22 +3,21 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "transport.h"
 
-/* One work-item per padded cell (the global size may be rounded up); the sediment carried out
- * of the domain goes to a scratch raster (0 where nothing runs) that stats.cl reduces. */
+/* One work-item per padded cell (the global size is rounded up to whole work-groups); the
+ * sediment carried out of the domain is summed per work-group into the tally partials. */
 __kernel void transport_conservative(int W, int H, __global const uchar* kind,
                                      __global const real* sediment, __global real* sediment_out,
                                      __global const real* depth_flow, __global const real* f_left,
                                      __global const real* f_right, __global const real* f_top,
                                      __global const real* f_bottom, __global const real* area,
-                                     real dt, __global real* tally_out) {
+                                     real dt, __global acc_t* partials, int groups) {
+  __local acc_t s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x >= W || y >= H) return;
-  const int i = x + y * W;
   real out = 0;
-  if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[i] == ERODEM_CELL_ACTIVE)
+  if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[x + y * W] == ERODEM_CELL_ACTIVE)
     transport_conservative_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left, f_right,
                                 f_top, f_bottom, area, dt, &out);
-  tally_out[i] = out;
+  cell_group_sum(s, (acc_t)out, partials + ERODEM_TALLY_SEDIMENT * groups + cell_group_index());
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */

@@ -66,7 +66,9 @@ class Backend {
   virtual std::string name() const = 0;
   /// What runs the kernels, e.g. "CPU reference, float32, 2 threads".
   virtual std::string device() const = 0;
-  /// Runs one process of the step sequence.
+  /// Runs one process of the step sequence. A backend may add the process's volumes to
+  /// `tally` later, at the next stats() or finish() (the OpenCL backend keeps them on the
+  /// device until then): keep `tally` alive until one of those returns.
   virtual void run(Process p, const StepInputs& in, StepTally& tally) = 0;
   /// Reductions over the current state.
   virtual FieldStats stats() = 0;
