@@ -1,18 +1,22 @@
 // `erodem bench`: cell-steps per second of each process and of the full step, per backend,
-// measured in one run.
+// measured in one run, set against a byte model of each process and the memory bandwidth
+// measured in the same run (docs/performance.md).
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
+#include "bandwidth.hpp"
 #include "commands.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/simulation.hpp"
 #include "erodem/terrain_synth.hpp"
+#include "json.hpp"
 
 namespace erodem::cli {
 
@@ -25,6 +29,7 @@ struct BenchOptions {
   long steps = 20;
   std::string backends = "cpu";
   std::string threads = "0";
+  long stream_floats = 64L << 20;  ///< elements per array of the bandwidth probe
   bool json = false;
 };
 
@@ -50,46 +55,153 @@ Params bench_params() {
   return p;
 }
 
-struct Row {
-  std::string backend, device, process;
-  double seconds_per_step = 0, cell_steps_per_second = 0;
+// ---- the byte model ---------------------------------------------------------------------
+//
+// The bytes each process must move per cell and step: every distinct field a sweep over the
+// grid reads, once, plus every field it writes, once; 4 bytes per float32 field, 1 byte for
+// the cell-kind field. Neighbour reads of a field count once (they hit the cache lines the
+// sweep brings in anyway); per-row arrays (dx, dy, area) are negligible; write-allocate
+// traffic is not counted, as STREAM does not count it. Counted from the cell functions of
+// kernels/common/*.h and the loops of kernels/cpu/*.cpp:
+//   boundary     boundary_fill_cell (boundary.h), cpu/boundary.cpp: halo cells only
+//   sources      rain_cell (sources.h), run_sources: reads kind, depth, rain_factor;
+//                writes depth (points only when it does not rain: nothing per cell)
+//   flow         flow_local_inertial_cell (flow.h), run_flow: reads kind, bed, depth,
+//                manning, 4 fluxes; writes 4 new fluxes. Pipes: no manning.
+//   water        water_update_cell (water.h), run_water: reads kind, depth, 4 fluxes;
+//                writes depth_next, velocity_x, velocity_y
+//   erosion      erosion_cell (erosion.h), run_erosion: reads kind, bed, sediment, depth,
+//                velocity_x, velocity_y, hardness; writes bed_next, sediment
+//   transport    transport_conservative_cell (transport.h), run_transport: reads kind,
+//                sediment, depth_next (the depth the flow saw), 4 fluxes; writes
+//                sediment_next. Semi-Lagrangian: reads kind, sediment, velocity_x,
+//                velocity_y; writes sediment_next
+//   thermal      two sweeps, thermal_share_cell then thermal_apply_cell (thermal.h),
+//                run_thermal: reads kind, bed, writes share; then reads kind, bed, share,
+//                writes bed_next
+//   evaporation  evaporation_cell, wetness_cell (sources.h), run_evaporation: reads kind,
+//                depth, wetness; writes depth (when the rate > 0), wetness
+//   stats        CpuBackend::stats, cell_state_ok (stats.h): reads kind, bed, depth,
+//                sediment, velocity_x, velocity_y; the driver runs it after every step
+// The OpenCL backend moves the same fields, plus per-cell scratch tallies that its
+// reductions sum (water, transport, evaporation), not counted here.
+struct BytesPerCell {
+  int read = 0, write = 0;
+  const char* reads;
+  const char* writes;
+  int total() const { return read + write; }
 };
 
-std::vector<Row> bench_one(const Terrain& terrain, Params p, const std::string& backend,
-                           long steps) {
+BytesPerCell bytes_per_cell(const std::string& process, const Params& p) {
+  constexpr int F = 4, K = 1;  // float32 field, cell kind
+  if (process == "boundary") return {0, 0, "(halo cells only)", ""};
+  if (process == "sources")
+    return p.rain.rate > 0 || !p.rain.series.empty()
+               ? BytesPerCell{K + 2 * F, F, "kind depth rain_factor", "depth"}
+               : BytesPerCell{0, 0, "(inflow cells only)", ""};
+  if (process == "flow")
+    return p.flow.scheme == FlowScheme::local_inertial
+               ? BytesPerCell{K + 7 * F, 4 * F, "kind bed depth manning flux*4", "flux*4"}
+               : BytesPerCell{K + 6 * F, 4 * F, "kind bed depth flux*4", "flux*4"};
+  if (process == "water")
+    return {K + 5 * F, 3 * F, "kind depth flux*4", "depth velocity_x velocity_y"};
+  if (process == "erosion")
+    return {K + 6 * F, 2 * F, "kind bed sediment depth velocity_x velocity_y hardness",
+            "bed sediment"};
+  if (process == "transport")
+    return p.transport.scheme == TransportScheme::conservative
+               ? BytesPerCell{K + 6 * F, F, "kind sediment depth_flow flux*4", "sediment"}
+               : BytesPerCell{K + 3 * F, F, "kind sediment velocity_x velocity_y", "sediment"};
+  if (process == "thermal")
+    return {(K + F) + (K + 2 * F), 2 * F, "kind bed | kind bed share", "share | bed"};
+  if (process == "evaporation")
+    return p.evaporation.rate > 0
+               ? BytesPerCell{K + 2 * F, 2 * F, "kind depth wetness", "depth wetness"}
+               : BytesPerCell{K + 2 * F, F, "kind depth wetness", "wetness"};
+  if (process == "stats")
+    return {K + 5 * F, 0, "kind bed depth sediment velocity_x velocity_y", ""};
+  return {0, 0, "", ""};
+}
+
+struct Row {
+  std::string backend, device, process;
+  int threads = 0;  ///< requested CPU threads (0: all cores); 0 for OpenCL
+  int bytes = 0;    ///< bytes per cell of the byte model
+  double seconds_per_step = 0, cell_steps_per_second = 0;
+  double gbs() const { return bytes * cell_steps_per_second / 1e9; }
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+constexpr int kRepetitions = 3;
+
+std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::string& backend,
+                           int threads, long steps) {
   auto be = make_backend(backend, terrain, p);
   Simulation sim(terrain, p, std::move(be));
   const auto seq = sim.sequence();
   const double cells = static_cast<double>(terrain.grid.cells());
   sim.step(3);  // warm-up: kernel builds, caches, page faults
   sim.backend().finish();
-  std::vector<double> per_process(seq.size(), 0.0);
   using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  // Per repetition and process: seconds per step. Slot seq.size() is the stats() reduction,
+  // the last one the full step.
+  const std::size_t n_stats = seq.size(), n_full = seq.size() + 1;
+  std::vector<std::vector<double>> per_step(seq.size() + 2);
   const double dt = sim.next_dt();
-  // Per process: each one run alone, waited for.
-  for (long s = 0; s < steps; ++s) {
-    const StepInputs in = sim.inputs_for(dt);
-    StepTally tally;
-    for (std::size_t k = 0; k < seq.size(); ++k) {
+  for (int rep = 0; rep < kRepetitions; ++rep) {
+    // Each process alone, waited for; then the reduction the driver runs after each step.
+    std::vector<double> total(seq.size() + 1, 0.0);
+    for (long s = 0; s < steps; ++s) {
+      const StepInputs in = sim.inputs_for(dt);
+      StepTally tally;
+      for (std::size_t k = 0; k < seq.size(); ++k) {
+        const auto t0 = Clock::now();
+        sim.backend().run(seq[k], in, tally);
+        sim.backend().finish();
+        total[k] += since(t0);
+      }
       const auto t0 = Clock::now();
-      sim.backend().run(seq[k], in, tally);
-      sim.backend().finish();
-      per_process[k] += std::chrono::duration<double>(Clock::now() - t0).count();
+      const FieldStats st = sim.backend().stats();
+      total[n_stats] += since(t0);
+      if (st.bad_cell >= 0)
+        throw Error(ExitCode::unstable, "bench: the benchmark state went unstable");
     }
+    for (std::size_t k = 0; k <= n_stats; ++k) per_step[k].push_back(total[k] / steps);
+    // Full steps as the driver runs them (with the ledger's reductions).
+    const auto t0 = Clock::now();
+    sim.step(steps);
+    sim.backend().finish();
+    per_step[n_full].push_back(since(t0) / steps);
   }
-  // Full steps as the driver runs them (with the ledger's reductions).
-  const auto t0 = Clock::now();
-  sim.step(steps);
-  sim.backend().finish();
-  const double full = std::chrono::duration<double>(Clock::now() - t0).count() / steps;
   std::vector<Row> rows;
   const std::string device = sim.backend().device();
-  for (std::size_t k = 0; k < seq.size(); ++k) {
-    const double sps = per_process[k] / steps;
-    rows.push_back({backend, device, process_name(seq[k]), sps, cells / sps});
+  int full_bytes = 0;
+  for (std::size_t k = 0; k < per_step.size(); ++k) {
+    const std::string name = k < seq.size() ? process_name(seq[k])
+                             : k == n_stats ? "stats"
+                                            : "full_step";
+    const int bytes = k == n_full ? full_bytes : bytes_per_cell(name, p).total();
+    full_bytes += bytes;
+    const double sps = median(per_step[k]);
+    rows.push_back({backend, device, name, threads, bytes, sps, cells / sps});
   }
-  rows.push_back({backend, device, "full_step", full, cells / full});
   return rows;
+}
+
+/// The bandwidth a row is measured against: one thread for one CPU thread, else all.
+double copy_ref(const Row& r, const Bandwidth& bw) {
+  return r.backend == "cpu" && (r.threads == 1 || bw.threads == 1) ? bw.copy_one : bw.copy_all;
+}
+double triad_ref(const Row& r, const Bandwidth& bw) {
+  return r.backend == "cpu" && (r.threads == 1 || bw.threads == 1) ? bw.triad_one : bw.triad_all;
 }
 
 int bench(const BenchOptions& o) {
@@ -109,34 +221,104 @@ int bench(const BenchOptions& o) {
     terrain = make_synthetic_terrain(d);
   }
   if (o.steps < 1) throw Error(ExitCode::usage, "--steps: expected at least 1");
-  std::vector<Row> rows;
+  if (o.stream_floats < 1024) throw Error(ExitCode::usage, "--stream-floats: expected >= 1024");
+  std::vector<std::pair<std::string, int>> runs;
   for (const auto& backend : split(o.backends)) {
-    const auto thread_list = backend == "cpu" ? split(o.threads) : std::vector<std::string>{"0"};
-    for (const auto& t : thread_list) {
-      Params p = bench_params();
-      p.numerics.threads = std::stoi(t);
-      auto r = bench_one(terrain, p, backend, o.steps);
-      rows.insert(rows.end(), r.begin(), r.end());
+    if (backend != "cpu" && backend != "opencl" && backend != "auto")
+      throw Error(ExitCode::usage, "--backends: '" + backend + "': expected cpu, opencl or auto");
+    if (backend != "cpu") {
+      runs.push_back({backend, 0});
+      continue;
+    }
+    for (const auto& t : split(o.threads)) {
+      int n = -1;
+      try {
+        std::size_t used = 0;
+        n = std::stoi(t, &used);
+        if (used != t.size()) n = -1;
+      } catch (const std::exception&) {
+        n = -1;
+      }
+      if (n < 0) throw Error(ExitCode::usage, "--threads: '" + t + "': expected an integer >= 0");
+      runs.push_back({backend, n});
     }
   }
+  const Params params = bench_params();
+  std::vector<Row> rows;
+  for (const auto& [backend, threads] : runs) {
+    Params p = params;
+    p.numerics.threads = threads;
+    auto r = bench_one(terrain, p, backend, threads, o.steps);
+    rows.insert(rows.end(), r.begin(), r.end());
+  }
+  // The probe after the kernels, so its 3 arrays do not sit in memory during the runs.
+  const Bandwidth bw = measure_bandwidth(static_cast<std::size_t>(o.stream_floats));
+  const bool small = bw.llc_bytes > 0 && o.stream_floats * sizeof(float) < 4 * bw.llc_bytes;
+
   const auto& g = terrain.grid;
   if (o.json) {
-    std::printf("{\"grid\": [%d, %d], \"steps\": %ld, \"source\": \"%s\", \"results\": [\n", g.nx,
-                g.ny, o.steps, terrain.source.c_str());
-    for (std::size_t k = 0; k < rows.size(); ++k)
+    std::printf(
+        "{\"grid\": [%d, %d], \"cells\": %zu, \"steps\": %ld, \"repetitions\": %d, "
+        "\"source\": %s,\n",
+        g.nx, g.ny, g.cells(), o.steps, kRepetitions, json_string(terrain.source).c_str());
+    std::printf(
+        " \"bandwidth\": {\"floats_per_array\": %ld, \"bytes_per_array\": %zu, "
+        "\"last_level_cache_bytes\": %zu, \"below_4x_llc\": %s, \"repetitions\": %d, "
+        "\"threads\": %d, \"copy_gbs\": %s, \"triad_gbs\": %s, \"copy_gbs_1_thread\": %s, "
+        "\"triad_gbs_1_thread\": %s},\n",
+        o.stream_floats, static_cast<std::size_t>(o.stream_floats) * sizeof(float), bw.llc_bytes,
+        small ? "true" : "false", bw.repetitions, bw.threads, json_number(bw.copy_all).c_str(),
+        json_number(bw.triad_all).c_str(), json_number(bw.copy_one).c_str(),
+        json_number(bw.triad_one).c_str());
+    std::printf(" \"results\": [\n");
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const auto& r = rows[k];
+      const double c = copy_ref(r, bw), t = triad_ref(r, bw);
       std::printf(
-          "  {\"backend\": \"%s\", \"device\": \"%s\", \"process\": \"%s\", "
-          "\"seconds_per_step\": %.6e, \"cell_steps_per_second\": %.6e}%s\n",
-          rows[k].backend.c_str(), rows[k].device.c_str(), rows[k].process.c_str(),
-          rows[k].seconds_per_step, rows[k].cell_steps_per_second, k + 1 < rows.size() ? "," : "");
-    std::printf("]}\n");
-  } else {
-    std::printf("%s: %d x %d cells, %ld timed steps\n", terrain.source.c_str(), g.nx, g.ny,
-                o.steps);
-    std::printf("%-38s %-12s %14s %18s\n", "device", "process", "ms/step", "cell-steps/s");
-    for (const auto& r : rows)
-      std::printf("%-38s %-12s %14.3f %18.4g\n", r.device.c_str(), r.process.c_str(),
-                  1e3 * r.seconds_per_step, r.cell_steps_per_second);
+          "  {\"backend\": %s, \"device\": %s, \"threads\": %d, \"process\": %s, "
+          "\"seconds_per_step\": %s, \"cell_steps_per_second\": %s, \"bytes_per_cell\": %d, "
+          "\"gbs\": %s, \"fraction_of_copy\": %s, \"fraction_of_triad\": %s}%s\n",
+          json_string(r.backend).c_str(), json_string(r.device).c_str(), r.threads,
+          json_string(r.process).c_str(), json_number(r.seconds_per_step).c_str(),
+          json_number(r.cell_steps_per_second).c_str(), r.bytes, json_number(r.gbs()).c_str(),
+          json_number(r.bytes ? r.gbs() / c : std::nan("")).c_str(),
+          json_number(r.bytes ? r.gbs() / t : std::nan("")).c_str(),
+          k + 1 < rows.size() ? "," : "");
+    }
+    std::printf(" ]}\n");
+    return 0;
+  }
+  std::printf("%s: %d x %d cells, %ld timed steps, median of %d repetitions\n",
+              terrain.source.c_str(), g.nx, g.ny, o.steps, kRepetitions);
+  std::printf(
+      "memory bandwidth (median of %d, %.0f MiB per array%s): copy %.2f GB/s, triad %.2f GB/s "
+      "with %d thread%s; copy %.2f GB/s, triad %.2f GB/s with 1 thread\n",
+      bw.repetitions, o.stream_floats * 4.0 / (1024.0 * 1024.0),
+      small ? ", below 4x the last-level cache: cache-resident" : "", bw.copy_all, bw.triad_all,
+      bw.threads, bw.threads == 1 ? "" : "s", bw.copy_one, bw.triad_one);
+  // Runs by a short label; their devices listed first.
+  auto label = [](const Row& r) {
+    return r.backend == "cpu" ? fmt::format("cpu/{}", r.threads ? std::to_string(r.threads) : "all")
+                              : r.backend;
+  };
+  std::string last;
+  for (const auto& r : rows)
+    if (label(r) != last) {
+      last = label(r);
+      std::printf("  %-10s %s\n", last.c_str(), r.device.c_str());
+    }
+  std::printf("%-10s %-12s %10s %14s %6s %8s %7s %7s\n", "run", "process", "ms/step",
+              "cell-steps/s", "B/cell", "GB/s", "%copy", "%triad");
+  for (const auto& r : rows) {
+    const double c = copy_ref(r, bw), t = triad_ref(r, bw);
+    if (r.bytes)
+      std::printf("%-10s %-12s %10.3f %14.4g %6d %8.2f %6.0f%% %6.0f%%\n", label(r).c_str(),
+                  r.process.c_str(), 1e3 * r.seconds_per_step, r.cell_steps_per_second, r.bytes,
+                  r.gbs(), 100 * r.gbs() / c, 100 * r.gbs() / t);
+    else
+      std::printf("%-10s %-12s %10.3f %14.4g %6s %8s %7s %7s\n", label(r).c_str(),
+                  r.process.c_str(), 1e3 * r.seconds_per_step, r.cell_steps_per_second, "-", "-",
+                  "-", "-");
   }
   return 0;
 }
@@ -156,6 +338,8 @@ Action add_bench(CLI::App& app) {
   sub->add_option("--backends", o->backends, "Comma-separated backends (cpu, opencl)");
   sub->add_option("--threads", o->threads,
                   "Comma-separated CPU thread counts to measure (0 = all cores)");
+  sub->add_option("--stream-floats", o->stream_floats,
+                  "Floats per array of the memory-bandwidth probe (3 arrays; default 64Mi)");
   sub->add_flag("--json", o->json, "Machine-readable output");
   return [o] { return bench(*o); };
 }

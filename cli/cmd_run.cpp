@@ -7,12 +7,13 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "commands.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/config.hpp"
-#include "erodem/io/raster.hpp"
+#include "erodem/io/results.hpp"
 #include "erodem/io/setup.hpp"
 #include "erodem/schema.hpp"
 
@@ -34,12 +35,33 @@ struct RunOptions {
   bool overwrite = false;
 };
 
-/// Where field `name` of a run whose output is `path` goes (GeoTIFF until HDF5 lands):
-/// run.h5 -> run_bed.tif, run_water_depth.tif, ...
-std::string field_path(const std::string& path, const std::string& name) {
-  std::filesystem::path p(path);
-  p.replace_extension();
-  return p.string() + "_" + name + ".tif";
+/// This process's command line (recorded in the result file), arguments quoted for a shell
+/// where needed.
+std::string command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string line, arg;
+  auto flush = [&] {
+    const bool plain =
+        !arg.empty() && arg.find_first_of(" \t\n'\"\\$`*?;&|<>()[]{}") == std::string::npos;
+    if (!line.empty()) line += ' ';
+    if (plain) {
+      line += arg;
+    } else {
+      line += '\'';
+      for (char c : arg) line += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      line += '\'';
+    }
+    arg.clear();
+  };
+  for (char c : raw) {
+    if (c == '\0')
+      flush();
+    else
+      arg += c;
+  }
+  if (!arg.empty()) flush();
+  return line;
 }
 
 /// Progress on a terminal (a bar redrawn in place) or in a log (a line every 10 %).
@@ -92,13 +114,8 @@ int run(const RunOptions& o) {
     std::fputs(dump_toml(p).c_str(), stdout);
     return 0;
   }
-  if (!p.output.gauges.empty() || p.output.interval > 0 || p.output.every != Params{}.output.every)
-    spdlog::warn(
-        "output.every, output.interval and output.gauges take effect with the HDF5 "
-        "writer; this version writes the final fields only");
-  // Check every output can be created before spending time on the run.
-  for (const auto& f : p.output.fields)
-    check_output_path(field_path(p.output.path, f), o.overwrite);
+  // Check the output can be created before reading the inputs.
+  check_output_path(p.output.path, o.overwrite);
 
   Simulation sim = io::make_simulation(p, o.backend);
   const auto& g = sim.grid();
@@ -114,13 +131,34 @@ int run(const RunOptions& o) {
       p.time.duration > 0 ? fmt::format("{:.6g} s simulated", p.time.duration)
                           : fmt::format("{} steps", p.time.steps));
 
+  // Results go to a temporary file beside the output (flushed at every snapshot) that is
+  // renamed into place when the run completes.
+  io::ResultWriter writer(p.output.path, sim, command_line(), o.overwrite);
+  writer.snapshot(sim);  // t = 0
+  const auto partial_note = [&] {
+    return fmt::format("the results up to step {} (t = {:.6g} s) are in {}; {} was not created",
+                       sim.steps_done(), sim.time(), writer.partial(), writer.path());
+  };
+
   auto previous = std::signal(SIGINT, on_sigint);
   Progress progress(stderr_is_terminal());
   try {
     while (!sim.finished() && !g_interrupted) {
       sim.step();
+      writer.step_done(sim);  // diagnostics every step, snapshots as configured
       progress.update(sim);
     }
+  } catch (const Error& e) {
+    progress.done();
+    std::signal(SIGINT, previous);
+    if (e.code() != ExitCode::unstable) throw;
+    // Keep the failing step (its diagnostics and state) for inspection.
+    try {
+      writer.record_step(sim);
+      writer.snapshot(sim);
+    } catch (const Error&) {  // the partial file keeps the earlier snapshots
+    }
+    throw Error(e.code(), std::string(e.what()) + "; " + partial_note());
   } catch (...) {
     progress.done();
     std::signal(SIGINT, previous);
@@ -129,25 +167,24 @@ int run(const RunOptions& o) {
   progress.done();
   std::signal(SIGINT, previous);
   if (g_interrupted) {
-    std::fprintf(stderr, "erodem: interrupted at step %ld (t = %.6g s); no output written\n",
-                 sim.steps_done(), sim.time());
+    writer.snapshot(sim);
+    std::fprintf(stderr, "erodem: interrupted at step %ld (t = %.6g s); %s\n", sim.steps_done(),
+                 sim.time(), partial_note().c_str());
     return 130;
   }
+  writer.finish(sim);
   const double wall = progress.elapsed();
   const double cells = static_cast<double>(g.cells());
+  // The backend and device on stdout too, so a saved result names what computed it (the
+  // HDF5 writer records them as the root attributes `backend` and `device`).
+  std::printf("backend %s, device %s\n", sim.backend().name().c_str(),
+              sim.backend().device().c_str());
   std::printf("%s", sim.ledger().format().c_str());
   std::printf("ran %ld steps to t = %.6g s in %.3f s wall (%.3g cell-steps/s)\n", sim.steps_done(),
               sim.time(), wall, cells * sim.steps_done() / wall);
-  for (const auto& name : p.output.fields) {
-    const auto& info = field_info(name);
-    const auto values = sim.field(info.id);
-    std::vector<float> f32(values.begin(), values.end());
-    for (std::size_t i = 0; i < f32.size(); ++i)
-      if (!sim.terrain().active(i)) f32[i] = std::nanf("");  // nodata stays nodata
-    const std::string path = field_path(p.output.path, name);
-    io::write_geotiff(path, g, f32, fmt::format("{} ({})", info.long_name, info.units));
-    std::printf("wrote %s\n", path.c_str());
-  }
+  std::printf("wrote %s (%zu snapshots of %zu fields, diagnostics of %ld steps) and %s\n",
+              writer.path().c_str(), writer.snapshots(), p.output.fields.size(), sim.steps_done(),
+              io::xdmf_path(writer.path()).c_str());
   return 0;
 }
 

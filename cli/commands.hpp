@@ -13,6 +13,9 @@ using Action = std::function<int()>;
 Action add_run(CLI::App& app);
 Action add_generate(CLI::App& app);
 Action add_bench(CLI::App& app);
+Action add_devices(CLI::App& app);
+Action add_compare(CLI::App& app);
+Action add_info(CLI::App& app);
 
 /// Whether stderr is a terminal (progress bar) or a log (periodic lines).
 bool stderr_is_terminal();

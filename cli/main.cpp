@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
   add(cli::add_run);
   add(cli::add_generate);
   add(cli::add_bench);
+  add(cli::add_devices);
+  add(cli::add_compare);
+  add(cli::add_info);
   spdlog::set_default_logger(spdlog::stderr_logger_mt("erodem"));
   spdlog::set_pattern("[%H:%M:%S] %v");
   try {

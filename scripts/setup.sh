@@ -10,7 +10,8 @@ DEBIAN_PACKAGES=(
   build-essential cmake ninja-build pkg-config git clang-format
   libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
   libgtest-dev googletest
-  libgdal-dev gdal-bin
+  libgdal-dev gdal-bin libgeographiclib-dev
+  libhdf5-dev hdf5-tools
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
 )
 
@@ -24,6 +25,12 @@ if ((${#missing[@]})); then
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# Python readers the tests open result files with (h5py, xarray with h5netcdf).
+if ! python3 -c 'import numpy, h5py, xarray, h5netcdf' 2>/dev/null; then
+  echo "setup: installing Python packages: numpy h5py xarray h5netcdf"
+  python3 -m pip install -q numpy h5py xarray h5netcdf
 fi
 
 # PoCL compiles kernels into a cache; keep it in a writable place.

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "erodem/io/raster.hpp"
+#include "erodem/io/results.hpp"
 
 namespace fs = std::filesystem;
 
@@ -103,13 +104,21 @@ TEST_F(Cli, RunWritesFieldsAndPrintsLedger) {
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("mass ledger"), std::string::npos);
   EXPECT_NE(r.output.find("closure"), std::string::npos);
-  EXPECT_EQ(files_matching("out_"), 3u);
-  // A second run refuses to overwrite, and leaves the files as they were.
-  const auto before = fs::last_write_time(dir_ / "out_bed.tif");
+  EXPECT_NE(r.output.find("wrote out.h5"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir_ / "out.xmf"));
+  EXPECT_FALSE(fs::exists(dir_ / ".out.h5.partial"));
+  {
+    const erodem::io::ResultReader out((dir_ / "out.h5").string());
+    EXPECT_EQ(out.times().size(), 3u);  // steps 0, 100 (output.every) and 200
+    EXPECT_EQ(out.diagnostics().size(), 200u);
+    EXPECT_EQ(out.fields(), (std::vector<std::string>{"bed", "water_depth", "erosion"}));
+  }
+  // A second run refuses to overwrite, and leaves the file as it was.
+  const auto before = fs::last_write_time(dir_ / "out.h5");
   const auto again = run_cli("run c.toml", dir_);
   EXPECT_EQ(again.code, 73) << again.output;
   EXPECT_NE(again.output.find("--overwrite"), std::string::npos);
-  EXPECT_EQ(fs::last_write_time(dir_ / "out_bed.tif"), before);
+  EXPECT_EQ(fs::last_write_time(dir_ / "out.h5"), before);
   EXPECT_EQ(run_cli("run c.toml --overwrite --set time.steps=3", dir_).code, 0);
 }
 
@@ -136,7 +145,8 @@ TEST_F(Cli, BadConfigValuesExit78WithoutOutput) {
     std::printf("[bad config] %s -> exit %d: %s", c.what, r.code, r.output.c_str());
     EXPECT_EQ(r.code, 78);
     EXPECT_NE(r.output.find(c.must_name), std::string::npos) << r.output;
-    EXPECT_EQ(files_matching("out_"), 0u);
+    EXPECT_EQ(files_matching("out"), 0u);
+    EXPECT_EQ(files_matching(".out"), 0u);
   }
 }
 
@@ -150,7 +160,8 @@ TEST_F(Cli, MissingFilesExit66) {
   std::printf("[missing DEM] exit %d: %s", r.code, r.output.c_str());
   EXPECT_EQ(r.code, 66);
   EXPECT_NE(r.output.find("hill.tif"), std::string::npos);
-  EXPECT_EQ(files_matching("out_"), 0u);
+  EXPECT_EQ(files_matching("out"), 0u);
+  EXPECT_EQ(files_matching(".out"), 0u);
 }
 
 TEST_F(Cli, UnstableRunExit75NamesTheCell) {
@@ -160,7 +171,12 @@ TEST_F(Cli, UnstableRunExit75NamesTheCell) {
   std::printf("[unstable] exit %d: %s", r.code, r.output.c_str());
   EXPECT_EQ(r.code, 75);
   EXPECT_NE(r.output.find("cell (col"), std::string::npos);
-  EXPECT_EQ(files_matching("out_"), 0u);
+  // The final name is not created; the steps so far stay in the partial file.
+  EXPECT_EQ(files_matching("out"), 0u);
+  EXPECT_TRUE(fs::exists(dir_ / ".out.h5.partial"));
+  EXPECT_NE(r.output.find(".out.h5.partial"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("was not created"), std::string::npos) << r.output;
+  EXPECT_GE(erodem::io::ResultReader((dir_ / ".out.h5.partial").string()).times().size(), 1u);
 }
 
 TEST_F(Cli, DumpConfigRoundTripsAndUsageErrors) {

@@ -19,6 +19,7 @@
 #include <system_error>
 
 #include "erodem/error.hpp"
+#include "erodem/io/geodesy.hpp"
 
 namespace erodem::io {
 namespace {
@@ -154,26 +155,74 @@ std::vector<double> read_band(GDALDatasetH ds, const std::array<int, 4>& w,
   return v;
 }
 
-/// Parses a user CRS ("EPSG:32610", WKT, PROJ string) into WKT; must be projected (or a
-/// local CRS in linear units). Returns the WKT and sets `metres_per_unit`.
-std::string user_crs_wkt(const std::string& crs, double& metres_per_unit) {
-  Srs srs(OSRNewSpatialReference(nullptr));
-  CPLErrorReset();
-  if (OSRSetFromUserInput(static_cast<OGRSpatialReferenceH>(srs.get()), crs.c_str()) != OGRERR_NONE)
-    throw config_error("dem.crs", "'" + crs + "' is not a CRS GDAL recognises" + gdal_reason());
-  auto h = static_cast<OGRSpatialReferenceH>(srs.get());
-  if (OSRIsGeographic(h))
-    throw config_error("dem.crs", "'" + crs +
-                                      "' is geographic (lat/lon); geographic grids are not yet "
-                                      "supported, give a projected CRS");
-  metres_per_unit = OSRGetLinearUnits(h, nullptr);
+/// WKT (WKT1, as GDAL writes into GeoTIFFs) of a spatial reference; `what` names it in
+/// errors.
+std::string wkt_of(OGRSpatialReferenceH h, const std::string& what) {
   char* wkt = nullptr;
   if (OSRExportToWkt(h, &wkt) != OGRERR_NONE || wkt == nullptr) {
     CPLFree(wkt);
-    throw config_error("dem.crs", "'" + crs + "' cannot be written as WKT");
+    throw config_error("dem.crs", "'" + what + "' cannot be written as WKT");
   }
   std::unique_ptr<char, CplFree> owned(wkt);
   return std::string(wkt);
+}
+
+/// Parses a user CRS ("EPSG:32610", "EPSG:4326", WKT, PROJ string). Returns the WKT;
+/// sets `geographic` and, for a projected (or local) CRS, `metres_per_unit`.
+std::string user_crs_wkt(const std::string& crs, double& metres_per_unit, bool& geographic) {
+  Srs srs(OSRNewSpatialReference(nullptr));
+  CPLErrorReset();
+  auto h = static_cast<OGRSpatialReferenceH>(srs.get());
+  if (OSRSetFromUserInput(h, crs.c_str()) != OGRERR_NONE)
+    throw config_error("dem.crs", "'" + crs + "' is not a CRS GDAL recognises" + gdal_reason());
+  geographic = OSRIsGeographic(h) != 0;
+  if (!geographic && OSRIsProjected(h) == 0 && OSRIsLocal(h) == 0)
+    throw config_error("dem.crs", "'" + crs +
+                                      "' is neither a projected nor a geographic (lat/lon) CRS "
+                                      "(a geocentric or vertical CRS cannot place a raster)");
+  metres_per_unit = geographic ? 1.0 : OSRGetLinearUnits(h, nullptr);
+  return wkt_of(h, crs);
+}
+
+/// Degrees per angular unit of a geographic CRS (1 for degrees, snapped so that the WKT's
+/// rounded radian value of a degree does not scale every coordinate by 1 + 3e-16).
+double degrees_per_unit(OGRSpatialReferenceH h) {
+  const double radians = OSRGetAngularUnits(h, nullptr);
+  const double degrees = radians * 180.0 / 3.14159265358979323846;
+  return std::fabs(degrees - 1.0) < 1e-12 ? 1.0 : degrees;
+}
+
+/// The ellipsoid of a geographic (or projected) CRS; `what` names the source in errors.
+Ellipsoid ellipsoid_of(OGRSpatialReferenceH h, const std::string& what) {
+  OGRErr err_a = OGRERR_NONE, err_f = OGRERR_NONE;
+  Ellipsoid e;
+  e.semi_major = OSRGetSemiMajor(h, &err_a);
+  e.inverse_flattening = OSRGetInvFlattening(h, &err_f);
+  const char* name = OSRGetAttrValue(h, "SPHEROID", 0);
+  e.name = name != nullptr ? name : "";
+  if (err_a != OGRERR_NONE || err_f != OGRERR_NONE)
+    throw Error(ExitCode::data, what + ": its CRS names no ellipsoid");
+  e.validate(what);
+  return e;
+}
+
+/// Cell sizes and areas of a lat/lon grid (g.nx, g.ny set) whose geotransform `gt` (already
+/// shifted to the window) is in the angular unit of geographic CRS `h`.
+void set_geographic_grid(Grid& g, OGRSpatialReferenceH h, const std::array<double, 6>& gt,
+                         const std::string& what) {
+  if (gt[2] != 0.0 || gt[4] != 0.0)
+    throw Error(ExitCode::data, what + ": rotated geotransforms are not supported");
+  const double deg = degrees_per_unit(h);
+  set_geographic_rows(g, ellipsoid_of(h, what), gt[3] * deg, gt[5] * deg, gt[1] * deg, what);
+}
+
+/// A spatial reference parsed from WKT (or any user input GDAL takes); null when it fails.
+Srs parse_srs(const std::string& text) {
+  Srs srs(OSRNewSpatialReference(nullptr));
+  if (OSRSetFromUserInput(static_cast<OGRSpatialReferenceH>(srs.get()), text.c_str()) !=
+      OGRERR_NONE)
+    return Srs();
+  return srs;
 }
 
 /// Sets constant per-row cell sizes dx, dy (m) and areas for all g.ny rows.
@@ -348,35 +397,40 @@ Terrain read_dem(const Params::Dem& dem) {
       throw config_error("dem.crs", path +
                                         " has its own georeferencing; dem.crs is only for files "
                                         "without it");
-    double metres_per_unit = 1.0;
+    g.nx = w[2];
+    g.ny = w[3];
+    g.georef.transform = shifted(gt, w[0], w[1]);
+    g.georef.has_transform = true;
     if (file_srs != nullptr) {
-      if (OSRIsGeographic(file_srs))
-        throw Error(ExitCode::data, path +
-                                        ": geographic (lat/lon) grids are not yet supported; "
-                                        "reproject it to a projected CRS (e.g. gdalwarp -t_srs "
-                                        "EPSG:326xx)");
-      metres_per_unit = OSRGetLinearUnits(file_srs, nullptr);
       const char* wkt = GDALGetProjectionRef(h);
       g.georef.crs_wkt = wkt != nullptr ? wkt : "";
     }
-    if (gt[2] != 0.0 || gt[4] != 0.0)
-      throw Error(ExitCode::data, path + ": rotated geotransforms are not supported");
-    const double dx = std::fabs(gt[1]) * metres_per_unit;
-    const double dy = std::fabs(gt[5]) * metres_per_unit;
-    if (!(std::isfinite(dx) && dx > 0.0 && std::isfinite(dy) && dy > 0.0))
-      throw Error(ExitCode::data, path + ": invalid pixel size in its geotransform");
-    g.nx = w[2];
-    g.ny = w[3];
-    set_uniform_rows(g, dx, dy);
-    g.georef.transform = shifted(gt, w[0], w[1]);
-    g.georef.has_transform = true;
-    g.georef.is_geographic = false;
+    if (file_srs != nullptr && OSRIsGeographic(file_srs)) {
+      g.georef.is_geographic = true;
+      set_geographic_grid(g, file_srs, g.georef.transform, path);
+    } else {
+      const double metres_per_unit =
+          file_srs != nullptr ? OSRGetLinearUnits(file_srs, nullptr) : 1.0;
+      if (gt[2] != 0.0 || gt[4] != 0.0)
+        throw Error(ExitCode::data, path + ": rotated geotransforms are not supported");
+      const double dx = std::fabs(gt[1]) * metres_per_unit;
+      const double dy = std::fabs(gt[5]) * metres_per_unit;
+      if (!(std::isfinite(dx) && dx > 0.0 && std::isfinite(dy) && dy > 0.0))
+        throw Error(ExitCode::data, path + ": invalid pixel size in its geotransform");
+      set_uniform_rows(g, dx, dy);
+      g.georef.is_geographic = false;
+    }
   } else if (dem.cell_size > 0.0) {
     g = Grid::uniform(w[2], w[3], dem.cell_size);
     g.georef.has_transform = false;
     if (!dem.crs.empty()) {
       double metres_per_unit = 1.0;
-      g.georef.crs_wkt = user_crs_wkt(dem.crs, metres_per_unit);
+      bool geographic = false;
+      g.georef.crs_wkt = user_crs_wkt(dem.crs, metres_per_unit, geographic);
+      if (geographic)
+        throw config_error("dem.crs", "'" + dem.crs + "' is geographic (lat/lon) but " + path +
+                                          " has no geotransform to place its cells in degrees; "
+                                          "dem.cell_size with dem.crs needs a projected CRS");
       // Grid::uniform's transform is in metres; express it in the CRS's unit.
       for (double* v : {&g.georef.transform[0], &g.georef.transform[1], &g.georef.transform[3],
                         &g.georef.transform[5]})
@@ -384,17 +438,29 @@ Terrain read_dem(const Params::Dem& dem) {
     }
   } else if (has_gt && !dem.crs.empty()) {
     double metres_per_unit = 1.0;
-    g.georef.crs_wkt = user_crs_wkt(dem.crs, metres_per_unit);
+    bool geographic = false;
+    g.georef.crs_wkt = user_crs_wkt(dem.crs, metres_per_unit, geographic);
     if (gt[2] != 0.0 || gt[4] != 0.0)
       throw Error(ExitCode::data, path + ": rotated geotransforms are not supported");
     g.nx = w[2];
     g.ny = w[3];
-    set_uniform_rows(g, std::fabs(gt[1]) * metres_per_unit, std::fabs(gt[5]) * metres_per_unit);
     g.georef.transform = shifted(gt, w[0], w[1]);
     g.georef.has_transform = true;
+    if (geographic) {
+      // The file's transform is taken as degrees (longitude, latitude) on this CRS.
+      Srs srs = parse_srs(g.georef.crs_wkt);
+      if (!srs) throw config_error("dem.crs", "'" + dem.crs + "' cannot be read back from WKT");
+      g.georef.is_geographic = true;
+      set_geographic_grid(g, static_cast<OGRSpatialReferenceH>(srs.get()), g.georef.transform,
+                          path + " (with dem.crs = '" + dem.crs + "')");
+    } else {
+      set_uniform_rows(g, std::fabs(gt[1]) * metres_per_unit, std::fabs(gt[5]) * metres_per_unit);
+    }
   } else {
     throw Error(ExitCode::config,
-                path + ": has no georeferencing; set dem.cell_size (and dem.crs)");
+                path +
+                    ": has no georeferencing; set dem.cell_size (and dem.crs), or dem.crs "
+                    "alone when its geotransform is in that CRS's units");
   }
   g.validate();
 
@@ -422,6 +488,12 @@ Terrain read_dem(const Params::Dem& dem) {
 int resample_factor(const Params::Dem& dem, const Grid& grid) {
   if (dem.resample_factor > 0) return dem.resample_factor;
   if (!(dem.resample > 0.0)) return 1;
+  if (grid.georef.is_geographic)
+    throw config_error("dem.resample",
+                       "a cell size in metres cannot coarsen the geographic (lat/lon) grid of " +
+                           dem.path +
+                           ", whose east-west cell size varies by row; give an "
+                           "integer factor (dem.resample = 4)");
   const double cell = grid.dx.empty() ? 0.0 : grid.dx[0];
   const double f = dem.resample / cell;
   const long n = std::lround(f);
@@ -461,6 +533,13 @@ Terrain coarsen(const Terrain& fine, int factor) {
     c.dx.push_back(dx * factor);
     c.dy.push_back(dy);
     c.area.push_back(area);
+  }
+  if (c.georef.is_geographic) {
+    // Exact sizes of the coarse cells, from the ellipsoid of the grid's CRS.
+    Srs srs = parse_srs(c.georef.crs_wkt);
+    if (!srs) throw Error(ExitCode::internal, t.source + ": geographic grid without a usable CRS");
+    set_geographic_grid(c, static_cast<OGRSpatialReferenceH>(srs.get()), c.georef.transform,
+                        t.source);
   }
   // Block averages over the valid cells; a block with none stays nodata.
   t.bed.assign(c.cells(), std::nan(""));
@@ -511,6 +590,86 @@ Terrain coarsen(const Terrain& fine, int factor) {
   t.hardness = average(fine.hardness);
   t.rain_factor = average(fine.rain_factor);
   return t;
+}
+
+RasterHeader read_raster_header(const std::string& path) {
+  ensure_gdal();
+  QuietGdal quiet;
+  Dataset ds = open_raster(path, "");
+  GDALDatasetH h = ds.get();
+  RasterHeader r;
+  GDALDriverH drv = GDALGetDatasetDriver(h);
+  if (drv != nullptr) {
+    r.driver = GDALGetDriverShortName(drv);
+    r.driver_long = GDALGetDriverLongName(drv);
+  }
+  r.nx = GDALGetRasterXSize(h);
+  r.ny = GDALGetRasterYSize(h);
+  r.bands = GDALGetRasterCount(h);
+  GDALRasterBandH band = GDALGetRasterBand(h, 1);
+  r.data_type = GDALGetDataTypeName(GDALGetRasterDataType(band));
+  int has_nodata = 0;
+  const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
+  if (has_nodata) r.nodata = nodata;
+  r.has_transform = GDALGetGeoTransform(h, r.transform.data()) == CE_None;
+  if (GDALGetSpatialRef(h) != nullptr) {
+    const char* wkt = GDALGetProjectionRef(h);
+    r.crs_wkt = wkt != nullptr ? wkt : "";
+  }
+  const char* units_tag = GDALGetMetadataItem(h, kUnitsKey, nullptr);
+  r.erodem_metres = r.has_transform && r.crs_wkt.empty() && units_tag != nullptr &&
+                    std::string(units_tag) == "metre";
+  return r;
+}
+
+CrsInfo describe_crs(const std::string& crs) {
+  ensure_gdal();
+  QuietGdal quiet;
+  if (crs.empty()) throw Error(ExitCode::data, "no CRS to describe");
+  Srs srs = parse_srs(crs);
+  if (!srs) throw Error(ExitCode::data, "not a CRS GDAL recognises" + gdal_reason());
+  auto h = static_cast<OGRSpatialReferenceH>(srs.get());
+  CrsInfo info;
+  const char* name = OSRGetName(h);
+  info.name = name != nullptr ? name : "";
+  const char* auth = OSRGetAuthorityName(h, nullptr);
+  const char* code = OSRGetAuthorityCode(h, nullptr);
+  if (auth != nullptr && code != nullptr) {
+    info.authority = std::string(auth) + ":" + code;
+  } else {
+    // A CRS written without its code (e.g. NAD83 in a GeoTIFF's keys): the code of the one
+    // CRS of the database that matches it with full confidence, if any.
+    int n = 0;
+    int* confidence = nullptr;
+    OGRSpatialReferenceH* matches = OSRFindMatches(h, nullptr, &n, &confidence);
+    if (matches != nullptr && n >= 1 && confidence[0] == 100 && (n == 1 || confidence[1] < 100)) {
+      auth = OSRGetAuthorityName(matches[0], nullptr);
+      code = OSRGetAuthorityCode(matches[0], nullptr);
+      if (auth != nullptr && code != nullptr) info.authority = std::string(auth) + ":" + code;
+    }
+    OSRFreeSRSArray(matches);
+    CPLFree(confidence);
+  }
+  info.geographic = OSRIsGeographic(h) != 0;
+  info.projected = OSRIsProjected(h) != 0;
+  char* unit = nullptr;
+  if (info.geographic) {
+    OSRGetAngularUnits(h, &unit);
+    info.unit_factor = degrees_per_unit(h);
+  } else {
+    info.unit_factor = OSRGetLinearUnits(h, &unit);
+  }
+  info.unit = unit != nullptr ? unit : "";  // owned by the spatial reference
+  OGRErr err_a = OGRERR_NONE, err_f = OGRERR_NONE;
+  info.ellipsoid.semi_major = OSRGetSemiMajor(h, &err_a);
+  info.ellipsoid.inverse_flattening = OSRGetInvFlattening(h, &err_f);
+  const char* ell = OSRGetAttrValue(h, "SPHEROID", 0);
+  info.ellipsoid.name = ell != nullptr ? ell : "";
+  if (err_a != OGRERR_NONE || err_f != OGRERR_NONE) {
+    info.ellipsoid.semi_major = std::nan("");
+    info.ellipsoid.inverse_flattening = std::nan("");
+  }
+  return info;
 }
 
 std::vector<double> read_raster_on_grid(const std::string& path, const Grid& grid,

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "erodem/grid.hpp"
+#include "erodem/io/geodesy.hpp"
 #include "erodem/params.hpp"
 
 namespace erodem::io {
@@ -37,13 +38,19 @@ namespace erodem::io {
 /// - Projected (or local) CRS: the file's geotransform and CRS (WKT); dx = |pixel width|
 ///   and dy = |pixel height| times the CRS's linear unit in metres. Rotated geotransforms
 ///   -> Error(ExitCode::data).
-/// - Geographic (lat/lon) CRS: Error(ExitCode::data, "... not yet supported").
+/// - Geographic (lat/lon) CRS: `is_geographic` is true, the transform stays in the CRS's
+///   angular unit (degrees), and the per-row cell sizes and areas are geodesic ones on the
+///   CRS's own ellipsoid (semi-major axis and inverse flattening from the CRS; e.g. GRS80
+///   for NAD83): see set_geographic_rows() in geodesy.hpp. Rotated geotransforms or
+///   latitudes outside [-90, 90] -> Error(ExitCode::data).
 /// - No geotransform, or no CRS: requires `dem.cell_size` > 0, else
 ///   Error(ExitCode::config, "<path>: has no georeferencing; set dem.cell_size (and
-///   dem.crs)"). The grid is then Grid::uniform(width, height, cell_size) (origin (0, 0) at
-///   the bottom-left corner) with `has_transform` false. Alternatively, for a file with a
-///   geotransform but no CRS, `dem.crs` alone (a projected CRS) takes the file's transform
-///   as given in that CRS. `dem.crs`, when given, must be a projected CRS GDAL recognises
+///   dem.crs) ..."). The grid is then Grid::uniform(width, height, cell_size) (origin (0, 0)
+///   at the bottom-left corner) with `has_transform` false; `dem.crs` with it must be
+///   projected. Alternatively, for a file with a geotransform but no CRS (an ESRI ASCII grid
+///   without .prj), `dem.crs` alone takes the file's transform as given in that CRS: a
+///   projected CRS (transform in its linear unit) or a geographic one ("EPSG:4326":
+///   transform in degrees, cell sizes as above). `dem.crs` is anything GDAL recognises
 ///   ("EPSG:32610", WKT, PROJ string); it becomes `crs_wkt`.
 /// - `dem.cell_size` or `dem.crs` given for a file that is georeferenced already ->
 ///   Error(ExitCode::config) (they never silently override the file).
@@ -53,13 +60,46 @@ namespace erodem::io {
 Terrain read_dem(const Params::Dem& dem);
 
 /// The averaging factor that `dem.resample` / `dem.resample_factor` ask for on `grid`
-/// (1 = none). A cell size that is not a whole multiple of the grid's is a config error.
+/// (1 = none). A cell size that is not a whole multiple of the grid's, or a cell size in
+/// metres for a geographic grid (whose cells vary by row), is a config error.
 int resample_factor(const Params::Dem& dem, const Grid& grid);
 
 /// Averages `factor` x `factor` blocks of valid cells into one coarser cell (a block with no
-/// valid cell is nodata); cell sizes and areas grow accordingly, partial blocks at the east
-/// and south edges are dropped.
+/// valid cell is nodata); cell sizes and areas grow accordingly (recomputed exactly on the
+/// ellipsoid for a geographic grid), partial blocks at the east and south edges are dropped.
 Terrain coarsen(const Terrain& fine, int factor);
+
+/// What a raster file says about itself, without reading its values (`erodem info`).
+struct RasterHeader {
+  std::string driver;       ///< GDAL driver short name ("GTiff", "AAIGrid", "PNG")
+  std::string driver_long;  ///< its long name ("GeoTIFF", "Arc/Info ASCII Grid")
+  int nx = 0, ny = 0, bands = 0;
+  std::string data_type;         ///< band 1's data type ("Int16", "Float32")
+  std::optional<double> nodata;  ///< band 1's declared nodata value
+  bool has_transform = false;
+  std::array<double, 6> transform{0.0, 1.0, 0.0, 0.0, 0.0, -1.0};
+  std::string crs_wkt;         ///< empty when the file names no CRS
+  bool erodem_metres = false;  ///< no CRS, but written by write_geotiff(): transform in metres
+};
+
+/// Opens `path` and reads its header. Missing -> Error(ExitCode::no_input); not a raster
+/// GDAL can read -> Error(ExitCode::data).
+RasterHeader read_raster_header(const std::string& path);
+
+/// A CRS described for people.
+struct CrsInfo {
+  std::string name;       ///< the CRS's own name ("WGS 84", "WGS 84 / UTM zone 11N")
+  std::string authority;  ///< "EPSG:4326" when the CRS carries an authority code, else ""
+  bool geographic = false;
+  bool projected = false;
+  std::string unit;          ///< its linear (projected) or angular (geographic) unit's name
+  double unit_factor = 1.0;  ///< metres per linear unit, or degrees per angular unit
+  Ellipsoid ellipsoid;       ///< the CRS's ellipsoid
+};
+
+/// Describes a CRS given as WKT (or anything GDAL's user input takes). An empty or
+/// unparsable text -> Error(ExitCode::data).
+CrsInfo describe_crs(const std::string& crs);
 
 /// Reads band 1 of a parameter raster (rain factor, Manning n, hardness, initial depth,
 /// ...) that must lie on `grid`: after applying `window` (col, row, width, height; pixels;

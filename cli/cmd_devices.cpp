@@ -1,0 +1,284 @@
+// `erodem devices`: the OpenCL platforms and devices, the CPU reference, and which one
+// `--backend auto` picks and why.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#ifdef ERODEM_HAVE_OPENCL
+#include <CL/cl.h>
+#endif
+
+#include "commands.hpp"
+#include "erodem/backends.hpp"
+#include "json.hpp"
+
+namespace erodem::cli {
+
+namespace {
+
+struct DevicesOptions {
+  bool json = false;
+};
+
+/// What list_opencl_devices() does not report (yet), queried here in the same order.
+struct ClExtra {
+  std::size_t max_work_group = 0;  ///< CL_DEVICE_MAX_WORK_GROUP_SIZE; 0: unknown
+  std::string version;             ///< CL_DEVICE_VERSION
+  std::string driver;              ///< CL_DRIVER_VERSION
+};
+
+#ifdef ERODEM_HAVE_OPENCL
+std::string cl_device_string(cl_device_id d, cl_device_info what) {
+  std::size_t size = 0;
+  if (clGetDeviceInfo(d, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
+  std::string s(size, '\0');
+  if (clGetDeviceInfo(d, what, size, s.data(), nullptr) != CL_SUCCESS) return {};
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+#endif
+
+/// The extras of every device, in list_opencl_devices()'s order (platforms, then their
+/// devices of CL_DEVICE_TYPE_ALL). An entry whose device name does not match `devices`
+/// stays unknown.
+std::vector<ClExtra> query_extras(const std::vector<ClDeviceInfo>& devices) {
+  std::vector<ClExtra> out(devices.size());
+#ifdef ERODEM_HAVE_OPENCL
+  cl_uint np = 0;
+  if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) return out;
+  std::vector<cl_platform_id> platforms(np);
+  if (clGetPlatformIDs(np, platforms.data(), nullptr) != CL_SUCCESS) return out;
+  std::size_t k = 0;
+  for (cl_platform_id p : platforms) {
+    cl_uint nd = 0;
+    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS || nd == 0) continue;
+    std::vector<cl_device_id> ids(nd);
+    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, nd, ids.data(), nullptr) != CL_SUCCESS) continue;
+    for (cl_device_id d : ids) {
+      if (k >= out.size()) return out;
+      if (cl_device_string(d, CL_DEVICE_NAME) == devices[k].device) {
+        std::size_t wg = 0;
+        if (clGetDeviceInfo(d, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof wg, &wg, nullptr) ==
+            CL_SUCCESS)
+          out[k].max_work_group = wg;
+        out[k].version = cl_device_string(d, CL_DEVICE_VERSION);
+        out[k].driver = cl_device_string(d, CL_DRIVER_VERSION);
+      }
+      ++k;
+    }
+  }
+#endif
+  return out;
+}
+
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// ERODEM_OPENCL_DEVICE matching, as the OpenCL backend does it: "<platform>:<device>",
+/// case-insensitive substrings, the platform part matching the platform's name or vendor;
+/// without ':' the selector names the device.
+bool selector_matches(const ClDeviceInfo& d, const std::string& selector) {
+  const auto colon = selector.find(':');
+  const std::string plat = colon == std::string::npos ? "" : lower(selector.substr(0, colon));
+  const std::string dev = lower(colon == std::string::npos ? selector : selector.substr(colon + 1));
+  const bool plat_ok = plat.empty() || lower(d.platform).find(plat) != std::string::npos ||
+                       lower(d.vendor).find(plat) != std::string::npos;
+  const bool dev_ok = dev.empty() || lower(d.device).find(dev) != std::string::npos;
+  return plat_ok && dev_ok;
+}
+
+bool is_pocl(const ClDeviceInfo& d) {
+  return d.platform.find("Portable Computing Language") != std::string::npos ||
+         d.vendor.find("pocl") != std::string::npos;
+}
+
+/// What `--backend auto` picks (float32 runs; float64 runs always get the CPU reference).
+struct AutoChoice {
+  std::string backend;  ///< "opencl", "cpu", or "" when auto would fail
+  int device = -1;      ///< index into the device list when backend is "opencl"
+  std::string reason;
+};
+
+// NOTE(lead): this repeats the rule of make_backend("auto") (kernels/cpu/cpu_backend.cpp)
+// and of the OpenCL backend's device choice (runtime_for in kernels/opencl_backend.cpp),
+// since backends.hpp has no function returning auto's choice. Move it there as
+// `auto_backend_choice()` and call it from both places.
+AutoChoice auto_choice(const std::vector<ClDeviceInfo>& devices, const std::string& selector) {
+  AutoChoice c;
+  if (devices.empty()) {
+    c.backend = "cpu";
+    c.reason = "no OpenCL device (or the OpenCL backend is not built): the CPU reference";
+    return c;
+  }
+  if (!selector.empty()) {
+    for (std::size_t k = 0; k < devices.size(); ++k)
+      if (selector_matches(devices[k], selector)) {
+        c.backend = "opencl";
+        c.device = static_cast<int>(k);
+        c.reason = fmt::format("ERODEM_OPENCL_DEVICE='{}' selects it", selector);
+        return c;
+      }
+    c.reason = fmt::format(
+        "ERODEM_OPENCL_DEVICE='{}' matches no device: auto (and --backend opencl) fail "
+        "with exit 2",
+        selector);
+    return c;
+  }
+  const auto gpu =
+      std::find_if(devices.begin(), devices.end(), [](const ClDeviceInfo& d) { return d.gpu(); });
+  if (gpu != devices.end()) {
+    c.backend = "opencl";
+    c.device = static_cast<int>(gpu - devices.begin());
+    c.reason = "the first OpenCL GPU";
+    return c;
+  }
+  if (std::any_of(devices.begin(), devices.end(), is_pocl)) {
+    c.backend = "opencl";
+    c.device = 0;
+    c.reason = is_pocl(devices.front())
+                   ? "no OpenCL GPU; OpenCL on the CPU through PoCL"
+                   : "no OpenCL GPU; a PoCL platform is present, so OpenCL on the first device";
+    return c;
+  }
+  c.backend = "cpu";
+  c.reason = "no OpenCL GPU and no PoCL: the CPU reference";
+  return c;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) {
+        auto s = line.substr(colon + 1);
+        s.erase(0, s.find_first_not_of(" \t"));
+        return s;
+      }
+    }
+  return "unknown CPU";
+}
+
+int cpu_threads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+std::string gib(std::uint64_t bytes) {
+  return fmt::format("{:.1f} GiB", static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0));
+}
+
+int devices(const DevicesOptions& o) {
+  const auto list = list_opencl_devices();
+  const auto extras = query_extras(list);
+  const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
+  const std::string selector = env ? env : "";
+  const AutoChoice choice = auto_choice(list, selector);
+  const std::string cpu = cpu_model();
+  const int threads = cpu_threads();
+#ifdef ERODEM_HAVE_OPENCL
+  const bool built = true;
+#else
+  const bool built = false;
+#endif
+  auto chosen_name = [&] {
+    if (choice.backend == "opencl")
+      return list[static_cast<std::size_t>(choice.device)].platform + " / " +
+             list[static_cast<std::size_t>(choice.device)].device;
+    if (choice.backend == "cpu") return std::string("CPU reference");
+    return std::string("none");
+  };
+
+  if (o.json) {
+    std::printf("{\"opencl_built\": %s, \"erodem_opencl_device\": %s,\n \"opencl_devices\": [",
+                built ? "true" : "false", env ? json_string(selector).c_str() : "null");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto& d = list[k];
+      const auto& e = extras[k];
+      std::printf(
+          "%s\n  {\"index\": %zu, \"platform\": %s, \"vendor\": %s, \"device\": %s, "
+          "\"type\": %s, \"compute_units\": %u, \"global_memory_bytes\": %llu, "
+          "\"max_work_group_size\": %s, \"fp64\": %s, \"version\": %s, \"driver\": %s, "
+          "\"auto\": %s}",
+          k == 0 ? "" : ",", k, json_string(d.platform).c_str(), json_string(d.vendor).c_str(),
+          json_string(d.device).c_str(), json_string(d.type).c_str(), d.compute_units,
+          static_cast<unsigned long long>(d.global_memory),
+          e.max_work_group ? std::to_string(e.max_work_group).c_str() : "null",
+          d.fp64 ? "true" : "false", json_string(e.version).c_str(), json_string(e.driver).c_str(),
+          choice.backend == "opencl" && choice.device == static_cast<int>(k) ? "true" : "false");
+    }
+    std::printf(
+        "%s],\n \"cpu_reference\": {\"device\": %s, \"threads\": %d, \"precisions\": "
+        "[\"float32\", \"float64\"], \"auto\": %s},\n",
+        list.empty() ? "" : "\n ", json_string(cpu).c_str(), threads,
+        choice.backend == "cpu" ? "true" : "false");
+    std::printf(
+        " \"auto\": {\"backend\": %s, \"device\": %s, \"reason\": %s, \"float64\": \"cpu\"}}\n",
+        choice.backend.empty() ? "null" : json_string(choice.backend).c_str(),
+        json_string(chosen_name()).c_str(), json_string(choice.reason).c_str());
+    return 0;
+  }
+
+  if (!built) {
+    std::printf("OpenCL: not built in (ERODEM_OPENCL=OFF)\n");
+  } else if (list.empty()) {
+    std::printf("OpenCL: no platform or device found\n");
+  } else {
+    std::printf("OpenCL devices:\n");
+    std::string platform;
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto& d = list[k];
+      const auto& e = extras[k];
+      if (d.platform != platform) {
+        std::printf("  platform %s (%s)\n", d.platform.c_str(), d.vendor.c_str());
+        platform = d.platform;
+      }
+      const bool picked = choice.backend == "opencl" && choice.device == static_cast<int>(k);
+      std::printf("  %s [%zu] %s\n", picked ? "*" : " ", k, d.device.c_str());
+      std::printf("        %s, %u compute units, %s global memory, max work-group %s, fp64 %s\n",
+                  d.type.c_str(), d.compute_units, gib(d.global_memory).c_str(),
+                  e.max_work_group ? std::to_string(e.max_work_group).c_str() : "?",
+                  d.fp64 ? "yes" : "no");
+      if (!e.version.empty())
+        std::printf("        %s, driver %s\n", e.version.c_str(), e.driver.c_str());
+    }
+  }
+  std::printf("CPU reference:\n  %s [cpu] %s, %d OpenMP thread%s, float32 and float64\n",
+              choice.backend == "cpu" ? "*" : " ", cpu.c_str(), threads, threads == 1 ? "" : "s");
+  std::printf("ERODEM_OPENCL_DEVICE: %s\n",
+              env ? ("'" + selector + "'").c_str() : "unset (\"<platform>:<device>\" substrings)");
+  if (choice.backend.empty())
+    std::printf("auto: fails: %s\n", choice.reason.c_str());
+  else
+    std::printf(
+        "auto picks: %s on %s (%s); numerics.precision = float64 runs on the CPU "
+        "reference\n",
+        choice.backend.c_str(), chosen_name().c_str(), choice.reason.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Action add_devices(CLI::App& app) {
+  auto o = std::make_shared<DevicesOptions>();
+  auto* sub = app.add_subcommand("devices", "OpenCL platforms and devices, and what auto picks");
+  sub->add_flag("--json", o->json, "Machine-readable output");
+  return [o] { return devices(*o); };
+}
+
+}  // namespace erodem::cli

@@ -1,0 +1,156 @@
+// erodem — result files: one HDF5 file per run that is also netCDF-4 / CF-1.8, so h5py,
+// xarray (engine="h5netcdf"), GDAL/QGIS and ParaView (through the .xmf sidecar) read it
+// as it is. Layout: docs/results.md and INTERFACES.md "Result files (.h5)".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "erodem/grid.hpp"
+#include "erodem/params.hpp"
+#include "erodem/simulation.hpp"
+
+namespace erodem::io {
+
+/// The version and `git describe` of this build.
+std::string build_version();
+std::string build_git_describe();
+
+/// Where a result file and its inputs came from; written as root attributes.
+struct Provenance {
+  std::string erodem_version = build_version();
+  std::string git_describe = build_git_describe();
+  std::string command_line;
+  std::string config_toml;  ///< the fully resolved config (dump_toml)
+  std::string backend;
+  std::string device;
+  std::string dem_path;    ///< DEM file, or the generator description
+  std::string dem_sha256;  ///< SHA-256 of the DEM file ("" for synthetic terrain)
+
+  /// Everything but `command_line` from a simulation (config from its params).
+  static Provenance of(const Simulation& sim, const std::string& command_line);
+};
+
+/// The temporary name a result file is written under until ResultWriter::finish():
+/// "dir/run.h5" -> "dir/.run.h5.partial".
+std::string partial_path(const std::string& path);
+/// The XDMF sidecar of a result file: "dir/run.h5" -> "dir/run.xmf".
+std::string xdmf_path(const std::string& path);
+
+/// Writes one run's result file.
+///
+/// The file is written under partial_path(path) and renamed to `path` by finish(); it is
+/// flushed after every snapshot, so a run that stops early (crash, unstable run, no
+/// finish()) leaves a readable partial file holding every snapshot, and every diagnostics
+/// row up to the last snapshot. The destructor closes the file without renaming it.
+///
+/// Errors: `path` exists and `overwrite` is false -> Error(ExitCode::cant_create, "...
+/// exists; give --overwrite ..."); the folder is missing or not writable ->
+/// Error(ExitCode::cant_create); a write that fails -> Error(ExitCode::io); a gauge outside
+/// the grid -> Error(ExitCode::config) naming output.gauges[i]; an unknown field name ->
+/// Error(ExitCode::config).
+class ResultWriter {
+ public:
+  /// A writer for runs on `grid` with `params` (output.fields, output.gauges, output.every
+  /// and output.interval are used).
+  ResultWriter(const std::string& path, const Grid& grid, const Params& params,
+               const Provenance& provenance, bool overwrite);
+  /// A writer for `sim`'s grid and parameters, provenance from the simulation.
+  ResultWriter(const std::string& path, const Simulation& sim, const std::string& command_line,
+               bool overwrite);
+  ~ResultWriter();
+  ResultWriter(const ResultWriter&) = delete;
+  ResultWriter& operator=(const ResultWriter&) = delete;
+
+  /// Appends the configured output fields at the simulation's current time (inactive cells
+  /// NaN), writes the buffered diagnostics and gauge rows, and flushes the file.
+  void snapshot(const Simulation& sim);
+  /// Buffers one row of diagnostics (and gauge samples) after a step of `sim`. Gauge
+  /// sampling copies whole fields from the backend (water_depth, velocity_x, velocity_y,
+  /// and bed when erosion or thermal erosion is on) to read a few cells: a cost like a
+  /// snapshot's field reads (without the compression), every step (measured: about 15 %
+  /// of the step time of a 256 x 256 CPU run).
+  void record_step(const Simulation& sim);
+  /// Whether output.every / output.interval ask for a snapshot at `sim`'s current step
+  /// (never twice for the same step).
+  bool snapshot_due(const Simulation& sim) const;
+  /// record_step(), then snapshot() when due.
+  void step_done(const Simulation& sim);
+  /// Takes a final snapshot unless the current step has one, then finish().
+  void finish(const Simulation& sim);
+  /// Writes what is buffered, closes the file, writes the .xmf sidecar and renames both
+  /// into place. Without `overwrite`, a file created at `path` meanwhile is an error.
+  void finish();
+
+  const std::string& path() const { return path_; }
+  /// Where the file is until finish().
+  const std::string& partial() const { return partial_; }
+  std::size_t snapshots() const { return times_.size(); }
+  /// Step of the last snapshot (-1 before the first).
+  long last_snapshot_step() const { return last_snapshot_step_; }
+
+ private:
+  struct Impl;
+  std::string path_, partial_;
+  bool overwrite_;
+  std::unique_ptr<Impl> impl_;
+  std::vector<double> times_;
+  long last_snapshot_step_ = -1;
+};
+
+/// Per-gauge series of a result file.
+struct GaugeSeries {
+  std::vector<double> x, y;  ///< gauge coordinates (CRS)
+  std::vector<double> time;  ///< s, one per step
+  /// [step][gauge]
+  std::vector<std::vector<double>> water_depth, water_level, speed;
+};
+
+/// Reads a result file written by ResultWriter (also a partial one).
+///
+/// Missing file -> Error(ExitCode::no_input); not an HDF5 file or not this layout ->
+/// Error(ExitCode::data).
+class ResultReader {
+ public:
+  explicit ResultReader(const std::string& path);
+  ~ResultReader();
+  ResultReader(const ResultReader&) = delete;
+  ResultReader& operator=(const ResultReader&) = delete;
+
+  /// The fields stored, in file order.
+  std::vector<std::string> fields() const;
+  /// Snapshot times (s since the start of the run).
+  const std::vector<double>& times() const { return times_; }
+  /// The index of the snapshot time nearest `time`.
+  std::size_t nearest_time_index(double time) const;
+  /// Field `name` at snapshot `index` (row-major ny x nx, NaN = nodata). Unknown field ->
+  /// Error(ExitCode::data); index out of range -> Error(ExitCode::usage).
+  std::vector<float> read_index(const std::string& name, std::size_t index) const;
+  /// Field `name` at the snapshot nearest `time` (s).
+  std::vector<float> read(const std::string& name, double time) const;
+  /// The grid: size, geotransform (from the GeoTransform attribute, else the x/y
+  /// coordinates), CRS (WKT) and the per-row cell sizes and areas (m, m^2) as written.
+  const Grid& grid() const { return grid_; }
+  /// The per-step diagnostics.
+  std::vector<Diagnostics> diagnostics() const;
+  /// Gauge series (empty when the run had none).
+  GaugeSeries gauges() const;
+  /// Root attributes (text), e.g. "config_toml", "erodem_version", "created".
+  const std::map<std::string, std::string>& attributes() const { return attributes_; }
+  /// One root attribute; "" when absent.
+  std::string attribute(const std::string& name) const;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::int64_t file_ = -1;
+  std::string path_;
+  std::vector<double> times_;
+  Grid grid_;
+  std::map<std::string, std::string> attributes_;
+};
+
+}  // namespace erodem::io

@@ -1,0 +1,1040 @@
+// erodem — result files (HDF5, netCDF-4 / CF-1.8 compatible). See results.hpp and
+// docs/results.md.
+#include "erodem/io/results.hpp"
+
+#include <fmt/format.h>
+#include <hdf5.h>
+#include <hdf5_hl.h>
+#include <ogr_srs_api.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+#include "erodem/error.hpp"
+#include "erodem/fields.hpp"
+#include "erodem/schema.hpp"
+
+#ifndef ERODEM_VERSION
+#define ERODEM_VERSION "unknown"
+#endif
+#ifndef ERODEM_GIT_DESCRIBE
+#define ERODEM_GIT_DESCRIBE "unknown"
+#endif
+
+namespace erodem::io {
+
+std::string build_version() {
+  return ERODEM_VERSION;
+}
+std::string build_git_describe() {
+  return ERODEM_GIT_DESCRIBE;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- HDF5 handles and errors --------------------------------------------------------------
+
+/// Turns HDF5's automatic error printing off on this thread for its lifetime (failures
+/// become erodem::Error messages instead).
+class QuietH5 {
+ public:
+  QuietH5() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietH5() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  QuietH5(const QuietH5&) = delete;
+  QuietH5& operator=(const QuietH5&) = delete;
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+/// ": <innermost HDF5 message>" or "" when the error stack is empty.
+std::string h5_reason() {
+  std::string msg;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_DOWNWARD,
+      [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
+        if (n == 0 && e->desc != nullptr) *static_cast<std::string*>(out) = e->desc;
+        return 0;
+      },
+      &msg);
+  return msg.empty() ? "" : ": " + msg;
+}
+
+/// An owned HDF5 identifier of any kind, closed by its kind's close function.
+class H5Id {
+ public:
+  H5Id() = default;
+  explicit H5Id(hid_t id) : id_(id) {}
+  ~H5Id() { reset(); }
+  H5Id(H5Id&& o) noexcept : id_(std::exchange(o.id_, H5I_INVALID_HID)) {}
+  H5Id& operator=(H5Id&& o) noexcept {
+    if (this != &o) {
+      reset();
+      id_ = std::exchange(o.id_, H5I_INVALID_HID);
+    }
+    return *this;
+  }
+  H5Id(const H5Id&) = delete;
+  H5Id& operator=(const H5Id&) = delete;
+  hid_t get() const { return id_; }
+  operator hid_t() const { return id_; }  // NOLINT: handles are used as hid_t
+  bool valid() const { return id_ >= 0; }
+  void reset() {
+    if (id_ < 0) return;
+    switch (H5Iget_type(id_)) {
+      case H5I_FILE:
+        H5Fclose(id_);
+        break;
+      case H5I_GROUP:
+        H5Gclose(id_);
+        break;
+      case H5I_DATASET:
+        H5Dclose(id_);
+        break;
+      case H5I_DATASPACE:
+        H5Sclose(id_);
+        break;
+      case H5I_DATATYPE:
+        H5Tclose(id_);
+        break;
+      case H5I_ATTR:
+        H5Aclose(id_);
+        break;
+      case H5I_GENPROP_LST:
+        H5Pclose(id_);
+        break;
+      default:
+        break;
+    }
+    id_ = H5I_INVALID_HID;
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+};
+
+/// Thrown for a failed HDF5 call while writing `path`.
+[[noreturn]] void write_failed(const std::string& path, const std::string& what) {
+  throw Error(ExitCode::io, path + ": writing " + what + " failed" + h5_reason());
+}
+
+H5Id checked(hid_t id, const std::string& path, const std::string& what) {
+  if (id < 0) write_failed(path, what);
+  return H5Id(id);
+}
+void checked(herr_t status, const std::string& path, const std::string& what) {
+  if (status < 0) write_failed(path, what);
+}
+
+constexpr unsigned kCreationOrder = H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED;
+
+// ---- attributes -----------------------------------------------------------------------------
+
+/// A text attribute as netCDF-4 writes one (NC_CHAR: fixed-length string, scalar). Values
+/// shorter than 2 bytes are null-padded to 2 so that h5py/h5netcdf decode them to str.
+void put_text(hid_t obj, const char* name, const std::string& value, const std::string& path) {
+  const std::size_t size = std::max<std::size_t>(value.size(), 2);
+  std::string buf = value;
+  buf.resize(size, '\0');
+  const bool ascii = std::all_of(value.begin(), value.end(),
+                                 [](char c) { return static_cast<unsigned char>(c) < 0x80; });
+  H5Id type = checked(H5Tcopy(H5T_C_S1), path, "a string type");
+  H5Tset_size(type, size);
+  H5Tset_strpad(type, H5T_STR_NULLTERM);
+  H5Tset_cset(type, ascii ? H5T_CSET_ASCII : H5T_CSET_UTF8);
+  H5Id space = checked(H5Screate(H5S_SCALAR), path, "a dataspace");
+  H5Id attr = checked(H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT), path,
+                      std::string("attribute ") + name);
+  checked(H5Awrite(attr, type, buf.data()), path, std::string("attribute ") + name);
+}
+
+/// A numeric attribute: one value (scalar) or an array.
+void put_numbers(hid_t obj, const char* name, hid_t file_type, hid_t mem_type, const void* data,
+                 hsize_t n, const std::string& path) {
+  H5Id space = checked(n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), path,
+                       "a dataspace");
+  H5Id attr = checked(H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT), path,
+                      std::string("attribute ") + name);
+  checked(H5Awrite(attr, mem_type, data), path, std::string("attribute ") + name);
+}
+
+/// A text attribute (fixed or variable length); false when absent or not text.
+bool get_text(hid_t obj, const char* name, std::string& out) {
+  if (H5Aexists(obj, name) <= 0) return false;
+  H5Id attr(H5Aopen(obj, name, H5P_DEFAULT));
+  if (!attr.valid()) return false;
+  H5Id type(H5Aget_type(attr));
+  if (H5Tget_class(type) != H5T_STRING) return false;
+  H5Id space(H5Aget_space(attr));
+  if (H5Sget_simple_extent_npoints(space) != 1) return false;
+  if (H5Tis_variable_str(type) > 0) {
+    H5Id mem(H5Tcopy(H5T_C_S1));
+    H5Tset_size(mem, H5T_VARIABLE);
+    H5Tset_cset(mem, H5Tget_cset(type));
+    char* s = nullptr;
+    if (H5Aread(attr, mem, &s) < 0) return false;
+    out = s != nullptr ? s : "";
+    H5free_memory(s);
+    return true;
+  }
+  const std::size_t size = H5Tget_size(type);
+  std::string buf(size, '\0');
+  if (H5Aread(attr, type, buf.data()) < 0) return false;
+  buf.resize(std::strlen(buf.c_str()));
+  out = buf;
+  return true;
+}
+
+// ---- datasets -------------------------------------------------------------------------------
+
+/// Creates a dataset as netCDF-4 does (attribute creation order, no time stamps).
+/// `chunk` empty = contiguous; `compress` = shuffle + deflate 4; `fill` = fill value.
+H5Id create_dataset(hid_t loc, const std::string& name, hid_t type,
+                    const std::vector<hsize_t>& dims, const std::vector<hsize_t>& maxdims,
+                    const std::vector<hsize_t>& chunk, bool compress, const void* fill,
+                    const std::string& path) {
+  H5Id space = checked(
+      dims.empty() ? H5Screate(H5S_SCALAR)
+                   : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), maxdims.data()),
+      path, "dataspace of " + name);
+  H5Id dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), path, "properties of " + name);
+  H5Pset_attr_creation_order(dcpl, kCreationOrder);
+  H5Pset_obj_track_times(dcpl, 0);
+  if (!chunk.empty()) {
+    checked(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), path,
+            "chunks of " + name);
+    if (compress) {
+      checked(H5Pset_shuffle(dcpl), path, "shuffle filter of " + name);
+      checked(H5Pset_deflate(dcpl, 4), path, "deflate filter of " + name);
+    }
+  }
+  if (fill != nullptr) checked(H5Pset_fill_value(dcpl, type, fill), path, "fill of " + name);
+  return checked(H5Dcreate2(loc, name.c_str(), type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
+                 "dataset " + name);
+}
+
+/// Appends `rows` rows to dataset `ds` along its first (unlimited) dimension.
+void append_rows(hid_t ds, hid_t mem_type, hsize_t rows, const void* data, const std::string& path,
+                 const std::string& name) {
+  if (rows == 0) return;
+  H5Id space = checked(H5Dget_space(ds), path, name);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  std::vector<hsize_t> start(dims.size(), 0), count = dims;
+  start[0] = dims[0];
+  count[0] = rows;
+  dims[0] += rows;
+  checked(H5Dset_extent(ds, dims.data()), path, "(extending) " + name);
+  H5Id file_space = checked(H5Dget_space(ds), path, name);
+  checked(
+      H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+      path, name);
+  H5Id mem_space = checked(H5Screate_simple(rank, count.data(), nullptr), path, name);
+  checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+}
+
+/// Whether `path` names an existing object (every link on the way exists).
+bool exists(hid_t loc, const std::string& path) {
+  std::size_t pos = 0;
+  while (true) {
+    pos = path.find('/', pos + 1);
+    const std::string part = path.substr(0, pos);
+    if (H5Lexists(loc, part.c_str(), H5P_DEFAULT) <= 0) return false;
+    if (pos == std::string::npos) return true;
+  }
+}
+
+// ---- the layout -----------------------------------------------------------------------------
+
+/// One per-step series of `diagnostics/`.
+struct DiagSeries {
+  const char* name;
+  double Diagnostics::*member;
+  const char* units;
+  const char* long_name;
+};
+
+const std::array<DiagSeries, 11>& diag_series() {
+  static const std::array<DiagSeries, 11> table{{
+      {"time", &Diagnostics::time, "s", "time since the start of the run, at the end of the step"},
+      {"dt", &Diagnostics::dt, "s", "time step"},
+      {"water_volume", &Diagnostics::water_volume, "m3", "water volume on the grid"},
+      {"material_volume", &Diagnostics::material_volume, "m3",
+       "bed plus suspended sediment volume"},
+      {"rain_volume", &Diagnostics::rain_volume, "m3", "cumulative rain volume"},
+      {"inflow_volume", &Diagnostics::inflow_volume, "m3", "cumulative inflow volume"},
+      {"boundary_outflow_volume", &Diagnostics::boundary_outflow_volume, "m3",
+       "cumulative net outflow through the boundary"},
+      {"evaporated_volume", &Diagnostics::evaporated_volume, "m3", "cumulative evaporated volume"},
+      {"closure_error", &Diagnostics::closure_error, "m3", "water ledger closure error"},
+      {"max_depth", &Diagnostics::max_depth, "m", "largest water depth"},
+      {"max_speed", &Diagnostics::max_speed, "m s-1", "largest flow speed"},
+  }};
+  return table;
+}
+
+constexpr const char* kGaugeSeries[] = {"water_depth", "water_level", "speed"};
+
+std::string iso_utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+/// Units of the grid's x/y coordinates: "m" unless the CRS says otherwise.
+std::string linear_units(const Georef& g) {
+  if (g.is_geographic) return "degrees";
+  if (g.crs_wkt.empty()) return "m";
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
+  std::string units = "m";
+  if (OSRImportFromWkt(srs, std::array<char*, 1>{const_cast<char*>(g.crs_wkt.c_str())}.data()) ==
+      OGRERR_NONE) {
+    char* name = nullptr;
+    const double factor = OSRGetLinearUnits(srs, &name);
+    if (factor != 1.0 && name != nullptr && *name != '\0') units = name;
+  }
+  OSRDestroySpatialReference(srs);
+  return units;
+}
+
+std::string geotransform_text(const std::array<double, 6>& t) {
+  return fmt::format("{:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}", t[0], t[1], t[2], t[3],
+                     t[4], t[5]);
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+/// Writes `text` to `path` through a temporary file in the same folder.
+void write_text_file(const std::string& path, const std::string& text) {
+  const std::string tmp = partial_path(path);
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(ExitCode::cant_create, tmp + ": cannot create: " + std::strerror(errno));
+    out << text;
+    out.flush();
+    if (!out) throw Error(ExitCode::io, tmp + ": writing failed");
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw Error(ExitCode::io, path + ": cannot rename into place: " + ec.message());
+  }
+}
+
+}  // namespace
+
+// ---- names --------------------------------------------------------------------------------
+
+std::string partial_path(const std::string& path) {
+  const fs::path p(path);
+  return (p.parent_path() / ("." + p.filename().string() + ".partial")).string();
+}
+
+std::string xdmf_path(const std::string& path) {
+  return fs::path(path).replace_extension(".xmf").string();
+}
+
+Provenance Provenance::of(const Simulation& sim, const std::string& command_line) {
+  Provenance p;
+  p.command_line = command_line;
+  p.config_toml = dump_toml(sim.params());
+  p.backend = sim.backend().name();
+  p.device = sim.backend().device();
+  p.dem_path = sim.terrain().source;
+  p.dem_sha256 = sim.terrain().source_sha256;
+  return p;
+}
+
+// ---- ResultWriter ---------------------------------------------------------------------------
+
+struct ResultWriter::Impl {
+  std::string partial;  // for messages
+  Grid grid;
+  Params::Output output;
+  std::string xname = "x", yname = "y";
+  H5Id file, time;
+  std::vector<std::pair<FieldInfo, H5Id>> fields;
+  // diagnostics/
+  H5Id diag_step;
+  std::vector<H5Id> diag;
+  std::vector<Diagnostics> pending;
+  std::vector<std::int64_t> pending_steps;
+  // gauges/
+  std::vector<std::size_t> gauge_cells;
+  H5Id gauge_step, gauge_time;
+  std::array<H5Id, 3> gauge;
+  std::vector<double> pending_gauge_time;
+  std::array<std::vector<double>, 3> pending_gauge;  // [series][row * n + gauge]
+  std::vector<std::int64_t> pending_gauge_steps;
+  bool bed_changes = true;  // erosion or thermal on: the bed is read at every gauge sample
+  std::vector<double> bed;  // the bed, when it does not change
+
+  H5Id create_group(const char* name) {
+    H5Id gcpl = checked(H5Pcreate(H5P_GROUP_CREATE), partial, "group properties");
+    H5Pset_link_creation_order(gcpl, kCreationOrder);
+    H5Pset_attr_creation_order(gcpl, kCreationOrder);
+    return checked(H5Gcreate2(file, name, H5P_DEFAULT, gcpl, H5P_DEFAULT), partial,
+                   std::string("group ") + name);
+  }
+
+  /// A coordinate variable that is also the dimension scale `name`.
+  H5Id coordinate(hid_t loc, const std::string& name, hid_t type, const void* values, hsize_t n,
+                  bool unlimited) {
+    const hsize_t dims = unlimited ? 0 : n, maxdims = unlimited ? H5S_UNLIMITED : n;
+    H5Id ds = create_dataset(loc, name, type, {dims}, {maxdims},
+                             unlimited ? std::vector<hsize_t>{512} : std::vector<hsize_t>{}, false,
+                             nullptr, partial);
+    if (!unlimited && n > 0)
+      checked(H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values), partial, name);
+    checked(H5DSset_scale(ds, name.c_str()), partial, "dimension scale " + name);
+    return ds;
+  }
+
+  /// A per-step series (step[, gauge]) in `loc`, its dimensions attached.
+  H5Id series(hid_t loc, const std::string& name, hid_t step_scale, hid_t second_scale,
+              hsize_t second, const char* units, const std::string& long_name) {
+    std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{1024};
+    if (second_scale >= 0) {
+      dims.push_back(second);
+      maxdims.push_back(second);
+      chunk = {std::max<hsize_t>(1, 16384 / std::max<hsize_t>(second, 1)), second};
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    H5Id ds = create_dataset(loc, name, H5T_IEEE_F64LE, dims, maxdims, chunk, false, &nan, partial);
+    checked(H5DSattach_scale(ds, step_scale, 0), partial, name + " dimensions");
+    if (second_scale >= 0)
+      checked(H5DSattach_scale(ds, second_scale, 1), partial, name + " dimensions");
+    put_text(ds, "units", units, partial);
+    put_text(ds, "long_name", long_name, partial);
+    put_numbers(ds, "_FillValue", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &nan, 1, partial);
+    return ds;
+  }
+
+  /// Writes the buffered diagnostics and gauge rows.
+  void flush_pending() {
+    const hsize_t rows = pending.size();
+    if (rows > 0) {
+      append_rows(diag_step, H5T_NATIVE_INT64, rows, pending_steps.data(), partial,
+                  "diagnostics/step");
+      std::vector<double> column(rows);
+      for (std::size_t k = 0; k < diag.size(); ++k) {
+        const auto& s = diag_series()[k];
+        for (std::size_t r = 0; r < rows; ++r) column[r] = pending[r].*s.member;
+        append_rows(diag[k], H5T_NATIVE_DOUBLE, rows, column.data(), partial,
+                    std::string("diagnostics/") + s.name);
+      }
+      pending.clear();
+      pending_steps.clear();
+    }
+    const hsize_t grows = pending_gauge_time.size();
+    if (grows > 0) {
+      append_rows(gauge_step, H5T_NATIVE_INT64, grows, pending_gauge_steps.data(), partial,
+                  "gauges/step");
+      append_rows(gauge_time, H5T_NATIVE_DOUBLE, grows, pending_gauge_time.data(), partial,
+                  "gauges/time");
+      for (std::size_t k = 0; k < gauge.size(); ++k) {
+        append_rows(gauge[k], H5T_NATIVE_DOUBLE, grows, pending_gauge[k].data(), partial,
+                    std::string("gauges/") + kGaugeSeries[k]);
+        pending_gauge[k].clear();
+      }
+      pending_gauge_time.clear();
+      pending_gauge_steps.clear();
+    }
+  }
+
+  void close() {
+    for (auto& f : fields) f.second.reset();
+    for (auto& d : diag) d.reset();
+    for (auto& g : gauge) g.reset();
+    diag_step.reset();
+    gauge_step.reset();
+    gauge_time.reset();
+    time.reset();
+    file.reset();
+  }
+};
+
+ResultWriter::ResultWriter(const std::string& path, const Simulation& sim,
+                           const std::string& command_line, bool overwrite)
+    : ResultWriter(path, sim.grid(), sim.params(), Provenance::of(sim, command_line), overwrite) {}
+
+ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Params& params,
+                           const Provenance& prov, bool overwrite)
+    : path_(path), partial_(partial_path(path)), overwrite_(overwrite) {
+  QuietH5 quiet;
+  // The output can be created: folder exists and is writable, no file in the way.
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw Error(ExitCode::cant_create,
+                path + ": cannot create output: folder '" + dir.string() + "' does not exist");
+  if (access(dir.c_str(), W_OK) != 0)
+    throw Error(ExitCode::cant_create, path + ": cannot create output: folder '" + dir.string() +
+                                           "' is not writable (" + std::strerror(errno) + ")");
+  if (!overwrite && fs::exists(p, ec))
+    throw Error(ExitCode::cant_create,
+                path + ": exists; not overwritten (give --overwrite to replace it)");
+  if (grid.nx <= 0 || grid.ny <= 0)
+    throw Error(ExitCode::internal, path + ": result file for an empty grid");
+
+  auto impl = std::make_unique<Impl>();
+  Impl& m = *impl;
+  m.partial = partial_;
+  m.grid = grid;
+  m.output = params.output;
+  m.bed_changes = params.erosion.enabled || params.thermal.enabled;
+  for (const auto& name : m.output.fields) m.fields.emplace_back(field_info(name), H5Id());
+  // Gauges must lie on the grid.
+  for (std::size_t i = 0; i < m.output.gauges.size(); ++i) {
+    const auto& g = m.output.gauges[i];
+    int col = 0, row = 0;
+    if (!grid.locate(g[0], g[1], col, row))
+      throw config_error(
+          fmt::format("output.gauges[{}]", i),
+          fmt::format("({:.10g}, {:.10g}) is outside the grid (x {:.10g} .. {:.10g}, y {:.10g} "
+                      ".. {:.10g})",
+                      g[0], g[1], grid.cell_center(0, 0)[0] - 0.5 * grid.georef.transform[1],
+                      grid.cell_center(grid.nx - 1, 0)[0] + 0.5 * grid.georef.transform[1],
+                      grid.cell_center(0, grid.ny - 1)[1] + 0.5 * grid.georef.transform[5],
+                      grid.cell_center(0, 0)[1] - 0.5 * grid.georef.transform[5]));
+    m.gauge_cells.push_back(static_cast<std::size_t>(row) * grid.nx + col);
+  }
+
+  // The file, tracking creation order like netCDF-4.
+  H5Id fcpl = checked(H5Pcreate(H5P_FILE_CREATE), partial_, "file properties");
+  H5Pset_link_creation_order(fcpl, kCreationOrder);
+  H5Pset_attr_creation_order(fcpl, kCreationOrder);
+  m.file = H5Id(H5Fcreate(partial_.c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT));
+  if (!m.file.valid())
+    throw Error(ExitCode::cant_create, partial_ + ": cannot create" + h5_reason());
+
+  // Root attributes.
+  const std::pair<const char*, std::string> root_attrs[] = {
+      {"Conventions", "CF-1.8"},
+      {"title", "erodem run"},
+      {"source", "erodem " + prov.erodem_version},
+      {"erodem_version", prov.erodem_version},
+      {"git_describe", prov.git_describe},
+      {"created", iso_utc_now()},
+      {"command_line", prov.command_line},
+      {"config_toml", prov.config_toml},
+      {"backend", prov.backend},
+      {"device", prov.device},
+      {"dem_path", prov.dem_path},
+      {"dem_sha256", prov.dem_sha256},
+  };
+  for (const auto& [name, value] : root_attrs) put_text(m.file, name, value, partial_);
+
+  // Dimensions and coordinates: time (unlimited), y, x.
+  const auto& geo = grid.georef;
+  if (geo.is_geographic) {
+    m.xname = "lon";
+    m.yname = "lat";
+  }
+  m.time = m.coordinate(m.file, "time", H5T_IEEE_F64LE, nullptr, 0, true);
+  put_text(m.time, "units", "s", partial_);
+  put_text(m.time, "long_name", "time since the start of the run", partial_);
+  put_text(m.time, "axis", "T", partial_);
+  std::vector<double> xs(static_cast<std::size_t>(grid.nx)), ys(static_cast<std::size_t>(grid.ny));
+  for (int c = 0; c < grid.nx; ++c) xs[c] = grid.cell_center(c, 0)[0];
+  for (int r = 0; r < grid.ny; ++r) ys[r] = grid.cell_center(0, r)[1];
+  H5Id y = m.coordinate(m.file, m.yname, H5T_IEEE_F64LE, ys.data(), ys.size(), false);
+  H5Id x = m.coordinate(m.file, m.xname, H5T_IEEE_F64LE, xs.data(), xs.size(), false);
+  const std::string units = linear_units(geo);
+  if (geo.is_geographic) {
+    put_text(y, "units", "degrees_north", partial_);
+    put_text(y, "standard_name", "latitude", partial_);
+    put_text(y, "long_name", "latitude of cell centre", partial_);
+    put_text(x, "units", "degrees_east", partial_);
+    put_text(x, "standard_name", "longitude", partial_);
+    put_text(x, "long_name", "longitude of cell centre", partial_);
+  } else {
+    put_text(y, "units", units, partial_);
+    put_text(y, "standard_name", "projection_y_coordinate", partial_);
+    put_text(y, "long_name", "y coordinate of cell centre", partial_);
+    put_text(x, "units", units, partial_);
+    put_text(x, "standard_name", "projection_x_coordinate", partial_);
+    put_text(x, "long_name", "x coordinate of cell centre", partial_);
+  }
+  put_text(y, "axis", "Y", partial_);
+  put_text(x, "axis", "X", partial_);
+  // Cell sizes and areas of each row (m, m^2): exact for geographic grids too.
+  {
+    const std::pair<const char*, const std::vector<double>*> rows[] = {
+        {"cell_dx", &grid.dx}, {"cell_dy", &grid.dy}, {"cell_area", &grid.area}};
+    const char* row_long[] = {"east-west cell size of the row", "north-south cell size of the row",
+                              "cell area of the row"};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto& [name, values] = rows[k];
+      if (values->size() != static_cast<std::size_t>(grid.ny)) continue;
+      H5Id ds = create_dataset(m.file, name, H5T_IEEE_F64LE, {ys.size()}, {ys.size()}, {}, false,
+                               nullptr, partial_);
+      checked(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values->data()),
+              partial_, name);
+      checked(H5DSattach_scale(ds, y, 0), partial_, std::string(name) + " dimensions");
+      put_text(ds, "units", k == 2 ? "m2" : "m", partial_);
+      put_text(ds, "long_name", row_long[k], partial_);
+    }
+  }
+
+  // The grid mapping.
+  {
+    const std::int32_t zero = 0;
+    H5Id crs = create_dataset(m.file, "crs", H5T_STD_I32LE, {}, {}, {}, false, nullptr, partial_);
+    checked(H5Dwrite(crs, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, &zero), partial_, "crs");
+    put_text(crs, "long_name", "coordinate reference system", partial_);
+    if (!geo.crs_wkt.empty()) {
+      put_text(crs, "crs_wkt", geo.crs_wkt, partial_);
+      put_text(crs, "spatial_ref", geo.crs_wkt, partial_);
+    } else {
+      put_text(crs, "comment",
+               "the CRS of the DEM is unknown; coordinates are in metres from the grid origin",
+               partial_);
+    }
+    put_text(crs, "GeoTransform", geotransform_text(geo.transform), partial_);
+  }
+
+  // Fields (time, y, x): float32, one time slice per chunk, shuffle + deflate.
+  const float fnan = std::numeric_limits<float>::quiet_NaN();
+  const hsize_t ny = grid.ny, nx = grid.nx;
+  for (auto& [info, ds] : m.fields) {
+    ds = create_dataset(m.file, info.name, H5T_IEEE_F32LE, {0, ny, nx}, {H5S_UNLIMITED, ny, nx},
+                        {1, std::min<hsize_t>(ny, 512), std::min<hsize_t>(nx, 512)}, true, &fnan,
+                        partial_);
+    checked(H5DSattach_scale(ds, m.time, 0), partial_, std::string(info.name) + " dimensions");
+    checked(H5DSattach_scale(ds, y, 1), partial_, std::string(info.name) + " dimensions");
+    checked(H5DSattach_scale(ds, x, 2), partial_, std::string(info.name) + " dimensions");
+    put_text(ds, "units", info.units, partial_);
+    put_text(ds, "long_name", info.long_name, partial_);
+    put_text(ds, "grid_mapping", "crs", partial_);
+    put_numbers(ds, "_FillValue", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, &fnan, 1, partial_);
+  }
+
+  // diagnostics/: one row per step.
+  {
+    H5Id group = m.create_group("diagnostics");
+    put_text(group, "comment", "one row per simulation step, at the end of the step", partial_);
+    m.diag_step = m.coordinate(group, "step", H5T_STD_I64LE, nullptr, 0, true);
+    put_text(m.diag_step, "long_name", "number of steps done", partial_);
+    for (const auto& s : diag_series())
+      m.diag.push_back(m.series(group, s.name, m.diag_step, -1, 0, s.units, s.long_name));
+  }
+
+  // gauges/: one row per step, one column per gauge.
+  if (!m.gauge_cells.empty()) {
+    H5Id group = m.create_group("gauges");
+    put_text(group, "comment",
+             "values of the cells containing the gauges (output.gauges), one row per step",
+             partial_);
+    const hsize_t n = m.gauge_cells.size();
+    std::vector<std::int32_t> ids(n);
+    std::vector<double> gx(n), gy(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      ids[i] = static_cast<std::int32_t>(i);
+      gx[i] = m.output.gauges[i][0];
+      gy[i] = m.output.gauges[i][1];
+    }
+    H5Id gauge = m.coordinate(group, "gauge", H5T_STD_I32LE, ids.data(), n, false);
+    put_text(gauge, "long_name", "gauge index in output.gauges", partial_);
+    for (const auto& [name, values] : {std::pair{"x", &gx}, std::pair{"y", &gy}}) {
+      H5Id ds = create_dataset(group, name, H5T_IEEE_F64LE, {n}, {n}, {}, false, nullptr, partial_);
+      checked(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values->data()),
+              partial_, std::string("gauges/") + name);
+      checked(H5DSattach_scale(ds, gauge, 0), partial_, std::string("gauges/") + name);
+      const bool is_x = std::string(name) == "x";
+      put_text(ds, "units", geo.is_geographic ? (is_x ? "degrees_east" : "degrees_north") : units,
+               partial_);
+      put_text(ds, "long_name", std::string("gauge ") + name + " coordinate", partial_);
+    }
+    m.gauge_step = m.coordinate(group, "step", H5T_STD_I64LE, nullptr, 0, true);
+    put_text(m.gauge_step, "long_name", "number of steps done", partial_);
+    m.gauge_time = m.series(group, "time", m.gauge_step, -1, 0, "s",
+                            "time since the start of the run, at the end of the step");
+    const char* gunits[] = {"m", "m", "m s-1"};
+    const char* glong[] = {"water depth at the gauge", "water surface elevation at the gauge",
+                           "flow speed at the gauge"};
+    for (std::size_t k = 0; k < m.gauge.size(); ++k)
+      m.gauge[k] = m.series(group, kGaugeSeries[k], m.gauge_step, gauge, n, gunits[k], glong[k]);
+  }
+  checked(H5Fflush(m.file, H5F_SCOPE_GLOBAL), partial_, "(flushing)");
+  impl_ = std::move(impl);
+}
+
+ResultWriter::~ResultWriter() {
+  if (!impl_) return;
+  QuietH5 quiet;
+  try {
+    impl_->flush_pending();
+  } catch (...) {  // a destructor reports nothing; the file keeps what it had
+  }
+  impl_->close();
+}
+
+void ResultWriter::snapshot(const Simulation& sim) {
+  if (!impl_) throw Error(ExitCode::internal, path_ + ": snapshot after finish()");
+  QuietH5 quiet;
+  Impl& m = *impl_;
+  const Grid& g = sim.grid();
+  if (g.nx != m.grid.nx || g.ny != m.grid.ny)
+    throw Error(ExitCode::internal, path_ + ": snapshot of a simulation on another grid");
+  const auto& terrain = sim.terrain();
+  std::vector<float> f32(g.cells());
+  for (auto& [info, ds] : m.fields) {
+    const auto values = sim.field(info.id);
+    for (std::size_t i = 0; i < f32.size(); ++i)
+      f32[i] = terrain.active(i) ? static_cast<float>(values[i]) : std::nanf("");
+    append_rows(ds, H5T_NATIVE_FLOAT, 1, f32.data(), partial_, info.name);
+  }
+  const double t = sim.time();
+  append_rows(m.time, H5T_NATIVE_DOUBLE, 1, &t, partial_, "time");
+  times_.push_back(t);
+  last_snapshot_step_ = sim.steps_done();
+  m.flush_pending();
+  checked(H5Fflush(m.file, H5F_SCOPE_GLOBAL), partial_, "(flushing)");
+}
+
+void ResultWriter::record_step(const Simulation& sim) {
+  if (!impl_) throw Error(ExitCode::internal, path_ + ": record_step after finish()");
+  Impl& m = *impl_;
+  m.pending.push_back(sim.diagnostics());
+  m.pending_steps.push_back(sim.steps_done());
+  if (m.gauge_cells.empty()) return;
+  if (m.bed.empty() || m.bed_changes) m.bed = sim.field(FieldId::bed);
+  const auto& bed = m.bed;
+  const auto depth = sim.field(FieldId::water_depth);
+  const auto vx = sim.field(FieldId::velocity_x);
+  const auto vy = sim.field(FieldId::velocity_y);
+  m.pending_gauge_time.push_back(sim.time());
+  m.pending_gauge_steps.push_back(sim.steps_done());
+  for (const std::size_t i : m.gauge_cells) {
+    const bool on = sim.terrain().active(i);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    m.pending_gauge[0].push_back(on ? depth[i] : nan);
+    m.pending_gauge[1].push_back(on ? bed[i] + depth[i] : nan);
+    m.pending_gauge[2].push_back(on ? std::hypot(vx[i], vy[i]) : nan);
+  }
+}
+
+bool ResultWriter::snapshot_due(const Simulation& sim) const {
+  if (times_.empty()) return true;
+  if (sim.steps_done() == last_snapshot_step_) return false;
+  if (!impl_) return false;
+  const auto& out = impl_->output;
+  if (out.interval > 0) {
+    const double eps = 1e-9 * out.interval;
+    return std::floor((sim.time() + eps) / out.interval) >
+           std::floor((times_.back() + eps) / out.interval);
+  }
+  return out.every > 0 && sim.steps_done() % out.every == 0;
+}
+
+void ResultWriter::step_done(const Simulation& sim) {
+  record_step(sim);
+  if (snapshot_due(sim)) snapshot(sim);
+}
+
+void ResultWriter::finish(const Simulation& sim) {
+  if (impl_ && last_snapshot_step_ != sim.steps_done()) snapshot(sim);
+  finish();
+}
+
+void ResultWriter::finish() {
+  if (!impl_) return;
+  QuietH5 quiet;
+  Impl& m = *impl_;
+  m.flush_pending();
+  const Grid grid = m.grid;
+  const std::string xname = m.xname, yname = m.yname;
+  std::vector<FieldInfo> infos;
+  for (const auto& f : m.fields) infos.push_back(f.first);
+  m.close();
+  impl_.reset();
+
+  std::error_code ec;
+  if (!overwrite_ && fs::exists(path_, ec))
+    throw Error(ExitCode::cant_create, path_ +
+                                           ": exists (created during the run); not overwritten "
+                                           "(give --overwrite); the results are in " +
+                                           partial_);
+
+  // The XDMF sidecar: one uniform rectilinear grid per snapshot, referencing the datasets.
+  const std::string h5name = fs::path(path_).filename().string();
+  const std::size_t nt = times_.size();
+  std::string xmf = fmt::format(
+      "<?xml version=\"1.0\" ?>\n"
+      "<!-- erodem results: open this file in ParaView (XDMF reader); data in {0} -->\n"
+      "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+      "  <Domain>\n"
+      "    <Grid Name=\"erodem\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+      xml_escape(h5name));
+  for (std::size_t k = 0; k < nt; ++k) {
+    xmf += fmt::format(
+        "      <Grid Name=\"t{0}\" GridType=\"Uniform\">\n"
+        "        <Time Value=\"{1:.17g}\"/>\n"
+        "        <Topology TopologyType=\"2DRectMesh\" Dimensions=\"{2} {3}\"/>\n"
+        "        <Geometry GeometryType=\"VXVY\">\n"
+        "          <DataItem Dimensions=\"{3}\" NumberType=\"Float\" Precision=\"8\" "
+        "Format=\"HDF\">{4}:/{5}</DataItem>\n"
+        "          <DataItem Dimensions=\"{2}\" NumberType=\"Float\" Precision=\"8\" "
+        "Format=\"HDF\">{4}:/{6}</DataItem>\n"
+        "        </Geometry>\n",
+        k, times_[k], grid.ny, grid.nx, xml_escape(h5name), xname, yname);
+    for (const auto& info : infos)
+      xmf += fmt::format(
+          "        <Attribute Name=\"{0}\" AttributeType=\"Scalar\" Center=\"Node\">\n"
+          "          <DataItem ItemType=\"HyperSlab\" Dimensions=\"{1} {2}\" "
+          "Type=\"HyperSlab\">\n"
+          "            <DataItem Dimensions=\"3 3\" Format=\"XML\">{3} 0 0 1 1 1 1 {1} "
+          "{2}</DataItem>\n"
+          "            <DataItem Dimensions=\"{4} {1} {2}\" NumberType=\"Float\" "
+          "Precision=\"4\" Format=\"HDF\">{5}:/{0}</DataItem>\n"
+          "          </DataItem>\n"
+          "        </Attribute>\n",
+          info.name, grid.ny, grid.nx, k, nt, xml_escape(h5name));
+    xmf += "      </Grid>\n";
+  }
+  xmf += "    </Grid>\n  </Domain>\n</Xdmf>\n";
+  write_text_file(xdmf_path(path_), xmf);
+
+  fs::rename(partial_, path_, ec);
+  if (ec)
+    throw Error(ExitCode::io,
+                path_ + ": cannot rename " + partial_ + " into place: " + ec.message());
+}
+
+// ---- ResultReader ---------------------------------------------------------------------------
+
+namespace {
+
+[[noreturn]] void not_ours(const std::string& path, const std::string& why) {
+  throw Error(ExitCode::data, path + ": not an erodem result file (" + why + ")");
+}
+
+/// A 1-D dataset as doubles.
+std::vector<double> read_doubles(hid_t loc, const std::string& name, const std::string& path) {
+  H5Id ds(H5Dopen2(loc, name.c_str(), H5P_DEFAULT));
+  if (!ds.valid()) not_ours(path, "no dataset " + name);
+  H5Id space(H5Dget_space(ds));
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  if (n < 0) not_ours(path, "unreadable dataset " + name);
+  std::vector<double> v(static_cast<std::size_t>(n));
+  if (n > 0 && H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+    throw Error(ExitCode::io, path + ": reading " + name + " failed" + h5_reason());
+  return v;
+}
+
+}  // namespace
+
+ResultReader::ResultReader(const std::string& path) : path_(path) {
+  QuietH5 quiet;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(ExitCode::no_input, path + ": no such file");
+  if (H5Fis_hdf5(path.c_str()) <= 0) not_ours(path, "not an HDF5 file");
+  file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file_ < 0) throw Error(ExitCode::data, path + ": cannot open" + h5_reason());
+  try {
+    if (H5Aexists(file_, "erodem_version") <= 0) not_ours(path, "no erodem_version attribute");
+    // Root attributes (text ones).
+    H5Aiterate2(
+        file_, H5_INDEX_NAME, H5_ITER_INC, nullptr,
+        [](hid_t loc, const char* name, const H5A_info_t*, void* out) -> herr_t {
+          std::string value;
+          if (get_text(loc, name, value))
+            (*static_cast<std::map<std::string, std::string>*>(out))[name] = value;
+          return 0;
+        },
+        &attributes_);
+    const bool geographic = exists(file_, "lon") && exists(file_, "lat");
+    const char* xname = geographic ? "lon" : "x";
+    const char* yname = geographic ? "lat" : "y";
+    if (!exists(file_, "time") || !exists(file_, xname) || !exists(file_, yname))
+      not_ours(path, "no time, y and x coordinates");
+    times_ = read_doubles(file_, "time", path);
+    const auto xs = read_doubles(file_, xname, path);
+    const auto ys = read_doubles(file_, yname, path);
+    if (xs.empty() || ys.empty()) not_ours(path, "empty grid");
+    Grid& g = grid_;
+    g.nx = static_cast<int>(xs.size());
+    g.ny = static_cast<int>(ys.size());
+    g.georef.is_geographic = geographic;
+    bool have_transform = false;
+    if (exists(file_, "crs")) {
+      H5Id crs(H5Dopen2(file_, "crs", H5P_DEFAULT));
+      std::string text;
+      if (crs.valid() && get_text(crs, "crs_wkt", text)) g.georef.crs_wkt = text;
+      if (crs.valid() && get_text(crs, "GeoTransform", text)) {
+        std::istringstream in(text);
+        auto& t = g.georef.transform;
+        have_transform = static_cast<bool>(in >> t[0] >> t[1] >> t[2] >> t[3] >> t[4] >> t[5]);
+      }
+    }
+    if (!have_transform) {  // from the cell centres
+      const double dx = g.nx > 1 ? (xs.back() - xs.front()) / (g.nx - 1) : 1.0;
+      const double dy = g.ny > 1 ? (ys.back() - ys.front()) / (g.ny - 1) : -1.0;
+      g.georef.transform = {xs.front() - 0.5 * dx, dx, 0.0, ys.front() - 0.5 * dy, 0.0, dy};
+    }
+    g.georef.has_transform = true;
+    const auto rows = static_cast<std::size_t>(g.ny);
+    if (exists(file_, "cell_dx") && exists(file_, "cell_dy") && exists(file_, "cell_area")) {
+      g.dx = read_doubles(file_, "cell_dx", path);
+      g.dy = read_doubles(file_, "cell_dy", path);
+      g.area = read_doubles(file_, "cell_area", path);
+      if (g.dx.size() != rows || g.dy.size() != rows || g.area.size() != rows)
+        not_ours(path, "cell sizes do not match the grid");
+    } else {  // from the transform (projected grids in metres)
+      const double dx = std::abs(g.georef.transform[1]), dy = std::abs(g.georef.transform[5]);
+      g.dx.assign(rows, dx);
+      g.dy.assign(rows, dy);
+      g.area.assign(rows, dx * dy);
+    }
+  } catch (...) {
+    H5Fclose(file_);
+    throw;
+  }
+}
+
+ResultReader::~ResultReader() {
+  if (file_ >= 0) H5Fclose(file_);
+}
+
+std::string ResultReader::attribute(const std::string& name) const {
+  const auto it = attributes_.find(name);
+  return it == attributes_.end() ? std::string() : it->second;
+}
+
+std::vector<std::string> ResultReader::fields() const {
+  QuietH5 quiet;
+  struct Walk {
+    std::vector<std::string> names;
+  } walk;
+  const auto visit = [](hid_t loc, const char* name, const H5L_info_t*, void* data) -> herr_t {
+    auto* w = static_cast<Walk*>(data);
+    H5Id ds(H5Dopen2(loc, name, H5P_DEFAULT));  // fails (quietly) for groups
+    if (!ds.valid()) return 0;
+    H5Id space(H5Dget_space(ds));
+    if (H5Sget_simple_extent_ndims(space) == 3) w->names.emplace_back(name);
+    return 0;
+  };
+  if (H5Literate(file_, H5_INDEX_CRT_ORDER, H5_ITER_INC, nullptr, visit, &walk) < 0) {
+    walk.names.clear();
+    H5Literate(file_, H5_INDEX_NAME, H5_ITER_INC, nullptr, visit, &walk);
+  }
+  return walk.names;
+}
+
+std::size_t ResultReader::nearest_time_index(double time) const {
+  if (times_.empty()) throw Error(ExitCode::data, path_ + ": holds no snapshot");
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < times_.size(); ++k)
+    if (std::abs(times_[k] - time) < std::abs(times_[best] - time)) best = k;
+  return best;
+}
+
+std::vector<float> ResultReader::read(const std::string& name, double time) const {
+  return read_index(name, nearest_time_index(time));
+}
+
+std::vector<float> ResultReader::read_index(const std::string& name, std::size_t index) const {
+  QuietH5 quiet;
+  if (index >= times_.size())
+    throw Error(ExitCode::usage,
+                fmt::format("{}: no snapshot {} (the file holds {})", path_, index, times_.size()));
+  const auto names = fields();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw Error(ExitCode::data, path_ + ": no field '" + name + "' (fields: " + list + ")");
+  }
+  H5Id ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
+  H5Id space(H5Dget_space(ds));
+  std::array<hsize_t, 3> dims{};
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  if (dims[1] != static_cast<hsize_t>(grid_.ny) || dims[2] != static_cast<hsize_t>(grid_.nx) ||
+      dims[0] <= index)
+    throw Error(ExitCode::data, path_ + ": field '" + name + "' does not match the grid");
+  const std::array<hsize_t, 3> start{index, 0, 0}, count{1, dims[1], dims[2]};
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  H5Id mem(H5Screate_simple(3, count.data(), nullptr));
+  std::vector<float> values(grid_.cells());
+  if (H5Dread(ds, H5T_NATIVE_FLOAT, mem, space, H5P_DEFAULT, values.data()) < 0)
+    throw Error(ExitCode::io, path_ + ": reading " + name + " failed" + h5_reason());
+  return values;
+}
+
+std::vector<Diagnostics> ResultReader::diagnostics() const {
+  QuietH5 quiet;
+  if (!exists(file_, "diagnostics")) return {};
+  std::vector<Diagnostics> rows;
+  for (const auto& s : diag_series()) {
+    const auto v = read_doubles(file_, std::string("diagnostics/") + s.name, path_);
+    if (rows.empty()) rows.resize(v.size());
+    if (v.size() != rows.size())
+      throw Error(ExitCode::data, path_ + ": diagnostics series of different lengths");
+    for (std::size_t r = 0; r < v.size(); ++r) rows[r].*s.member = v[r];
+  }
+  return rows;
+}
+
+GaugeSeries ResultReader::gauges() const {
+  QuietH5 quiet;
+  GaugeSeries out;
+  if (!exists(file_, "gauges")) return out;
+  out.x = read_doubles(file_, "gauges/x", path_);
+  out.y = read_doubles(file_, "gauges/y", path_);
+  out.time = read_doubles(file_, "gauges/time", path_);
+  const std::size_t n = out.x.size();
+  std::vector<std::vector<double>>* series[] = {&out.water_depth, &out.water_level, &out.speed};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto flat = read_doubles(file_, std::string("gauges/") + kGaugeSeries[k], path_);
+    for (std::size_t r = 0; n > 0 && r < flat.size() / n; ++r)
+      series[k]->emplace_back(flat.begin() + static_cast<std::ptrdiff_t>(r * n),
+                              flat.begin() + static_cast<std::ptrdiff_t>((r + 1) * n));
+  }
+  return out;
+}
+
+}  // namespace erodem::io

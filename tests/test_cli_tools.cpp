@@ -1,0 +1,184 @@
+// erodem — the tool subcommands end to end: devices, compare, bench.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "erodem/backends.hpp"
+#include "erodem/grid.hpp"
+#include "erodem/io/raster.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliResult {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CliResult run_cli(const std::string& args, const fs::path& cwd) {
+  const std::string cmd = "cd '" + cwd.string() + "' && '" ERODEM_CLI_PATH "' " + args + " 2>&1";
+  CliResult r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+bool contains(const std::string& text, const std::string& what) {
+  return text.find(what) != std::string::npos;
+}
+
+class CliTools : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("erodem_cli_tools_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Writes `stem`_<field>.tif for each field, as `erodem run` names its outputs, on an
+  /// nx x ny grid of 10 m cells; values base + field index + scale * cell index.
+  void write_run(const std::string& stem, int nx, int ny, double base, double scale,
+                 const std::vector<std::string>& fields = {"bed", "water_depth"}) const {
+    const erodem::Grid g = erodem::Grid::uniform(nx, ny, 10.0);
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      std::vector<float> v(g.cells());
+      for (std::size_t i = 0; i < v.size(); ++i)
+        v[i] = static_cast<float>(base + static_cast<double>(f) + scale * static_cast<double>(i));
+      erodem::io::write_geotiff((dir_ / (stem + "_" + fields[f] + ".tif")).string(), g, v,
+                                fields[f]);
+    }
+  }
+  fs::path dir_;
+};
+
+TEST_F(CliTools, DevicesListsTheCpuReferenceAndWhatAutoPicks) {
+  const auto r = run_cli("devices", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "CPU reference")) << r.output;
+  EXPECT_TRUE(contains(r.output, "auto picks")) << r.output;
+  const auto devices = erodem::list_opencl_devices();
+  if (erodem::opencl_available()) {
+    ASSERT_FALSE(devices.empty());
+    EXPECT_TRUE(contains(r.output, devices.front().device)) << r.output;
+    EXPECT_TRUE(contains(r.output, "compute units")) << r.output;
+  }
+  const auto j = run_cli("devices --json", dir_);
+  ASSERT_EQ(j.code, 0) << j.output;
+  ASSERT_FALSE(j.output.empty());
+  EXPECT_EQ(j.output.front(), '{') << j.output;
+  EXPECT_TRUE(contains(j.output, "\"cpu_reference\"")) << j.output;
+  EXPECT_TRUE(contains(j.output, "\"opencl_devices\"")) << j.output;
+  EXPECT_TRUE(contains(j.output, "\"auto\": {\"backend\": ")) << j.output;
+  if (erodem::opencl_available()) {
+    EXPECT_TRUE(contains(j.output, "\"max_work_group_size\"")) << j.output;
+    EXPECT_TRUE(contains(j.output, "\"device\": \"" + devices.front().device + "\"")) << j.output;
+  }
+}
+
+TEST_F(CliTools, CompareIdenticalOutputsPasses) {
+  write_run("a", 16, 12, 100.0, 0.01);
+  write_run("b", 16, 12, 100.0, 0.01);
+  const auto r = run_cli("compare a.h5 b.h5 --json", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"field\": \"bed\"")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"field\": \"water_depth\"")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"rel_l2\": 0,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"cells\": 192")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"ok\": true}")) << r.output;
+  // The table form, and single GeoTIFFs.
+  const auto t = run_cli("compare a.h5 b.h5", dir_);
+  EXPECT_EQ(t.code, 0) << t.output;
+  EXPECT_TRUE(contains(t.output, "within tolerance")) << t.output;
+  EXPECT_EQ(run_cli("compare a_bed.tif b_bed.tif", dir_).code, 0);
+}
+
+TEST_F(CliTools, CompareDifferentOutputsFailsAboveTolerance) {
+  write_run("a", 16, 12, 100.0, 0.01);
+  write_run("b", 16, 12, 100.0, 0.02);  // differs most at the last cell (15, 11)
+  const auto r = run_cli("compare a.h5 b.h5 --tol 1e-5", dir_);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "FAIL")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(15,11)")) << r.output;
+  const auto j = run_cli("compare a.h5 b.h5 --json --fields bed", dir_);
+  EXPECT_EQ(j.code, 1) << j.output;
+  EXPECT_TRUE(contains(j.output, "\"max_abs_at\": [15, 11]")) << j.output;
+  EXPECT_FALSE(contains(j.output, "water_depth")) << j.output;
+  const auto loose = run_cli("compare a.h5 b.h5 --tol 0.5", dir_);
+  EXPECT_EQ(loose.code, 0) << loose.output;
+}
+
+TEST_F(CliTools, CompareMismatchedGridsExit65AndMissingInputs66) {
+  write_run("a", 16, 12, 100.0, 0.01);
+  write_run("small", 12, 12, 100.0, 0.01);
+  const auto r = run_cli("compare a.h5 small.h5", dir_);
+  EXPECT_EQ(r.code, 65) << r.output;
+  EXPECT_TRUE(contains(r.output, "mismatch")) << r.output;
+  EXPECT_EQ(run_cli("compare a.h5 nothing.h5", dir_).code, 66);
+  EXPECT_EQ(run_cli("compare a_bed.tif nothing.tif", dir_).code, 66);
+  // A field that one output lacks.
+  write_run("c", 16, 12, 100.0, 0.01, {"bed"});
+  const auto lacking = run_cli("compare a.h5 c.h5", dir_);
+  EXPECT_EQ(lacking.code, 66) << lacking.output;
+  EXPECT_TRUE(contains(lacking.output, "water_depth")) << lacking.output;
+  EXPECT_EQ(run_cli("compare a.h5 c.h5 --fields bed", dir_).code, 0);
+}
+
+TEST_F(CliTools, CompareResultFilesAtMatchingTimes) {
+  ASSERT_EQ(run_cli("generate --kind hill --size 24 --relief 20 hill.tif", dir_).code, 0);
+  std::ofstream(dir_ / "c.toml") << R"([dem]
+path = "hill.tif"
+[time]
+steps = 20
+dt = 0.5
+[rain]
+rate = "100 mm/h"
+[output]
+path = "out.h5"
+every = 10
+fields = ["bed", "water_depth"]
+)";
+  ASSERT_EQ(run_cli("run c.toml --backend cpu --output a.h5", dir_).code, 0);
+  ASSERT_EQ(run_cli("run c.toml --backend cpu --output b.h5", dir_).code, 0);
+  ASSERT_EQ(
+      run_cli("run c.toml --backend cpu --output wet.h5 --set 'rain.rate=200 mm/h'", dir_).code, 0);
+  const auto same = run_cli("compare a.h5 b.h5 --json", dir_);
+  EXPECT_EQ(same.code, 0) << same.output;
+  EXPECT_TRUE(contains(same.output, "\"times\": [0, 5, 10]")) << same.output;
+  EXPECT_TRUE(contains(same.output, "\"rel_l2\": 0,")) << same.output;
+  const auto wet = run_cli("compare wet.h5 a.h5 --fields water_depth", dir_);
+  EXPECT_EQ(wet.code, 1) << wet.output;
+  EXPECT_EQ(run_cli("compare wet.h5 a.h5 --fields water_depth --tol 10", dir_).code, 0);
+}
+
+TEST_F(CliTools, BenchReportsRatesAndBandwidth) {
+  const auto r =
+      run_cli("bench --size 64 --steps 2 --threads 1 --stream-floats 1048576 --json", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.front(), '{') << r.output;
+  for (const char* key : {"\"cell_steps_per_second\"", "\"bandwidth\"", "\"copy_gbs\"",
+                          "\"triad_gbs\"", "\"copy_gbs_1_thread\"", "\"bytes_per_cell\"", "\"gbs\"",
+                          "\"fraction_of_copy\"", "\"fraction_of_triad\"", "\"process\": \"flow\"",
+                          "\"process\": \"stats\"", "\"process\": \"full_step\""})
+    EXPECT_TRUE(contains(r.output, key)) << key << "\n" << r.output;
+  // The byte model of the benchmark scenario (local inertial, conservative transport).
+  EXPECT_TRUE(contains(r.output, "\"process\": \"flow\", \"seconds_per_step\"")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 45,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 213,")) << r.output;
+}
+
+}  // namespace
