@@ -134,7 +134,15 @@ double Simulation::next_dt() const {
       dt = std::min(dt, t.cfl * std::sqrt(l * area_min / (2.0 * params_.flow.pipe_area * g)));
     }
   }
-  if (t.duration > 0) dt = std::min(dt, t.duration - time_);
+  if (t.duration > 0) {
+    // End exactly at the duration without a sliver of a last step: a tiny dt lets the
+    // outflow limit pass fluxes up to depth * area / dt, which shows as spurious speeds.
+    const double remaining = t.duration - time_;
+    if (remaining <= dt)
+      dt = remaining;
+    else if (remaining < 2.0 * dt)
+      dt = 0.5 * remaining;
+  }
   return dt;
 }
 
