@@ -8,4 +8,4 @@ bash scripts/setup.sh build
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$PWD/build/pocl-cache}
 mkdir -p out/puget_sound
 ./build/cli/erodem run experiments/puget_sound/config.toml --overwrite "$@"
-echo "results: $PWD/out/puget_sound/ (one GeoTIFF per field; see docs/experiments/puget_sound.md)"
+echo "results: $PWD/out/puget_sound/puget_sound.h5 (+ .xmf for ParaView); see docs/experiments/puget_sound.md and docs/results.md"

@@ -583,3 +583,25 @@ TEST(Raster, PugetSoundPng) {
   EXPECT_EQ(t.grid.area[0], 25600.0);
   EXPECT_TRUE(t.mask.empty());
 }
+
+// dem.nodata_value: the sea stored as 0 becomes nodata (so it can be held at sea level).
+TEST(Raster, NodataValueMasksTheSea) {
+  erodem::Params::Dem dem;
+  dem.path = kPuget;
+  dem.z_scale = 0.1;
+  dem.cell_size = 160.0;
+  dem.nodata_value = 0.0;
+  const auto t = erodem::io::read_dem(dem);
+  std::size_t masked = 0;
+  double lowest = HUGE_VAL;
+  for (std::size_t i = 0; i < t.bed.size(); ++i) {
+    if (!t.active(i))
+      ++masked;
+    else
+      lowest = std::min(lowest, t.bed[i]);
+  }
+  std::printf("  puget sound with nodata_value 0: %zu cells masked, lowest land %.3f m\n", masked,
+              lowest);
+  EXPECT_EQ(masked, 39421u);  // the cells stored as 0
+  EXPECT_GT(lowest, 0.0);
+}

@@ -741,6 +741,10 @@ const std::vector<Descriptor>& descriptor_table() {
              "cell size (m) for files without georeferencing and synthetic terrain; 0 = from "
              "the file"),
       text(ERODEM_FIELD(dem.crs), "CRS (e.g. \"EPSG:32610\") for files without georeferencing"),
+      optional_number(ERODEM_FIELD(dem.nodata_value), D::dimensionless, any_finite(),
+                      "stored value to treat as nodata, in the file's units before z_scale "
+                      "(e.g. 0 for a heightmap whose sea is 0; with boundary.nodata = \"sea\" "
+                      "such cells hold the sea level)"),
 
       optional_number(ERODEM_FIELD(initial.water_level), D::length, any_finite(),
                       "fill every active cell up to this water surface elevation (m)"),

@@ -468,11 +468,16 @@ Terrain read_dem(const Params::Dem& dem) {
   std::vector<std::uint8_t> valid;
   t.bed = read_band(h, w, valid, "", path);
   std::size_t n_valid = 0;
-  for (std::size_t i = 0; i < t.bed.size(); ++i)
+  for (std::size_t i = 0; i < t.bed.size(); ++i) {
+    // dem.nodata_value marks cells of a file that declares no nodata (e.g. sea at 0).
+    if (dem.nodata_value && t.bed[i] == *dem.nodata_value) valid[i] = 0;
     if (valid[i] != 0) {
       t.bed[i] *= dem.z_scale;
       ++n_valid;
+    } else {
+      t.bed[i] = std::nan("");
     }
+  }
   if (n_valid == 0)
     throw Error(ExitCode::data, path + ": no valid (non-nodata) cells" +
                                     (dem.window ? " in window " + window_text(*dem.window) : ""));

@@ -49,8 +49,9 @@ struct Params {
     double resample = 0.0;                     ///< coarser cell size (m); 0 = none
     int resample_factor = 0;                   ///< integer averaging factor; 0 = none
     double z_scale = 1.0;                      ///< multiplier of stored values (1)
-    double cell_size = 0.0;  ///< m; for files without georeferencing (and synthetic)
-    std::string crs;         ///< CRS for files without georeferencing
+    double cell_size = 0.0;              ///< m; for files without georeferencing (and synthetic)
+    std::string crs;                     ///< CRS for files without georeferencing
+    std::optional<double> nodata_value;  ///< stored value to treat as nodata (before z_scale)
   } dem;
 
   struct Initial {
