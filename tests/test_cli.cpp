@@ -122,6 +122,36 @@ TEST_F(Cli, RunWritesFieldsAndPrintsLedger) {
   EXPECT_EQ(run_cli("run c.toml --overwrite --set time.steps=3", dir_).code, 0);
 }
 
+TEST_F(Cli, ExportWritesAStoredFieldAsGeoTiff) {
+  ASSERT_EQ(run_cli("generate --kind hill --size 48 --relief 30 hill.tif", dir_).code, 0);
+  write("c.toml", kConfig);
+  ASSERT_EQ(run_cli("run c.toml", dir_).code, 0);
+  const auto r = run_cli("export out.h5 --field water_depth --time 50 depth50.tif", dir_);
+  std::printf("[export] exit %d: %s", r.code, r.output.c_str());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const erodem::io::ResultReader run((dir_ / "out.h5").string());
+  erodem::Params::Dem d;
+  d.path = (dir_ / "depth50.tif").string();
+  const auto tif = erodem::io::read_dem(d);
+  const auto stored = run.read_index("water_depth", run.nearest_time_index(50.0));
+  ASSERT_EQ(tif.bed.size(), stored.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < stored.size(); ++i)
+    worst = std::max(worst, std::abs(tif.bed[i] - static_cast<double>(stored[i])));
+  EXPECT_EQ(worst, 0.0) << "the GeoTIFF holds the stored float32 values";
+  EXPECT_EQ(tif.grid.georef.transform, run.grid().georef.transform);
+  // A time or field the file does not hold is a clear error, and nothing is written.
+  const auto no_time = run_cli("export out.h5 --field water_depth --time 42 x.tif", dir_);
+  std::printf("[export] %s", no_time.output.c_str());
+  EXPECT_EQ(no_time.code, 65);
+  EXPECT_NE(no_time.output.find("stored: 0, 50, 100"), std::string::npos) << no_time.output;
+  const auto no_field = run_cli("export out.h5 --field sediment x.tif", dir_);
+  EXPECT_EQ(no_field.code, 65);
+  EXPECT_NE(no_field.output.find("'sediment'"), std::string::npos) << no_field.output;
+  EXPECT_FALSE(fs::exists(dir_ / "x.tif"));
+  EXPECT_EQ(run_cli("export nowhere.h5 --field bed x.tif", dir_).code, 66);
+}
+
 TEST_F(Cli, BadConfigValuesExit78WithoutOutput) {
   ASSERT_EQ(run_cli("generate --kind hill --size 16 hill.tif", dir_).code, 0);
   struct Case {
