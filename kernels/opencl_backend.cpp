@@ -4,6 +4,7 @@
 // defined; otherwise only the functions that say the backend is not built.
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
+#include "erodem/initial_state.hpp"
 
 #ifndef ERODEM_HAVE_OPENCL
 
@@ -465,18 +466,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     throw Error(ExitCode::data, fmt::format("backend 'opencl': a grid of {} x {} is too large "
                                             "(at most 2^31 padded cells)",
                                             nx_, ny_));
-  const std::size_t cells = g.cells();
-  auto check_size = [&](const std::vector<double>& v, const char* what) {
-    if (!v.empty() && v.size() != cells)
-      throw Error(ExitCode::data,
-                  fmt::format("{}: {} values for a grid of {} x {}", what, v.size(), g.nx, g.ny));
-  };
-  check_size(terrain.bed, "bed");
-  if (terrain.bed.size() != cells) throw Error(ExitCode::data, "bed: missing");
-  check_size(terrain.water_depth, "initial water depth");
-  check_size(terrain.manning_n, "flow.manning_n");
-  check_size(terrain.hardness, "erosion.hardness");
-  check_size(terrain.rain_factor, "rain.raster");
+  const PaddedState state = build_padded_state(terrain, params);
 
   rt_ = runtime_for(selector);
   cl_int err = CL_SUCCESS;
@@ -484,86 +474,14 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   check(err, "clCreateCommandQueue");
   acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
 
-  // ---- the host state, built exactly as the CPU reference builds it ----
-  auto at = [&](int x, int y) {
-    return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
-  };
-  std::vector<Real> dx(H_), dy(H_), area(H_);
-  area_host_.resize(H_);
-  for (int y = 0; y < H_; ++y) {
-    const int r = std::clamp(y - 1, 0, ny_ - 1);
-    dx[y] = static_cast<Real>(g.dx[r]);
-    dy[y] = static_cast<Real>(g.dy[r]);
-    area[y] = static_cast<Real>(g.area[r]);
-    area_host_[y] = area[y];
-  }
-  using Kind = cl_uchar;
-  const double sea = params.boundary.sea_level;
-  std::vector<Kind> kind(n_, ERODEM_CELL_WALL);
-  for (int r = 0; r < ny_; ++r)
-    for (int c = 0; c < nx_; ++c) {
-      const auto i = static_cast<std::size_t>(r) * nx_ + c;
-      kind[at(c + 1, r + 1)] = terrain.active(i)                           ? ERODEM_CELL_ACTIVE
-                               : params.boundary.nodata == NodataKind::sea ? ERODEM_CELL_FIXED
-                                                                           : ERODEM_CELL_WALL;
-    }
-  auto edge_kind = [](BoundaryKind b) {
-    switch (b) {
-      case BoundaryKind::open:
-        return Kind{ERODEM_CELL_OPEN};
-      case BoundaryKind::fixed_level:
-        return Kind{ERODEM_CELL_FIXED};
-      case BoundaryKind::closed:
-        break;
-    }
-    return Kind{ERODEM_CELL_WALL};
-  };
-  for (int y = 1; y <= ny_; ++y) {
-    if (kind[at(1, y)] == ERODEM_CELL_ACTIVE) kind[at(0, y)] = edge_kind(params.boundary.west);
-    if (kind[at(nx_, y)] == ERODEM_CELL_ACTIVE)
-      kind[at(nx_ + 1, y)] = edge_kind(params.boundary.east);
-  }
-  for (int x = 1; x <= nx_; ++x) {
-    if (kind[at(x, 1)] == ERODEM_CELL_ACTIVE) kind[at(x, 0)] = edge_kind(params.boundary.north);
-    if (kind[at(x, ny_)] == ERODEM_CELL_ACTIVE)
-      kind[at(x, ny_ + 1)] = edge_kind(params.boundary.south);
-  }
-  std::vector<double> bed(n_, 0.0), depth(n_, 0.0);
-  for (int r = 0; r < ny_; ++r)
-    for (int c = 0; c < nx_; ++c) {
-      const auto i = static_cast<std::size_t>(r) * nx_ + c;
-      const auto p = at(c + 1, r + 1);
-      if (kind[p] != ERODEM_CELL_ACTIVE) continue;
-      bed[p] = terrain.bed[i];
-      if (!terrain.water_depth.empty())
-        depth[p] = terrain.water_depth[i];
-      else if (params.initial.water_level)
-        depth[p] = std::max(0.0, *params.initial.water_level - bed[p]);
-      else
-        depth[p] = params.initial.water_depth.value;
-    }
-  for (int y = 1; y <= ny_; ++y)
-    for (int x = 1; x <= nx_; ++x) {
-      const auto p = at(x, y);
-      if (kind[p] == ERODEM_CELL_ACTIVE) continue;
-      double low = sea;
-      for (auto q : {p - 1, p + 1, p - W_, p + W_})
-        if (kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, bed[q]);
-      bed[p] = kind[p] == ERODEM_CELL_FIXED ? low : 0.0;
-      depth[p] = kind[p] == ERODEM_CELL_FIXED ? sea - low : 0.0;
-    }
+  // ---- the host state: the same padded state the CPU reference starts from ----
   auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
-  auto raster_or = [&](const std::vector<double>& raster, double scalar) {
-    std::vector<Real> out(n_, static_cast<Real>(scalar));
-    if (raster.empty()) return out;
-    for (int y = 0; y < H_; ++y)
-      for (int x = 0; x < W_; ++x) {
-        const int r = std::clamp(y - 1, 0, ny_ - 1), c = std::clamp(x - 1, 0, nx_ - 1);
-        out[at(x, y)] = static_cast<Real>(raster[static_cast<std::size_t>(r) * nx_ + c]);
-      }
-    return out;
-  };
-  const std::vector<Real> bed_r = to_real(bed), depth_r = to_real(depth), zeros(n_, Real(0));
+  const std::vector<Real> dx = to_real(state.dx), dy = to_real(state.dy),
+                          area = to_real(state.area);
+  area_host_.assign(area.begin(), area.end());
+  const std::vector<cl_uchar> kind(state.kind.begin(), state.kind.end());
+  const std::vector<Real> bed_r = to_real(state.bed), depth_r = to_real(state.depth),
+                          zeros(n_, Real(0));
 
   // ---- the device state ----
   kind_ = upload(kind);
@@ -585,9 +503,9 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   velocity_y_ = upload(zeros);
   thermal_share_ = upload(zeros);
   wetness_ = upload(depth_r);
-  manning_ = upload(raster_or(terrain.manning_n, params.flow.manning_n.value));
-  hardness_ = upload(raster_or(terrain.hardness, params.erosion.hardness.value));
-  rain_factor_ = upload(raster_or(terrain.rain_factor, 1.0));
+  manning_ = upload(to_real(state.manning));
+  hardness_ = upload(to_real(state.hardness));
+  rain_factor_ = upload(to_real(state.rain_factor));
 
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
   // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_runner.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/grid.hpp"
 #include "erodem/io/raster.hpp"
@@ -17,22 +18,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliResult {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CliResult run_cli(const std::string& args, const fs::path& cwd) {
-  const std::string cmd = "cd '" + cwd.string() + "' && '" ERODEM_CLI_PATH "' " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using erodem::test::CliResult;
+using erodem::test::run_cli;
 
 bool contains(const std::string& text, const std::string& what) {
   return text.find(what) != std::string::npos;

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_runner.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/geodesy.hpp"
 #include "erodem/io/raster.hpp"
@@ -94,22 +95,8 @@ double geodesic_outline_area(const std::array<double, 4>& o, double a, double f,
   return std::fabs(area);
 }
 
-struct CliResult {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CliResult run_cli(const std::string& args) {
-  const std::string cmd = "'" ERODEM_CLI_PATH "' " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using erodem::test::CliResult;
+using erodem::test::run_cli;
 
 /// The number after `"key": ` in a JSON text; NaN when absent.
 double json_value(const std::string& json, const std::string& key) {

@@ -14,6 +14,7 @@
 #include "common/stats.h"
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
+#include "erodem/initial_state.hpp"
 
 namespace erodem {
 
@@ -24,99 +25,20 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       ny_(terrain.grid.ny),
       W_(terrain.grid.nx + 2),
       H_(terrain.grid.ny + 2) {
-  const auto& g = terrain.grid;
-  g.validate();
-  const auto n = static_cast<std::size_t>(W_) * H_;
-  const std::size_t cells = g.cells();
-  auto check_size = [&](const std::vector<double>& v, const char* what) {
-    if (!v.empty() && v.size() != cells)
-      throw Error(ExitCode::data,
-                  fmt::format("{}: {} values for a grid of {} x {}", what, v.size(), g.nx, g.ny));
-  };
-  check_size(terrain.bed, "bed");
-  if (terrain.bed.size() != cells) throw Error(ExitCode::data, "bed: missing");
-  check_size(terrain.water_depth, "initial water depth");
-  check_size(terrain.manning_n, "flow.manning_n");
-  check_size(terrain.hardness, "erosion.hardness");
-  check_size(terrain.rain_factor, "rain.raster");
+  const PaddedState s = build_padded_state(terrain, params);
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
 #else
   threads_ = 1;
 #endif
-
-  // Geometry per padded row; halo rows repeat their neighbours.
-  dx_.resize(H_);
-  dy_.resize(H_);
-  area_.resize(H_);
-  for (int y = 0; y < H_; ++y) {
-    const int r = std::clamp(y - 1, 0, ny_ - 1);
-    dx_[y] = static_cast<Real>(g.dx[r]);
-    dy_[y] = static_cast<Real>(g.dy[r]);
-    area_[y] = static_cast<Real>(g.area[r]);
-  }
-
-  // Cell kinds: DEM cells active or nodata (wall or sea); halo by the edge's boundary kind.
-  const double sea = params.boundary.sea_level;
-  kind_.assign(n, ERODEM_CELL_WALL);
-  for (int r = 0; r < ny_; ++r)
-    for (int c = 0; c < nx_; ++c) {
-      const auto i = static_cast<std::size_t>(r) * nx_ + c;
-      kind_[at(c + 1, r + 1)] = terrain.active(i)                           ? ERODEM_CELL_ACTIVE
-                                : params.boundary.nodata == NodataKind::sea ? ERODEM_CELL_FIXED
-                                                                            : ERODEM_CELL_WALL;
-    }
-  auto edge_kind = [](BoundaryKind b) {
-    switch (b) {
-      case BoundaryKind::open:
-        return Kind{ERODEM_CELL_OPEN};
-      case BoundaryKind::fixed_level:
-        return Kind{ERODEM_CELL_FIXED};
-      case BoundaryKind::closed:
-        break;
-    }
-    return Kind{ERODEM_CELL_WALL};
-  };
-  for (int y = 1; y <= ny_; ++y) {
-    if (kind_[at(1, y)] == ERODEM_CELL_ACTIVE) kind_[at(0, y)] = edge_kind(params.boundary.west);
-    if (kind_[at(nx_, y)] == ERODEM_CELL_ACTIVE)
-      kind_[at(nx_ + 1, y)] = edge_kind(params.boundary.east);
-  }
-  for (int x = 1; x <= nx_; ++x) {
-    if (kind_[at(x, 1)] == ERODEM_CELL_ACTIVE) kind_[at(x, 0)] = edge_kind(params.boundary.north);
-    if (kind_[at(x, ny_)] == ERODEM_CELL_ACTIVE)
-      kind_[at(x, ny_ + 1)] = edge_kind(params.boundary.south);
-  }
-
-  // Bed and initial water (computed in double, then rounded once).
-  std::vector<double> bed(n, 0.0), depth(n, 0.0);
-  for (int r = 0; r < ny_; ++r)
-    for (int c = 0; c < nx_; ++c) {
-      const auto i = static_cast<std::size_t>(r) * nx_ + c;
-      const auto p = at(c + 1, r + 1);
-      if (kind_[p] != ERODEM_CELL_ACTIVE) continue;
-      bed[p] = terrain.bed[i];
-      if (!terrain.water_depth.empty())
-        depth[p] = terrain.water_depth[i];
-      else if (params.initial.water_level)
-        depth[p] = std::max(0.0, *params.initial.water_level - bed[p]);
-      else
-        depth[p] = params.initial.water_depth.value;
-    }
-  // Nodata cells: sea ghosts hold the sea over a bed no higher than their active neighbours.
-  for (int y = 1; y <= ny_; ++y)
-    for (int x = 1; x <= nx_; ++x) {
-      const auto p = at(x, y);
-      if (kind_[p] == ERODEM_CELL_ACTIVE) continue;
-      double low = sea;
-      for (auto q : {p - 1, p + 1, p - W_, p + W_})
-        if (kind_[q] == ERODEM_CELL_ACTIVE) low = std::min(low, bed[q]);
-      bed[p] = kind_[p] == ERODEM_CELL_FIXED ? low : 0.0;
-      depth[p] = kind_[p] == ERODEM_CELL_FIXED ? sea - low : 0.0;
-    }
   auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
-  bed_ = to_real(bed);
-  depth_ = to_real(depth);
+  const std::size_t n = s.size();
+  kind_ = s.kind;
+  dx_ = to_real(s.dx);
+  dy_ = to_real(s.dy);
+  area_ = to_real(s.area);
+  bed_ = to_real(s.bed);
+  depth_ = to_real(s.depth);
   bed_next_ = bed_;
   bed0_ = bed_;
   depth_next_ = depth_;
@@ -130,21 +52,9 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   velocity_y_.assign(n, Real(0));
   thermal_share_.assign(n, Real(0));
   wetness_ = depth_;
-
-  // Rasters or scalars; halo cells copy the nearest DEM cell (Manning n is read at faces).
-  auto raster_or = [&](const std::vector<double>& raster, double scalar) {
-    std::vector<Real> out(n, static_cast<Real>(scalar));
-    if (raster.empty()) return out;
-    for (int y = 0; y < H_; ++y)
-      for (int x = 0; x < W_; ++x) {
-        const int r = std::clamp(y - 1, 0, ny_ - 1), c = std::clamp(x - 1, 0, nx_ - 1);
-        out[at(x, y)] = static_cast<Real>(raster[static_cast<std::size_t>(r) * nx_ + c]);
-      }
-    return out;
-  };
-  manning_ = raster_or(terrain.manning_n, params.flow.manning_n.value);
-  hardness_ = raster_or(terrain.hardness, params.erosion.hardness.value);
-  rain_factor_ = raster_or(terrain.rain_factor, 1.0);
+  manning_ = to_real(s.manning);
+  hardness_ = to_real(s.hardness);
+  rain_factor_ = to_real(s.rain_factor);
   row_sums_a_.assign(H_, 0.0);
   row_sums_b_.assign(H_, 0.0);
   run_boundary();

@@ -1,0 +1,34 @@
+// erodem — the padded initial state every backend starts from, built once on the host.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "erodem/grid.hpp"
+#include "erodem/params.hpp"
+
+namespace erodem {
+
+/// The padded raster (W = nx + 2 by H = ny + 2, one ghost cell around the DEM; see
+/// kernels/common/compat.h) of a run's initial state, in double. Backends round it to their
+/// precision once, so every backend starts from the same numbers.
+struct PaddedState {
+  int nx = 0, ny = 0, W = 0, H = 0;
+  std::vector<std::uint8_t> kind;    ///< ERODEM_CELL_* of every padded cell
+  std::vector<double> dx, dy, area;  ///< per padded row (m, m, m^2); halo rows repeat
+  std::vector<double> bed, depth;    ///< m; ghosts as the boundary kinds set them
+  std::vector<double> manning, hardness, rain_factor;  ///< rasters or the scalar parameter
+  std::size_t at(int x, int y) const {
+    return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
+  }
+  std::size_t size() const { return static_cast<std::size_t>(W) * static_cast<std::size_t>(H); }
+};
+
+/// Cell kinds from the mask and the boundary parameters (halo by each edge's kind, nodata as
+/// wall or sea), bed and initial water (computed in double: initial.water_level - bed, a
+/// raster, or a uniform depth), sea ghosts over the lowest active neighbour, and the
+/// parameter rasters with their halo. Throws erodem::Error(data) on rasters of the wrong size.
+PaddedState build_padded_state(const Terrain& terrain, const Params& params);
+
+}  // namespace erodem

@@ -1,0 +1,130 @@
+#include "erodem/initial_state.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "common/compat.h"
+#include "erodem/error.hpp"
+
+namespace erodem {
+
+namespace {
+
+std::uint8_t edge_kind(BoundaryKind b) {
+  switch (b) {
+    case BoundaryKind::open:
+      return ERODEM_CELL_OPEN;
+    case BoundaryKind::fixed_level:
+      return ERODEM_CELL_FIXED;
+    case BoundaryKind::closed:
+      break;
+  }
+  return ERODEM_CELL_WALL;
+}
+
+}  // namespace
+
+PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
+  const auto& g = terrain.grid;
+  g.validate();
+  const std::size_t cells = g.cells();
+  auto check_size = [&](const std::vector<double>& v, const char* what) {
+    if (!v.empty() && v.size() != cells)
+      throw Error(ExitCode::data,
+                  fmt::format("{}: {} values for a grid of {} x {}", what, v.size(), g.nx, g.ny));
+  };
+  if (terrain.bed.size() != cells) throw Error(ExitCode::data, "bed: missing");
+  check_size(terrain.water_depth, "initial water depth");
+  check_size(terrain.manning_n, "flow.manning_n");
+  check_size(terrain.hardness, "erosion.hardness");
+  check_size(terrain.rain_factor, "rain.raster");
+
+  PaddedState s;
+  s.nx = g.nx;
+  s.ny = g.ny;
+  s.W = g.nx + 2;
+  s.H = g.ny + 2;
+  const int nx = s.nx, ny = s.ny, W = s.W, H = s.H;
+  const std::size_t n = s.size();
+
+  // Geometry per padded row; halo rows repeat their neighbours.
+  s.dx.resize(H);
+  s.dy.resize(H);
+  s.area.resize(H);
+  for (int y = 0; y < H; ++y) {
+    const int r = std::clamp(y - 1, 0, ny - 1);
+    s.dx[y] = g.dx[r];
+    s.dy[y] = g.dy[r];
+    s.area[y] = g.area[r];
+  }
+
+  // Cell kinds: DEM cells active or nodata (wall or sea); halo by the edge's boundary kind.
+  s.kind.assign(n, ERODEM_CELL_WALL);
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx + c;
+      s.kind[s.at(c + 1, r + 1)] = terrain.active(i)                           ? ERODEM_CELL_ACTIVE
+                                   : params.boundary.nodata == NodataKind::sea ? ERODEM_CELL_FIXED
+                                                                               : ERODEM_CELL_WALL;
+    }
+  for (int y = 1; y <= ny; ++y) {
+    if (s.kind[s.at(1, y)] == ERODEM_CELL_ACTIVE)
+      s.kind[s.at(0, y)] = edge_kind(params.boundary.west);
+    if (s.kind[s.at(nx, y)] == ERODEM_CELL_ACTIVE)
+      s.kind[s.at(nx + 1, y)] = edge_kind(params.boundary.east);
+  }
+  for (int x = 1; x <= nx; ++x) {
+    if (s.kind[s.at(x, 1)] == ERODEM_CELL_ACTIVE)
+      s.kind[s.at(x, 0)] = edge_kind(params.boundary.north);
+    if (s.kind[s.at(x, ny)] == ERODEM_CELL_ACTIVE)
+      s.kind[s.at(x, ny + 1)] = edge_kind(params.boundary.south);
+  }
+
+  // Bed and initial water (computed in double; backends round once).
+  s.bed.assign(n, 0.0);
+  s.depth.assign(n, 0.0);
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx + c;
+      const auto p = s.at(c + 1, r + 1);
+      if (s.kind[p] != ERODEM_CELL_ACTIVE) continue;
+      s.bed[p] = terrain.bed[i];
+      if (!terrain.water_depth.empty())
+        s.depth[p] = terrain.water_depth[i];
+      else if (params.initial.water_level)
+        s.depth[p] = std::max(0.0, *params.initial.water_level - s.bed[p]);
+      else
+        s.depth[p] = params.initial.water_depth.value;
+    }
+  // Nodata cells: sea ghosts hold the sea over a bed no higher than their active neighbours.
+  const double sea = params.boundary.sea_level;
+  for (int y = 1; y <= ny; ++y)
+    for (int x = 1; x <= nx; ++x) {
+      const auto p = s.at(x, y);
+      if (s.kind[p] == ERODEM_CELL_ACTIVE) continue;
+      double low = sea;
+      for (auto q : {p - 1, p + 1, p - W, p + W})
+        if (s.kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, s.bed[q]);
+      s.bed[p] = s.kind[p] == ERODEM_CELL_FIXED ? low : 0.0;
+      s.depth[p] = s.kind[p] == ERODEM_CELL_FIXED ? sea - low : 0.0;
+    }
+
+  // Rasters or scalars; halo cells copy the nearest DEM cell (Manning n is read at faces).
+  auto raster_or = [&](const std::vector<double>& raster, double scalar) {
+    std::vector<double> out(n, scalar);
+    if (raster.empty()) return out;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const int r = std::clamp(y - 1, 0, ny - 1), c = std::clamp(x - 1, 0, nx - 1);
+        out[s.at(x, y)] = raster[static_cast<std::size_t>(r) * nx + c];
+      }
+    return out;
+  };
+  s.manning = raster_or(terrain.manning_n, params.flow.manning_n.value);
+  s.hardness = raster_or(terrain.hardness, params.erosion.hardness.value);
+  s.rain_factor = raster_or(terrain.rain_factor, 1.0);
+  return s;
+}
+
+}  // namespace erodem
