@@ -6,6 +6,8 @@
 #include <functional>
 #include <string>
 
+#include "erodem/io/paths.hpp"
+
 namespace erodem::cli {
 
 /// Registers a subcommand on `app` and returns the action to run when it is chosen.
@@ -21,8 +23,7 @@ Action add_export(CLI::App& app);
 /// Whether stderr is a terminal (progress bar) or a log (periodic lines).
 bool stderr_is_terminal();
 
-/// Fails with ExitCode::cant_create unless `path` can be created: its folder exists and is
-/// writable, and (without `overwrite`) no file of that name exists yet.
-void check_output_path(const std::string& path, bool overwrite);
+/// Output paths are checked by io::check_output_path (erodem/io/paths.hpp).
+using io::check_output_path;
 
 }  // namespace erodem::cli

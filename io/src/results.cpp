@@ -23,6 +23,7 @@
 
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
+#include "erodem/io/paths.hpp"
 #include "erodem/schema.hpp"
 
 #ifndef ERODEM_VERSION
@@ -505,19 +506,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
                            const Provenance& prov, bool overwrite)
     : path_(path), partial_(partial_path(path)), overwrite_(overwrite) {
   QuietH5 quiet;
-  // The output can be created: folder exists and is writable, no file in the way.
-  const fs::path p(path);
-  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error(ExitCode::cant_create,
-                path + ": cannot create output: folder '" + dir.string() + "' does not exist");
-  if (access(dir.c_str(), W_OK) != 0)
-    throw Error(ExitCode::cant_create, path + ": cannot create output: folder '" + dir.string() +
-                                           "' is not writable (" + std::strerror(errno) + ")");
-  if (!overwrite && fs::exists(p, ec))
-    throw Error(ExitCode::cant_create,
-                path + ": exists; not overwritten (give --overwrite to replace it)");
+  check_output_path(path, overwrite);  // folder exists and is writable, no file in the way
   if (grid.nx <= 0 || grid.ny <= 0)
     throw Error(ExitCode::internal, path + ": result file for an empty grid");
 
