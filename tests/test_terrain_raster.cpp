@@ -605,3 +605,32 @@ TEST(Raster, NodataValueMasksTheSea) {
   EXPECT_EQ(masked, 39421u);  // the cells stored as 0
   EXPECT_GT(lowest, 0.0);
 }
+
+// dem.resample: block averages over the valid cells only; an all-nodata block stays nodata;
+// parameter rasters average over the same cells; cell size and transform scale.
+TEST(Raster, CoarsenAveragesValidCells) {
+  erodem::Terrain fine;
+  fine.grid = erodem::Grid::uniform(4, 4, 10.0);
+  fine.bed = {1, 2, 10, 10,  //
+              3, 4, 10, 10,  //
+              5, 5, 0,  0,   //
+              5, 5, 0,  0};
+  fine.mask.assign(16, 1);
+  fine.mask[0] = 0;                                             // 1 m cell is nodata
+  for (std::size_t k : {10u, 11u, 14u, 15u}) fine.mask[k] = 0;  // whole block nodata
+  fine.manning_n.assign(16, 0.02);
+  fine.manning_n[1] = 0.05;
+  const auto c = erodem::io::coarsen(fine, 2);
+  std::printf("  coarsened beds: %.4f %.4f %.4f %s\n", c.bed[0], c.bed[1], c.bed[2],
+              c.active(3) ? "active" : "nodata");
+  ASSERT_EQ(c.grid.nx, 2);
+  ASSERT_EQ(c.grid.ny, 2);
+  EXPECT_DOUBLE_EQ(c.bed[0], 3.0);  // (2 + 3 + 4) / 3: the nodata cell is left out
+  EXPECT_DOUBLE_EQ(c.bed[1], 10.0);
+  EXPECT_DOUBLE_EQ(c.bed[2], 5.0);
+  EXPECT_FALSE(c.active(3));
+  EXPECT_DOUBLE_EQ(c.manning_n[0], (0.05 + 0.02 + 0.02) / 3);
+  EXPECT_DOUBLE_EQ(c.grid.dx[0], 20.0);
+  EXPECT_DOUBLE_EQ(c.grid.area[0], 400.0);
+  EXPECT_DOUBLE_EQ(c.grid.georef.transform[1], 20.0);
+}

@@ -546,48 +546,44 @@ Terrain coarsen(const Terrain& fine, int factor) {
     set_geographic_grid(c, static_cast<OGRSpatialReferenceH>(srs.get()), c.georef.transform,
                         t.source);
   }
-  // Block averages over the valid cells; a block with none stays nodata.
+  // Block averages over the valid cells; a block with none stays nodata. One helper serves
+  // the bed and every parameter raster, so they average over the same cells.
+  auto block_mean = [&](const std::vector<double>& v, int r, int col, double& mean) {
+    double sum = 0;
+    int n = 0;
+    for (int i = 0; i < factor; ++i)
+      for (int j = 0; j < factor; ++j) {
+        const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
+        if (!fine.active(k)) continue;
+        sum += v[k];
+        ++n;
+      }
+    mean = n > 0 ? sum / n : 0.0;
+    return n > 0;
+  };
   t.bed.assign(c.cells(), std::nan(""));
   std::vector<std::uint8_t> mask(c.cells(), 0);
   bool any_masked = false;
   for (int r = 0; r < ny; ++r)
     for (int col = 0; col < nx; ++col) {
-      double sum = 0;
-      int n = 0;
-      for (int i = 0; i < factor; ++i)
-        for (int j = 0; j < factor; ++j) {
-          const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
-          if (!fine.active(k)) continue;
-          sum += fine.bed[k];
-          ++n;
-        }
       const auto o = static_cast<std::size_t>(r) * nx + col;
-      if (n > 0) {
-        t.bed[o] = sum / n;
+      double mean = 0;
+      if (block_mean(fine.bed, r, col, mean)) {
+        t.bed[o] = mean;
         mask[o] = 1;
       } else {
         any_masked = true;
       }
     }
   if (any_masked) t.mask = std::move(mask);
-  // Parameter rasters on the fine grid are averaged over the same blocks.
+  // Parameter rasters on the fine grid (0 where a block has no valid cell).
   auto average = [&](const std::vector<double>& v) {
     std::vector<double> out;
     if (v.empty()) return out;
     out.assign(c.cells(), 0.0);
     for (int r = 0; r < ny; ++r)
-      for (int col = 0; col < nx; ++col) {
-        double sum = 0;
-        int n = 0;
-        for (int i = 0; i < factor; ++i)
-          for (int j = 0; j < factor; ++j) {
-            const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
-            if (!fine.active(k)) continue;
-            sum += v[k];
-            ++n;
-          }
-        out[static_cast<std::size_t>(r) * nx + col] = n > 0 ? sum / n : 0.0;
-      }
+      for (int col = 0; col < nx; ++col)
+        block_mean(v, r, col, out[static_cast<std::size_t>(r) * nx + col]);
     return out;
   };
   t.water_depth = average(fine.water_depth);
