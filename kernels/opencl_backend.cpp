@@ -911,6 +911,8 @@ Buffer* OpenClBackend::field_buffer(FieldId id) {
       return &wetness_;
     case FieldId::manning_n:
       return &manning_;
+    case FieldId::initial_bed:
+      return &bed0_;
     case FieldId::erosion:
       return nullptr;
   }

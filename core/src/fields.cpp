@@ -19,6 +19,7 @@ const std::vector<FieldInfo>& field_table() {
       {FieldId::wetness, "wetness", "m", "running mean of water depth"},
       {FieldId::erosion, "erosion", "m", "cumulative net erosion (negative: deposition)"},
       {FieldId::manning_n, "manning_n", "s m-1/3", "Manning roughness coefficient"},
+      {FieldId::initial_bed, "initial_bed", "m", "bed elevation at the start of the run"},
   };
   return table;
 }

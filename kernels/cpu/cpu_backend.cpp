@@ -183,6 +183,8 @@ std::vector<Real>* CpuBackend<Real>::field_storage(FieldId id) {
       return &wetness_;
     case FieldId::manning_n:
       return &manning_;
+    case FieldId::initial_bed:
+      return &bed0_;
     case FieldId::erosion:
       return nullptr;
   }

@@ -20,6 +20,7 @@ enum class FieldId {
   wetness,
   erosion,  ///< derived: initial bed - bed (m); negative = deposition
   manning_n,
+  initial_bed,  ///< bed at the start of the run (m); erosion = initial_bed - bed
 };
 
 struct FieldInfo {
