@@ -227,6 +227,13 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
     }
 }
 
+template <class Real>
+HostView CpuBackend<Real>::host_view(FieldId id) {
+  std::vector<Real>* src = field_storage(id);
+  if (!src) return {};
+  return {src->data() + at(1, 1), sizeof(Real), static_cast<std::ptrdiff_t>(W_)};
+}
+
 template class CpuBackend<float>;
 template class CpuBackend<double>;
 

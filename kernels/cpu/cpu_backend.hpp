@@ -26,6 +26,7 @@ class CpuBackend final : public Backend {
   FieldStats stats() override;
   std::vector<double> field(FieldId id) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
+  HostView host_view(FieldId id) override;
 
   // One function per process, each in kernels/cpu/<process>.cpp.
   void run_boundary();

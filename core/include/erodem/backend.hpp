@@ -3,6 +3,7 @@
 // time, so each process can be timed, switched off or compared on its own.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -59,6 +60,16 @@ struct FieldStats {
   std::int64_t bad_cell = -1;  ///< first cell with NaN, infinite or negative state; -1: none
 };
 
+/// Where a backend keeps a field of the DEM grid in host memory (the CPU reference does):
+/// DEM cell (row r, col c) is the element at `data + (r * row_stride + c) * element_size`
+/// bytes. `data` is null where the field is not host-resident (OpenCL) or derived (erosion).
+/// Valid until the next run() or set_field(): processes write into a second buffer and swap.
+struct HostView {
+  void* data = nullptr;
+  std::size_t element_size = 0;   ///< bytes: 4 (float32) or 8 (float64)
+  std::ptrdiff_t row_stride = 0;  ///< elements between the starts of two rows
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -78,6 +89,8 @@ class Backend {
   virtual std::vector<double> field(FieldId id) const = 0;
   /// Replaces a field of the DEM grid (row-major (ny, nx)).
   virtual void set_field(FieldId id, const std::vector<double>& values) = 0;
+  /// The field in host memory, to read or write in place; empty where it is not there.
+  virtual HostView host_view(FieldId) { return {}; }
 };
 
 }  // namespace erodem
