@@ -834,6 +834,8 @@ const std::vector<Descriptor>& descriptor_table() {
                 "fields written in each snapshot"),
       points(ERODEM_FIELD(output.gauges),
              "gauge points [[x, y], ...] in the DEM's CRS: depth, level and speed every step"),
+      boolean(ERODEM_FIELD(output.restart_state),
+              "store the full state at each snapshot, so a run can restart from it"),
 
       choice(ERODEM_FIELD(numerics.precision),
              Choices<Precision>{{"float32", Precision::float32}, {"float64", Precision::float64}},

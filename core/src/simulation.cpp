@@ -44,6 +44,53 @@ double series_value(const Series& s, double t) {
   return lo->value + w * (hi->value - lo->value);
 }
 
+const std::vector<FieldId>& state_fields() {
+  static const std::vector<FieldId> ids{
+      FieldId::bed,        FieldId::initial_bed, FieldId::water_depth, FieldId::sediment,
+      FieldId::velocity_x, FieldId::velocity_y,  FieldId::flux_left,   FieldId::flux_right,
+      FieldId::flux_top,   FieldId::flux_bottom, FieldId::wetness};
+  return ids;
+}
+
+RestartPoint Simulation::restart_point() const {
+  RestartPoint p;
+  p.time = time_;
+  p.steps = steps_;
+  p.ledger = ledger_;
+  for (FieldId id : state_fields()) p.fields.push_back(backend_->field(id));
+  return p;
+}
+
+void Simulation::restore(const RestartPoint& point) {
+  const auto& ids = state_fields();
+  if (point.fields.size() != ids.size())
+    throw Error(ExitCode::data, fmt::format("restart state: {} fields, expected {}",
+                                            point.fields.size(), ids.size()));
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (point.fields[k].size() != terrain_.grid.cells())
+      throw Error(ExitCode::data,
+                  fmt::format("restart state: field '{}' has {} values for a grid of {} x {}",
+                              field_info(ids[k]).name, point.fields[k].size(), terrain_.grid.nx,
+                              terrain_.grid.ny));
+    backend_->set_field(ids[k], point.fields[k]);
+  }
+  time_ = point.time;
+  steps_ = point.steps;
+  ledger_ = point.ledger;
+  stats_ = backend_->stats();
+  diag_ = Diagnostics{time_,
+                      0.0,
+                      stats_.water_volume,
+                      stats_.material_volume,
+                      ledger_.rain,
+                      ledger_.inflow,
+                      ledger_.boundary_out,
+                      ledger_.evaporated,
+                      ledger_.closure_error(),
+                      stats_.max_depth,
+                      stats_.max_speed};
+}
+
 Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> backend)
     : terrain_(std::move(terrain)), params_(std::move(params)), backend_(std::move(backend)) {
   if (!backend_) throw Error(ExitCode::internal, "simulation: no backend");

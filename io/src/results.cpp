@@ -294,6 +294,29 @@ const std::array<DiagSeries, 11>& diag_series() {
 
 constexpr const char* kGaugeSeries[] = {"water_depth", "water_level", "speed"};
 
+/// One ledger entry of `restart/`, one value per snapshot.
+struct LedgerEntry {
+  const char* name;
+  double Ledger::*member;
+};
+
+const std::array<LedgerEntry, 11>& ledger_entries() {
+  static const std::array<LedgerEntry, 11> table{{
+      {"ledger_water_initial", &Ledger::water_initial},
+      {"ledger_water", &Ledger::water},
+      {"ledger_rain", &Ledger::rain},
+      {"ledger_inflow", &Ledger::inflow},
+      {"ledger_boundary_out", &Ledger::boundary_out},
+      {"ledger_evaporated", &Ledger::evaporated},
+      {"ledger_clipped", &Ledger::clipped},
+      {"ledger_material_initial", &Ledger::material_initial},
+      {"ledger_material", &Ledger::material},
+      {"ledger_sediment_out", &Ledger::sediment_out},
+      {"ledger_transport_change", &Ledger::transport_change},
+  }};
+  return table;
+}
+
 std::string iso_utc_now() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -410,8 +433,14 @@ struct ResultWriter::Impl {
   std::vector<double> pending_gauge_time;
   std::array<std::vector<double>, 3> pending_gauge;  // [series][row * n + gauge]
   std::vector<std::int64_t> pending_gauge_steps;
-  bool bed_changes = true;  // erosion or thermal on: the bed is read at every gauge sample
-  std::vector<double> bed;  // the bed, when it does not change
+  // restart/: the full state at every snapshot (output.restart_state)
+  bool restart = false;
+  bool restart_f64 = false;          // float64 runs keep their state in float64
+  std::vector<H5Id> restart_fields;  // state_fields(), in order
+  H5Id restart_steps;
+  std::vector<H5Id> restart_ledger;  // ledger_entries(), in order
+  bool bed_changes = true;           // erosion or thermal on: the bed is read at every gauge sample
+  std::vector<double> bed;           // the bed, when it does not change
 
   H5Id create_group(const char* name) {
     H5Id gcpl = checked(H5Pcreate(H5P_GROUP_CREATE), partial, "group properties");
@@ -490,6 +519,9 @@ struct ResultWriter::Impl {
     for (auto& f : fields) f.second.reset();
     for (auto& d : diag) d.reset();
     for (auto& g : gauge) g.reset();
+    for (auto& d : restart_fields) d.reset();
+    for (auto& d : restart_ledger) d.reset();
+    restart_steps.reset();
     diag_step.reset();
     gauge_step.reset();
     gauge_time.reset();
@@ -516,6 +548,8 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   m.grid = grid;
   m.output = params.output;
   m.bed_changes = params.erosion.enabled || params.thermal.enabled;
+  m.restart = params.output.restart_state;
+  m.restart_f64 = params.numerics.precision == Precision::float64;
   for (const auto& name : m.output.fields) m.fields.emplace_back(field_info(name), H5Id());
   // Gauges must lie on the grid.
   for (std::size_t i = 0; i < m.output.gauges.size(); ++i) {
@@ -557,6 +591,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
       {"dem_sha256", prov.dem_sha256},
   };
   for (const auto& [name, value] : root_attrs) put_text(m.file, name, value, partial_);
+  if (!prov.restart_from.empty()) put_text(m.file, "restart_from", prov.restart_from, partial_);
 
   // Dimensions and coordinates: time (unlimited), y, x.
   const auto& geo = grid.georef;
@@ -653,6 +688,42 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
       m.diag.push_back(m.series(group, s.name, m.diag_step, -1, 0, s.units, s.long_name));
   }
 
+  // restart/: every state field in the precision of the run (so a restart is exact), the
+  // step count and the ledger, at every snapshot.
+  if (m.restart) {
+    H5Id group = m.create_group("restart");
+    put_text(group, "comment",
+             "the full state at each snapshot time, for erodem run --restart FILE:TIME; not "
+             "masked: inactive cells hold their internal values",
+             partial_);
+    const hid_t type = m.restart_f64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE;
+    for (FieldId id : state_fields()) {
+      const auto& info = field_info(id);
+      H5Id ds = create_dataset(group, info.name, type, {0, ny, nx}, {H5S_UNLIMITED, ny, nx},
+                               {1, std::min<hsize_t>(ny, 512), std::min<hsize_t>(nx, 512)}, true,
+                               nullptr, partial_);
+      checked(H5DSattach_scale(ds, m.time, 0), partial_, std::string("restart/") + info.name);
+      checked(H5DSattach_scale(ds, y, 1), partial_, std::string("restart/") + info.name);
+      checked(H5DSattach_scale(ds, x, 2), partial_, std::string("restart/") + info.name);
+      put_text(ds, "units", info.units, partial_);
+      put_text(ds, "long_name", info.long_name, partial_);
+      m.restart_fields.push_back(std::move(ds));
+    }
+    auto per_snapshot = [&](const char* name, hid_t t, const char* unit,
+                            const std::string& long_name) {
+      H5Id ds =
+          create_dataset(group, name, t, {0}, {H5S_UNLIMITED}, {512}, false, nullptr, partial_);
+      checked(H5DSattach_scale(ds, m.time, 0), partial_, std::string("restart/") + name);
+      put_text(ds, "units", unit, partial_);
+      put_text(ds, "long_name", long_name, partial_);
+      return ds;
+    };
+    m.restart_steps = per_snapshot("steps", H5T_STD_I64LE, "1", "steps done");
+    for (const auto& e : ledger_entries())
+      m.restart_ledger.push_back(
+          per_snapshot(e.name, H5T_IEEE_F64LE, "m3", std::string("ledger entry ") + (e.name + 7)));
+  }
+
   // gauges/: one row per step, one column per gauge.
   if (!m.gauge_cells.empty()) {
     H5Id group = m.create_group("gauges");
@@ -718,6 +789,28 @@ void ResultWriter::snapshot(const Simulation& sim) {
       f32[i] = terrain.active(i) ? static_cast<float>(values[i]) : std::nanf("");
     append_rows(ds, H5T_NATIVE_FLOAT, 1, f32.data(), partial_, info.name);
   }
+  if (m.restart) {
+    const RestartPoint point = sim.restart_point();
+    std::vector<float> state32(m.restart_f64 ? 0 : g.cells());
+    for (std::size_t k = 0; k < point.fields.size(); ++k) {
+      const auto& v = point.fields[k];
+      const std::string name = std::string("restart/") + field_info(state_fields()[k]).name;
+      if (m.restart_f64) {
+        append_rows(m.restart_fields[k], H5T_NATIVE_DOUBLE, 1, v.data(), partial_, name);
+      } else {
+        for (std::size_t i = 0; i < v.size(); ++i) state32[i] = static_cast<float>(v[i]);
+        append_rows(m.restart_fields[k], H5T_NATIVE_FLOAT, 1, state32.data(), partial_, name);
+      }
+    }
+    const std::int64_t steps = point.steps;
+    append_rows(m.restart_steps, H5T_NATIVE_INT64, 1, &steps, partial_, "restart/steps");
+    for (std::size_t k = 0; k < ledger_entries().size(); ++k) {
+      const double v = point.ledger.*ledger_entries()[k].member;
+      append_rows(m.restart_ledger[k], H5T_NATIVE_DOUBLE, 1, &v, partial_,
+                  std::string("restart/") + ledger_entries()[k].name);
+    }
+  }
+  // The time last: a file cut short mid-snapshot lists only the complete snapshots.
   const double t = sim.time();
   append_rows(m.time, H5T_NATIVE_DOUBLE, 1, &t, partial_, "time");
   times_.push_back(t);
@@ -992,6 +1085,49 @@ std::vector<float> ResultReader::read_index(const std::string& name, std::size_t
   if (H5Dread(ds, H5T_NATIVE_FLOAT, mem, space, H5P_DEFAULT, values.data()) < 0)
     throw Error(ExitCode::io, path_ + ": reading " + name + " failed" + h5_reason());
   return values;
+}
+
+bool ResultReader::has_restart_state() const {
+  QuietH5 quiet;
+  return exists(file_, "restart/steps");
+}
+
+RestartPoint ResultReader::restart_point(std::size_t index) const {
+  QuietH5 quiet;
+  if (!has_restart_state())
+    throw Error(ExitCode::data, path_ +
+                                    ": holds no restart state (it was written with "
+                                    "output.restart_state = false, or by an older erodem)");
+  const auto steps = read_doubles(file_, "restart/steps", path_);
+  if (index >= times_.size() || index >= steps.size())
+    throw Error(ExitCode::usage,
+                fmt::format("{}: no restart state at snapshot {} (the file holds {})", path_, index,
+                            std::min(times_.size(), steps.size())));
+  RestartPoint p;
+  p.time = times_[index];
+  p.steps = static_cast<long>(steps[index]);
+  for (const auto& e : ledger_entries())
+    p.ledger.*e.member = read_doubles(file_, std::string("restart/") + e.name, path_).at(index);
+  for (FieldId id : state_fields()) {
+    const std::string name = std::string("restart/") + field_info(id).name;
+    H5Id ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
+    if (!ds.valid()) not_ours(path_, "no dataset " + name);
+    H5Id space(H5Dget_space(ds));
+    std::array<hsize_t, 3> dims{};
+    if (H5Sget_simple_extent_ndims(space) != 3) not_ours(path_, name + " is not (time, y, x)");
+    H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+    if (dims[1] != static_cast<hsize_t>(grid_.ny) || dims[2] != static_cast<hsize_t>(grid_.nx) ||
+        dims[0] <= index)
+      not_ours(path_, name + " does not match the grid and the snapshots");
+    const std::array<hsize_t, 3> start{index, 0, 0}, count{1, dims[1], dims[2]};
+    H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+    H5Id mem(H5Screate_simple(3, count.data(), nullptr));
+    std::vector<double> values(grid_.cells());
+    if (H5Dread(ds, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, values.data()) < 0)
+      throw Error(ExitCode::io, path_ + ": reading " + name + " failed" + h5_reason());
+    p.fields.push_back(std::move(values));
+  }
+  return p;
 }
 
 std::vector<Diagnostics> ResultReader::diagnostics() const {

@@ -126,6 +126,7 @@ struct Params {
     std::vector<std::string> fields{"bed",        "water_depth", "sediment",
                                     "velocity_x", "velocity_y",  "erosion"};
     std::vector<std::array<double, 2>> gauges;  ///< x, y in the DEM's CRS
+    bool restart_state = true;  ///< store the full state at each snapshot (restartable)
   } output;
 
   struct Numerics {

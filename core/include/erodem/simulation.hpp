@@ -28,6 +28,21 @@ struct Diagnostics {
   double max_depth = 0.0, max_speed = 0.0;
 };
 
+/// The state of a run between two steps: with the same terrain and parameters, a run
+/// restored from it continues exactly as the uninterrupted run would (same backend and
+/// precision: bit for bit).
+struct RestartPoint {
+  double time = 0.0;  ///< s since the start of the run
+  long steps = 0;     ///< steps done
+  Ledger ledger;
+  /// Values of state_fields(), in that order, each row-major (ny, nx).
+  std::vector<std::vector<double>> fields;
+};
+
+/// The fields a backend keeps from one step to the next (everything else is derived from
+/// the terrain and the parameters, or recomputed within a step).
+const std::vector<FieldId>& state_fields();
+
 class Simulation {
  public:
   /// Takes the host inputs, the validated parameters and the backend that holds the state
@@ -44,6 +59,13 @@ class Simulation {
   bool finished() const;
   /// Runs to the configured end; `on_step` (optional) is called after every step.
   void run(const std::function<void(const Simulation&)>& on_step = {});
+
+  /// The state now, to continue from later (copies every state field from the backend).
+  RestartPoint restart_point() const;
+  /// Continues from `point` (taken from a run with this terrain and these parameters):
+  /// sets the backend's state fields, the time, the step count and the ledger. Throws
+  /// Error(ExitCode::data) when the point does not fit the grid.
+  void restore(const RestartPoint& point);
 
   /// The time step the next step will take (s).
   double next_dt() const;

@@ -28,8 +28,9 @@ struct Provenance {
   std::string config_toml;  ///< the fully resolved config (dump_toml)
   std::string backend;
   std::string device;
-  std::string dem_path;    ///< DEM file, or the generator description
-  std::string dem_sha256;  ///< SHA-256 of the DEM file ("" for synthetic terrain)
+  std::string dem_path;      ///< DEM file, or the generator description
+  std::string dem_sha256;    ///< SHA-256 of the DEM file ("" for synthetic terrain)
+  std::string restart_from;  ///< "FILE:TIME" a restarted run continued from ("" otherwise)
 
   /// Everything but `command_line` from a simulation (config from its params).
   static Provenance of(const Simulation& sim, const std::string& command_line);
@@ -137,6 +138,12 @@ class ResultReader {
   const Grid& grid() const { return grid_; }
   /// The per-step diagnostics.
   std::vector<Diagnostics> diagnostics() const;
+  /// Whether the file holds the full state at its snapshots (output.restart_state).
+  bool has_restart_state() const;
+  /// The full state at snapshot `index`, to continue the run from (Simulation::restore).
+  /// No restart state -> Error(ExitCode::data) saying how to get one; index out of range
+  /// -> Error(ExitCode::usage).
+  RestartPoint restart_point(std::size_t index) const;
   /// Gauge series (empty when the run had none).
   GaugeSeries gauges() const;
   /// Root attributes (text), e.g. "config_toml", "erodem_version", "created".

@@ -1,0 +1,273 @@
+// erodem — restart: a run continued from any stored time of its result file reproduces the
+// uninterrupted run bit for bit (same backend and precision), and bad restarts are clear
+// errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cli_runner.hpp"
+#include "erodem/backends.hpp"
+#include "erodem/io/results.hpp"
+#include "erodem/simulation.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using erodem::test::run_cli;
+
+/// Local inertial flow, conservative transport, thermal collapse, an open and a fixed-level
+/// edge, a rain series and adaptive steps: every state field changes.
+const char* kInertial = R"([dem]
+synthetic = "valley"
+size = 48
+seed = 3
+relief = "40 m"
+cell_size = "10 m"
+[initial]
+water_depth = 0.05
+[time]
+duration = "8 min"
+adaptive = true
+cfl = 0.7
+dt_max = "2 s"
+[flow]
+scheme = "local_inertial"
+manning_n = 0.035
+[rain]
+series = [[0, "80 mm/h"], [200, "20 mm/h"]]
+[erosion]
+enabled = true
+sediment_capacity = 0.2
+dissolving_rate = 0.01
+deposition_rate = 0.05
+[thermal]
+enabled = true
+talus_angle = 30.0
+rate = 0.05
+[evaporation]
+rate = 1e-6
+[boundary]
+east = "open"
+west = "fixed_level"
+sea_level = 1.0
+[output]
+path = "full.h5"
+interval = "2 min"
+fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness"]
+)";
+
+/// Pipes, semi-Lagrangian transport, a point inflow hydrograph and fixed steps.
+const char* kPipes = R"([dem]
+synthetic = "hill"
+size = 40
+seed = 5
+relief = "20 m"
+cell_size = "5 m"
+[time]
+steps = 150
+dt = 0.1
+[flow]
+scheme = "pipes"
+[rain]
+rate = "30 mm/h"
+[[inflow]]
+point = [60.0, 140.0]
+hydrograph = [[0, 0.0], [5, 2.0], [15, 0.5]]
+[erosion]
+enabled = true
+sediment_capacity = 0.5
+dissolving_rate = 0.05
+deposition_rate = 0.1
+[transport]
+scheme = "semi_lagrangian"
+[boundary]
+south = "open"
+[output]
+path = "full.h5"
+every = 50
+fields = ["bed", "water_depth", "sediment", "erosion", "flux_left", "flux_top"]
+)";
+
+struct Case {
+  const char* name;
+  const char* config;
+  const char* backend;    // --backend
+  const char* precision;  // numerics.precision
+};
+
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.name << "_" << c.backend << "_" << c.precision;
+}
+
+class Restart : public ::testing::TestWithParam<Case> {
+ protected:
+  void SetUp() override {
+    if (std::string(GetParam().backend) == "opencl" && !erodem::opencl_available())
+      GTEST_SKIP() << "no OpenCL device";
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->name());
+    for (char& ch : name)
+      if (ch == '/') ch = '_';
+    dir_ = fs::temp_directory_path() / ("erodem_restart_" + name);
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(dir_ / "config.toml") << GetParam().config;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string run_args(const std::string& extra) const {
+    return std::string("run config.toml --backend ") + GetParam().backend +
+           " --set numerics.precision=" + GetParam().precision + " " + extra;
+  }
+  fs::path dir_;
+};
+
+/// Exact equality of two float fields, NaN (nodata) equal to NaN; returns the cells that
+/// differ.
+std::size_t differing(const std::vector<float>& a, const std::vector<float>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0) ++n;
+  return n;
+}
+
+std::size_t differing(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(double)) != 0) ++n;
+  return n;
+}
+
+TEST_P(Restart, FromEveryStoredTimeReproducesTheRunBitForBit) {
+  const auto full = run_cli(run_args("--output full.h5"), dir_);
+  ASSERT_EQ(full.code, 0) << full.output;
+  const erodem::io::ResultReader a((dir_ / "full.h5").string());
+  ASSERT_TRUE(a.has_restart_state());
+  const auto times = a.times();
+  ASSERT_GE(times.size(), 4u);
+  const auto diag_a = a.diagnostics();
+  const auto fields = a.fields();
+
+  // From the first snapshot after t = 0 and from the one before the last.
+  for (std::size_t from : {std::size_t{1}, times.size() - 2}) {
+    const std::string out = "restart_" + std::to_string(from) + ".h5";
+    const auto r = run_cli(
+        run_args("--output " + out + " --restart full.h5:" + std::to_string(times[from])), dir_);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(r.output.find("differs"), std::string::npos) << r.output;
+    const erodem::io::ResultReader b((dir_ / out).string());
+    ASSERT_EQ(b.times().size(), times.size() - from);
+    EXPECT_NE(b.attribute("restart_from").find("full.h5:"), std::string::npos);
+    std::size_t cells_compared = 0, cells_differing = 0;
+    for (std::size_t j = 0; j < b.times().size(); ++j) {
+      const std::size_t i = from + j;
+      ASSERT_EQ(b.times()[j], times[i]) << "snapshot " << j;
+      for (const auto& f : fields) {
+        const auto va = a.read_index(f, i), vb = b.read_index(f, j);
+        cells_compared += va.size();
+        cells_differing += differing(va, vb);
+      }
+      const auto pa = a.restart_point(i), pb = b.restart_point(j);
+      EXPECT_EQ(pa.steps, pb.steps);
+      EXPECT_EQ(std::memcmp(&pa.ledger, &pb.ledger, sizeof pa.ledger), 0) << "ledger at " << i;
+      for (std::size_t k = 0; k < pa.fields.size(); ++k) {
+        cells_compared += pa.fields[k].size();
+        cells_differing += differing(pa.fields[k], pb.fields[k]);
+      }
+    }
+    // The diagnostics of every step after the restart.
+    const auto diag_b = b.diagnostics();
+    const auto steps_from = static_cast<std::size_t>(a.restart_point(from).steps);
+    ASSERT_EQ(diag_b.size(), diag_a.size() - steps_from);
+    std::size_t diag_differing = 0;
+    for (std::size_t s = 0; s < diag_b.size(); ++s)
+      if (std::memcmp(&diag_a[steps_from + s], &diag_b[s], sizeof(erodem::Diagnostics)) != 0)
+        ++diag_differing;
+    std::printf(
+        "[restart] %s from t = %.6g s (step %zu): %zu of %zu stored values differ, %zu of "
+        "%zu diagnostics rows differ (bound: 0)\n",
+        ::testing::PrintToString(GetParam()).c_str(), times[from], steps_from, cells_differing,
+        cells_compared, diag_differing, diag_b.size());
+    EXPECT_EQ(cells_differing, 0u);
+    EXPECT_EQ(diag_differing, 0u);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Runs, Restart,
+                         ::testing::Values(Case{"inertial", kInertial, "cpu", "float32"},
+                                           Case{"inertial", kInertial, "cpu", "float64"},
+                                           Case{"inertial", kInertial, "opencl", "float32"},
+                                           Case{"pipes", kPipes, "cpu", "float32"},
+                                           Case{"pipes", kPipes, "opencl", "float32"}),
+                         [](const ::testing::TestParamInfo<Case>& p) {
+                           return std::string(p.param.name) + "_" + p.param.backend + "_" +
+                                  p.param.precision;
+                         });
+
+class RestartErrors : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("erodem_restart_errors_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(dir_ / "config.toml") << kPipes;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(RestartErrors, ClearMessagesAndExitCodes) {
+  ASSERT_EQ(run_cli("run config.toml --backend cpu --set time.steps=20 --set output.every=10 "
+                    "--output a.h5",
+                    dir_)
+                .code,
+            0);
+  // A time the file does not hold: usage error listing the stored times.
+  auto r = run_cli("run config.toml --backend cpu --output b.h5 --restart a.h5:0.55", dir_);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("no snapshot at that time"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("t = 0, 1, 2 s"), std::string::npos) << r.output;
+  // A missing file.
+  r = run_cli("run config.toml --backend cpu --output b.h5 --restart nothere.h5", dir_);
+  EXPECT_EQ(r.code, 66) << r.output;
+  EXPECT_NE(r.output.find("nothere.h5"), std::string::npos) << r.output;
+  // A file without the restart state.
+  ASSERT_EQ(run_cli("run config.toml --backend cpu --set time.steps=20 --set output.every=10 "
+                    "--set output.restart_state=false --output plain.h5",
+                    dir_)
+                .code,
+            0);
+  r = run_cli("run config.toml --backend cpu --output b.h5 --restart plain.h5", dir_);
+  EXPECT_EQ(r.code, 65) << r.output;
+  EXPECT_NE(r.output.find("no restart state"), std::string::npos) << r.output;
+  // Another grid.
+  r = run_cli(
+      "run config.toml --backend cpu --set dem.size=32 --output b.h5 "
+      "--restart a.h5",
+      dir_);
+  EXPECT_EQ(r.code, 65) << r.output;
+  EXPECT_NE(r.output.find("40 x 40"), std::string::npos) << r.output;
+  // A changed parameter is allowed, with a warning naming it; default time = the last one.
+  r = run_cli(
+      "run config.toml --backend cpu --set time.steps=30 --set erosion.dissolving_rate=0.2 "
+      "--output c.h5 --restart a.h5",
+      dir_);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("erosion.dissolving_rate"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("step 20"), std::string::npos) << r.output;
+  // Nothing left behind by the failed runs.
+  EXPECT_FALSE(fs::exists(dir_ / "b.h5"));
+  EXPECT_FALSE(fs::exists(dir_ / ".b.h5.partial"));
+}
+
+}  // namespace
