@@ -17,10 +17,13 @@ void check_output_path(const std::string& path, bool overwrite) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     throw Error(ExitCode::cant_create,
-                path + ": cannot create output: folder '" + dir.string() + "' does not exist");
+                path + ": cannot create output: '" + dir.string() +
+                    (fs::exists(dir, ec) ? "' is not a folder" : "' (folder) does not exist"));
   if (access(dir.c_str(), W_OK) != 0)
     throw Error(ExitCode::cant_create, path + ": cannot create output: folder '" + dir.string() +
                                            "' is not writable (" + std::strerror(errno) + ")");
+  if (fs::is_directory(p, ec))
+    throw Error(ExitCode::cant_create, path + ": cannot create output: it is a folder");
   if (!overwrite && fs::exists(p, ec))
     throw Error(ExitCode::cant_create,
                 path + ": exists; not overwritten (give --overwrite to replace it)");
