@@ -78,17 +78,21 @@ void Simulation::restore(const RestartPoint& point) {
   steps_ = point.steps;
   ledger_ = point.ledger;
   stats_ = backend_->stats();
-  diag_ = Diagnostics{time_,
-                      0.0,
-                      stats_.water_volume,
-                      stats_.material_volume,
-                      ledger_.rain,
-                      ledger_.inflow,
-                      ledger_.boundary_out,
-                      ledger_.evaporated,
-                      ledger_.closure_error(),
-                      stats_.max_depth,
-                      stats_.max_speed};
+  diag_ = diagnostics_now(0.0);
+}
+
+Diagnostics Simulation::diagnostics_now(double dt) const {
+  return Diagnostics{time_,
+                     dt,
+                     stats_.water_volume,
+                     stats_.material_volume,
+                     ledger_.rain,
+                     ledger_.inflow,
+                     ledger_.boundary_out,
+                     ledger_.evaporated,
+                     ledger_.closure_error(),
+                     stats_.max_depth,
+                     stats_.max_speed};
 }
 
 Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> backend)
@@ -272,17 +276,7 @@ void Simulation::step() {
   ledger_.water = stats_.water_volume;
   ledger_.material = stats_.material_volume;
 
-  diag_ = Diagnostics{time_,
-                      dt,
-                      stats_.water_volume,
-                      stats_.material_volume,
-                      ledger_.rain,
-                      ledger_.inflow,
-                      ledger_.boundary_out,
-                      ledger_.evaporated,
-                      ledger_.closure_error(),
-                      stats_.max_depth,
-                      stats_.max_speed};
+  diag_ = diagnostics_now(dt);
   // Check after the books are updated, so a caller catching the error sees this step.
   check_stability(dt);
 }

@@ -98,6 +98,8 @@ class Simulation {
   };
   void resolve_inflows();
   void check_stability(double dt) const;
+  /// The diagnostics row of the current state after a step of `dt` seconds.
+  Diagnostics diagnostics_now(double dt) const;
 
   Terrain terrain_;
   Params params_;
