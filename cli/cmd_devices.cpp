@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -81,82 +80,6 @@ std::vector<ClExtra> query_extras(const std::vector<ClDeviceInfo>& devices) {
   return out;
 }
 
-std::string lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-/// ERODEM_OPENCL_DEVICE matching, as the OpenCL backend does it: "<platform>:<device>",
-/// case-insensitive substrings, the platform part matching the platform's name or vendor;
-/// without ':' the selector names the device.
-bool selector_matches(const ClDeviceInfo& d, const std::string& selector) {
-  const auto colon = selector.find(':');
-  const std::string plat = colon == std::string::npos ? "" : lower(selector.substr(0, colon));
-  const std::string dev = lower(colon == std::string::npos ? selector : selector.substr(colon + 1));
-  const bool plat_ok = plat.empty() || lower(d.platform).find(plat) != std::string::npos ||
-                       lower(d.vendor).find(plat) != std::string::npos;
-  const bool dev_ok = dev.empty() || lower(d.device).find(dev) != std::string::npos;
-  return plat_ok && dev_ok;
-}
-
-bool is_pocl(const ClDeviceInfo& d) {
-  return d.platform.find("Portable Computing Language") != std::string::npos ||
-         d.vendor.find("pocl") != std::string::npos;
-}
-
-/// What `--backend auto` picks (float32 runs; float64 runs always get the CPU reference).
-struct AutoChoice {
-  std::string backend;  ///< "opencl", "cpu", or "" when auto would fail
-  int device = -1;      ///< index into the device list when backend is "opencl"
-  std::string reason;
-};
-
-// NOTE(lead): this repeats the rule of make_backend("auto") (kernels/cpu/cpu_backend.cpp)
-// and of the OpenCL backend's device choice (runtime_for in kernels/opencl_backend.cpp),
-// since backends.hpp has no function returning auto's choice. Move it there as
-// `auto_backend_choice()` and call it from both places.
-AutoChoice auto_choice(const std::vector<ClDeviceInfo>& devices, const std::string& selector) {
-  AutoChoice c;
-  if (devices.empty()) {
-    c.backend = "cpu";
-    c.reason = "no OpenCL device (or the OpenCL backend is not built): the CPU reference";
-    return c;
-  }
-  if (!selector.empty()) {
-    for (std::size_t k = 0; k < devices.size(); ++k)
-      if (selector_matches(devices[k], selector)) {
-        c.backend = "opencl";
-        c.device = static_cast<int>(k);
-        c.reason = fmt::format("ERODEM_OPENCL_DEVICE='{}' selects it", selector);
-        return c;
-      }
-    c.reason = fmt::format(
-        "ERODEM_OPENCL_DEVICE='{}' matches no device: auto (and --backend opencl) fail "
-        "with exit 2",
-        selector);
-    return c;
-  }
-  const auto gpu =
-      std::find_if(devices.begin(), devices.end(), [](const ClDeviceInfo& d) { return d.gpu(); });
-  if (gpu != devices.end()) {
-    c.backend = "opencl";
-    c.device = static_cast<int>(gpu - devices.begin());
-    c.reason = "the first OpenCL GPU";
-    return c;
-  }
-  if (std::any_of(devices.begin(), devices.end(), is_pocl)) {
-    c.backend = "opencl";
-    c.device = 0;
-    c.reason = is_pocl(devices.front())
-                   ? "no OpenCL GPU; OpenCL on the CPU through PoCL"
-                   : "no OpenCL GPU; a PoCL platform is present, so OpenCL on the first device";
-    return c;
-  }
-  c.backend = "cpu";
-  c.reason = "no OpenCL GPU and no PoCL: the CPU reference";
-  return c;
-}
-
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
   for (std::string line; std::getline(in, line);)
@@ -188,7 +111,7 @@ int devices(const DevicesOptions& o) {
   const auto extras = query_extras(list);
   const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
   const std::string selector = env ? env : "";
-  const AutoChoice choice = auto_choice(list, selector);
+  const BackendChoice choice = auto_backend_choice(list, selector);
   const std::string cpu = cpu_model();
   const int threads = cpu_threads();
 #ifdef ERODEM_HAVE_OPENCL

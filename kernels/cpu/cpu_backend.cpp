@@ -243,29 +243,4 @@ std::unique_ptr<Backend> make_cpu_backend(const Terrain& terrain, const Params& 
   return std::make_unique<CpuBackend<float>>(terrain, params);
 }
 
-std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& terrain,
-                                      const Params& params) {
-  if (name == "cpu") return make_cpu_backend(terrain, params);
-  if (name == "opencl") return make_opencl_backend(terrain, params);
-  if (name == "auto") {
-    // A GPU OpenCL device, else OpenCL on PoCL, else the CPU reference. The OpenCL backend
-    // runs float32 only; ERODEM_OPENCL_DEVICE, when set, chooses the OpenCL device.
-    if (params.numerics.precision == Precision::float32) {
-      const auto devices = list_opencl_devices();
-      const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
-      const bool any_gpu = std::any_of(devices.begin(), devices.end(),
-                                       [](const ClDeviceInfo& d) { return d.gpu(); });
-      const bool pocl = std::any_of(devices.begin(), devices.end(), [](const ClDeviceInfo& d) {
-        return d.platform.find("Portable Computing Language") != std::string::npos ||
-               d.vendor.find("pocl") != std::string::npos;
-      });
-      if ((env && *env && !devices.empty()) || any_gpu || pocl)
-        return make_opencl_backend(terrain, params);
-    }
-    return make_cpu_backend(terrain, params);
-  }
-  throw Error(ExitCode::usage, "backend '" + name + "': expected auto, cpu or opencl" +
-                                   (opencl_available() ? "" : " (no OpenCL device here)"));
-}
-
 }  // namespace erodem

@@ -41,6 +41,22 @@ std::vector<ClDeviceInfo> list_opencl_devices();
 /// Whether the OpenCL backend is built and at least one device is present.
 bool opencl_available();
 
+/// Whether ERODEM_OPENCL_DEVICE-style `selector` ("<platform>:<device>", case-insensitive
+/// substrings, the platform part matching the platform's name or vendor, either part may be
+/// empty; without ':' it names the device) selects `d`.
+bool opencl_selector_matches(const ClDeviceInfo& d, const std::string& selector);
+
+/// What `--backend auto` runs a float32 run on (float64 runs always get the CPU reference).
+struct BackendChoice {
+  std::string backend;  ///< "opencl", "cpu", or "" when auto fails (a selector matching nothing)
+  int device = -1;      ///< index into the device list when backend is "opencl"
+  std::string reason;   ///< why, in words
+};
+/// The rule of make_backend("auto"): the device `selector` (ERODEM_OPENCL_DEVICE) names, else
+/// the first OpenCL GPU, else OpenCL on PoCL, else the CPU reference.
+BackendChoice auto_backend_choice(const std::vector<ClDeviceInfo>& devices,
+                                  const std::string& selector);
+
 /// The OpenCL backend (float32), on the device chosen by ERODEM_OPENCL_DEVICE
 /// ("<platform substring>:<device substring>", case-insensitive, either part may be empty),
 /// else the first GPU, else the first device. Throws Error(usage) when there is no OpenCL

@@ -1,0 +1,94 @@
+// erodem — which backend `auto` runs on, and building a backend by name. One rule, used by
+// make_backend() and reported by `erodem devices`.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+
+#include "erodem/backends.hpp"
+#include "erodem/error.hpp"
+
+namespace erodem {
+
+namespace {
+
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool is_pocl(const ClDeviceInfo& d) {
+  return d.platform.find("Portable Computing Language") != std::string::npos ||
+         d.vendor.find("pocl") != std::string::npos;
+}
+
+}  // namespace
+
+bool opencl_selector_matches(const ClDeviceInfo& d, const std::string& selector) {
+  const auto colon = selector.find(':');
+  const std::string plat = colon == std::string::npos ? "" : lower(selector.substr(0, colon));
+  const std::string dev = lower(colon == std::string::npos ? selector : selector.substr(colon + 1));
+  const bool plat_ok = plat.empty() || lower(d.platform).find(plat) != std::string::npos ||
+                       lower(d.vendor).find(plat) != std::string::npos;
+  const bool dev_ok = dev.empty() || lower(d.device).find(dev) != std::string::npos;
+  return plat_ok && dev_ok;
+}
+
+BackendChoice auto_backend_choice(const std::vector<ClDeviceInfo>& devices,
+                                  const std::string& selector) {
+  BackendChoice c;
+  if (devices.empty()) {
+    c.backend = "cpu";
+    c.reason = "no OpenCL device (or the OpenCL backend is not built): the CPU reference";
+    return c;
+  }
+  if (!selector.empty()) {
+    for (std::size_t k = 0; k < devices.size(); ++k)
+      if (opencl_selector_matches(devices[k], selector)) {
+        c.backend = "opencl";
+        c.device = static_cast<int>(k);
+        c.reason = "ERODEM_OPENCL_DEVICE='" + selector + "' selects it";
+        return c;
+      }
+    c.reason = "ERODEM_OPENCL_DEVICE='" + selector +
+               "' matches no device: auto (and --backend opencl) fail with exit 2";
+    return c;
+  }
+  const auto gpu =
+      std::find_if(devices.begin(), devices.end(), [](const ClDeviceInfo& d) { return d.gpu(); });
+  if (gpu != devices.end()) {
+    c.backend = "opencl";
+    c.device = static_cast<int>(gpu - devices.begin());
+    c.reason = "the first OpenCL GPU";
+    return c;
+  }
+  if (std::any_of(devices.begin(), devices.end(), is_pocl)) {
+    c.backend = "opencl";
+    c.device = 0;
+    c.reason = is_pocl(devices.front())
+                   ? "no OpenCL GPU; OpenCL on the CPU through PoCL"
+                   : "no OpenCL GPU; a PoCL platform is present, so OpenCL on the first device";
+    return c;
+  }
+  c.backend = "cpu";
+  c.reason = "no OpenCL GPU and no PoCL: the CPU reference";
+  return c;
+}
+
+std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& terrain,
+                                      const Params& params) {
+  if (name == "cpu") return make_cpu_backend(terrain, params);
+  if (name == "opencl") return make_opencl_backend(terrain, params);
+  if (name == "auto") {
+    // The OpenCL backend runs float32 only.
+    if (params.numerics.precision != Precision::float32) return make_cpu_backend(terrain, params);
+    const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
+    const BackendChoice choice = auto_backend_choice(list_opencl_devices(), env ? env : "");
+    // No choice (a selector that matches nothing): the OpenCL backend says why, exit 2.
+    if (choice.backend != "cpu") return make_opencl_backend(terrain, params);
+    return make_cpu_backend(terrain, params);
+  }
+  throw Error(ExitCode::usage, "backend '" + name + "': expected auto, cpu or opencl" +
+                                   (opencl_available() ? "" : " (no OpenCL device here)"));
+}
+
+}  // namespace erodem
