@@ -19,6 +19,7 @@ Action add_devices(CLI::App& app);
 Action add_compare(CLI::App& app);
 Action add_info(CLI::App& app);
 Action add_export(CLI::App& app);
+Action add_view(CLI::App& app);
 
 /// Whether stderr is a terminal (progress bar) or a log (periodic lines).
 bool stderr_is_terminal();

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   add(cli::add_compare);
   add(cli::add_info);
   add(cli::add_export);
+  add(cli::add_view);
   spdlog::set_default_logger(spdlog::stderr_logger_mt("erodem"));
   spdlog::set_pattern("[%H:%M:%S] %v");
   try {
