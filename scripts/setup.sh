@@ -16,6 +16,7 @@ DEBIAN_PACKAGES=(
   # the VTK viewer (`erodem view`); VTK's CMake config also needs MPI (pulled in by
   # libvtk9-dev). xvfb-run (xvfb + xauth) and Mesa render it without a screen (tests).
   libvtk9-dev xvfb xauth libgl1-mesa-dri
+  pybind11-dev
 )
 
 missing=()
@@ -35,11 +36,20 @@ if ! python3 -c 'import numpy, h5py, xarray, h5netcdf' 2>/dev/null; then
   echo "setup: installing Python packages: numpy h5py xarray h5netcdf"
   python3 -m pip install -q numpy h5py xarray h5netcdf
 fi
+# The Python bindings (python/, docs/python.md): pybind11 (Debian pybind11-dev above, or pip),
+# the build backend of `pip install .`, and what the package and its tests use.
+if ! python3 -c 'import scikit_build_core, pybind11, pandas, dask, distributed, tqdm, matplotlib, pytest' 2>/dev/null; then
+  echo "setup: installing Python packages: scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest"
+  python3 -m pip install -q scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest
+fi
 
 # PoCL compiles kernels into a cache; keep it in a writable place.
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$PWD/$BUILD_DIR/pocl-cache}
 mkdir -p "$POCL_CACHE_DIR"
 
-cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release ${ERODEM_CMAKE_ARGS:-}
+# The Python module is built for the pyenv/PATH python3 (its real executable, not a shim).
+PYTHON_EXE=$(python3 -c 'import sys; print(sys.executable)')
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE="$PYTHON_EXE" \
+  ${ERODEM_CMAKE_ARGS:-}
 cmake --build "$BUILD_DIR" --parallel "$(nproc)"
 echo "setup: built $BUILD_DIR/cli/erodem"

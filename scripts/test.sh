@@ -17,10 +17,13 @@ echo "clang-format: $(echo "$files" | wc -w) files clean"
 echo "== Release test suite"
 ctest --test-dir build --output-on-failure --timeout 900 -j "$(nproc)"
 
+echo "== Python tests (pytest against the build tree: build/python, build/cli/erodem)"
+ERODEM_BUILD_DIR=build python3 -m pytest tests/python -q -rs
+
 echo "== Debug test suite under AddressSanitizer + UndefinedBehaviorSanitizer"
 # -O1 keeps the sanitized suite fast enough; the 10,000-step physics tests run in Release
 # above and are left out here.
-ERODEM_CMAKE_ARGS="-DCMAKE_BUILD_TYPE=Debug -DERODEM_SANITIZE=ON" \
+ERODEM_CMAKE_ARGS="-DCMAKE_BUILD_TYPE=Debug -DERODEM_SANITIZE=ON -DERODEM_PYTHON=OFF" \
   bash scripts/setup.sh build-sanitize >/dev/null
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

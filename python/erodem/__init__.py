@@ -1,0 +1,735 @@
+"""erodem — hydrology and hydraulic erosion on real DEMs, from Python.
+
+The package is a thin layer over the C++ core (the extension module ``erodem._erodem``):
+parameters are checked by the one C++ schema (the same keys, units and ranges as the TOML
+config and ``erodem run --set``), the simulation runs in C++ with the GIL released, and
+result files are written by the same writer as ``erodem run``.
+
+Public API (``docs/python.md``): :func:`read_dem`, :class:`DEM`, :class:`Simulation`,
+:func:`open_run`, :func:`sweep`, :func:`parameter_keys`, :func:`parameter_info`,
+:exc:`UnstableError`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shlex
+import sys
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _erodem
+from ._erodem import UnstableError
+
+__all__ = [
+    "DEM",
+    "Simulation",
+    "UnstableError",
+    "open_run",
+    "parameter_info",
+    "parameter_keys",
+    "read_dem",
+    "sweep",
+]
+
+__version__ = "0.1.0"
+
+#: Names of the fields a Simulation exposes (MODEL.md); all in SI units.
+FIELDS = (
+    "bed",
+    "water_depth",
+    "sediment",
+    "velocity_x",
+    "velocity_y",
+    "flux_left",
+    "flux_right",
+    "flux_top",
+    "flux_bottom",
+    "hardness",
+    "wetness",
+    "erosion",
+    "manning_n",
+    "initial_bed",
+)
+
+Settings = List[Tuple[str, str]]
+
+
+# ---- parameters: Python values -> (dotted key, TOML text) for the C++ schema -----------
+
+
+def _toml_string(s: str) -> str:
+    """A TOML basic string holding ``s``."""
+    out = ['"']
+    for ch in s:
+        if ch == '"':
+            out.append('\\"')
+        elif ch == "\\":
+            out.append("\\\\")
+        elif ch == "\n":
+            out.append("\\n")
+        elif ch == "\t":
+            out.append("\\t")
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append("\\u%04x" % ord(ch))
+        else:
+            out.append(ch)
+    out.append('"')
+    return "".join(out)
+
+
+def _toml_text(value: Any, key: str) -> str:
+    """``value`` (number, bool, string, sequence, mapping, numpy scalar or array) as TOML
+    value text. Other types raise ValueError naming the parameter ``key``."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    elif isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)  # shortest text that reads back to the same double
+    if isinstance(value, (str, os.PathLike)):
+        return _toml_string(os.fspath(value))
+    if isinstance(value, Mapping):
+        items = ", ".join(
+            "%s = %s" % (_toml_string(str(k)), _toml_text(v, "%s.%s" % (key, k)))
+            for k, v in value.items()
+        )
+        return "{" + items + "}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_text(v, key) for v in value) + "]"
+    raise ValueError(
+        "parameter '%s': cannot use a value of type %s; expected a number, boolean, string "
+        "(with a unit, e.g. \"20 mm/h\") or a list" % (key, type(value).__name__)
+    )
+
+
+def _flatten(params: Mapping[str, Any], prefix: str = "") -> Dict[str, Any]:
+    """Nested dicts and ``a__b`` names to dotted keys: ``{"erosion": {"min_tilt": 0.1}}``
+    and ``erosion__min_tilt=0.1`` both give ``{"erosion.min_tilt": 0.1}``. Lists (e.g. of
+    inflow tables) are values, not nested."""
+    out: Dict[str, Any] = {}
+    for k, v in params.items():
+        key = prefix + str(k).replace("__", ".")
+        if isinstance(v, Mapping):
+            out.update(_flatten(v, key + "."))
+        else:
+            out[key] = v
+    return out
+
+
+def _settings(params: Mapping[str, Any]) -> Settings:
+    """Dotted keys and values as (key, TOML text) pairs, for the C++ schema."""
+    return [(k, _toml_text(v, k)) for k, v in _flatten(params).items()]
+
+
+def parameter_keys() -> List[str]:
+    """All parameter names, dotted (``"erosion.sediment_capacity"``), in schema order.
+
+    Returns
+    -------
+    list of str
+        The keys of the TOML config; in Python keywords write ``.`` as ``__``.
+    """
+    return list(_erodem.parameter_keys())
+
+
+def parameter_info(key: str) -> Dict[str, str]:
+    """What the schema knows about one parameter.
+
+    Parameters
+    ----------
+    key : str
+        Dotted key (``"rain.rate"``) or keyword form (``"rain__rate"``).
+
+    Returns
+    -------
+    dict
+        ``key``, ``type``, ``unit`` (SI unit of the stored value), ``accepted`` (range or
+        choices), ``default`` (TOML text) and ``doc``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown key (the message suggests the closest one).
+    """
+    return dict(_erodem.parameter_info(key.replace("__", ".")))
+
+
+# ---- DEMs -------------------------------------------------------------------------------
+
+
+class DEM:
+    """A DEM on its grid, as :func:`read_dem` returns it.
+
+    It carries the settings it was read with (path, window, resample, z_scale, cell_size,
+    crs, nodata_value), so a :class:`Simulation` built on it runs on exactly this terrain,
+    and it pickles as those settings (a worker process reads the file again).
+
+    Attributes
+    ----------
+    elevation : numpy.ndarray
+        Bed elevation (m), float32 ``(ny, nx)``, row 0 north, NaN at nodata cells.
+    mask : numpy.ndarray
+        bool ``(ny, nx)``: True for active cells, False for nodata.
+    transform : tuple of 6 float
+        GDAL geotransform of the top-left corner (CRS units: metres, or degrees when
+        geographic).
+    crs : str
+        The CRS as WKT ('' when unknown).
+    is_geographic : bool
+        True for lat/lon grids (cell sizes vary by row).
+    dx, dy, area : numpy.ndarray
+        Per-row cell sizes (m) and cell areas (m^2), shape ``(ny,)``.
+    shape : tuple of int
+        ``(ny, nx)``.
+    path : str
+        The DEM file; ``sha256`` its checksum.
+    settings : dict
+        The ``dem.*`` settings (dotted keys) it was read with.
+    """
+
+    def __init__(self, settings: Mapping[str, Any]):
+        self.settings = dict(settings)
+        self._terrain = _erodem.Terrain(_settings(self.settings))
+
+    @property
+    def elevation(self) -> np.ndarray:
+        """Bed elevation (m), float32 ``(ny, nx)``, row 0 north, NaN at nodata cells (a copy)."""
+        return self._terrain.elevation
+
+    @property
+    def mask(self) -> np.ndarray:
+        """Active cells: bool ``(ny, nx)``, False where the DEM is nodata (a copy)."""
+        return self._terrain.mask
+
+    @property
+    def transform(self) -> Tuple[float, ...]:
+        """GDAL geotransform ``(x0, pixel width, 0, y0, 0, pixel height)`` of the top-left
+        corner, in the CRS's units (metres, or degrees when geographic)."""
+        return tuple(self._terrain.transform)
+
+    @property
+    def crs(self) -> str:
+        """The CRS as WKT ('' when unknown)."""
+        return self._terrain.crs
+
+    @property
+    def is_geographic(self) -> bool:
+        """True for lat/lon grids, whose cell sizes vary by row."""
+        return self._terrain.is_geographic
+
+    @property
+    def dx(self) -> np.ndarray:
+        """East-west cell size of each row (m), shape ``(ny,)``."""
+        return np.asarray(self._terrain.dx)
+
+    @property
+    def dy(self) -> np.ndarray:
+        """North-south cell size of each row (m), shape ``(ny,)``."""
+        return np.asarray(self._terrain.dy)
+
+    @property
+    def area(self) -> np.ndarray:
+        """Cell area of each row (m^2), shape ``(ny,)``."""
+        return np.asarray(self._terrain.area)
+
+    @property
+    def shape(self) -> Tuple[int, int]:
+        """``(ny, nx)``."""
+        return tuple(self._terrain.shape)
+
+    @property
+    def path(self) -> str:
+        """The DEM file (absolute path)."""
+        return self._terrain.source
+
+    @property
+    def sha256(self) -> str:
+        """SHA-256 of the DEM file's bytes (lower-case hex)."""
+        return self._terrain.sha256
+
+    def __reduce__(self):
+        return (DEM, (self.settings,))
+
+    def __repr__(self) -> str:
+        ny, nx = self.shape
+        return "<erodem.DEM %s: %d x %d cells, dx %.4g m>" % (
+            self.path,
+            nx,
+            ny,
+            min(self.dx.min(), self.dy.min()),
+        )
+
+
+def read_dem(
+    path: Union[str, os.PathLike],
+    window: Optional[Sequence[int]] = None,
+    resample: Union[None, int, float, str] = None,
+    z_scale: float = 1.0,
+    cell_size: Union[None, float, str] = None,
+    crs: Optional[str] = None,
+    nodata_value: Optional[float] = None,
+) -> DEM:
+    """Reads a DEM (any raster GDAL reads) as the simulation will see it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The raster file.
+    window : sequence of 4 int, optional
+        ``(col, row, width, height)`` in pixels: read only that part.
+    resample : int or float or str, optional
+        Coarser cells by block averaging: an integer factor (``4``), or a cell size in
+        metres (``320.0`` or ``"320 m"``, a whole multiple of the file's).
+    z_scale : float, default 1.0
+        Multiplier of the stored values (e.g. 0.1 for Puget Sound's 0.1 m units).
+    cell_size : float or str, optional
+        Cell size (m) for files without georeferencing.
+    crs : str, optional
+        CRS (``"EPSG:32610"``, WKT) for files without one.
+    nodata_value : float, optional
+        A stored value to treat as nodata (before ``z_scale``).
+
+    Returns
+    -------
+    DEM
+
+    Raises
+    ------
+    FileNotFoundError
+        The file does not exist.
+    ValueError
+        Bad settings (naming the ``dem.*`` parameter), or a file GDAL cannot read.
+    """
+    s: Dict[str, Any] = {"dem.path": os.path.abspath(os.fspath(path))}
+    if window is not None:
+        s["dem.window"] = [int(v) for v in window]
+    if resample is not None:
+        if isinstance(resample, (int, np.integer)) and not isinstance(resample, bool):
+            s["dem.resample_factor"] = int(resample)
+        else:
+            s["dem.resample"] = resample
+    if z_scale != 1.0:
+        s["dem.z_scale"] = z_scale
+    if cell_size is not None:
+        s["dem.cell_size"] = cell_size
+    if crs is not None:
+        s["dem.crs"] = crs
+    if nodata_value is not None:
+        s["dem.nodata_value"] = nodata_value
+    return DEM(s)
+
+
+# ---- simulations ------------------------------------------------------------------------
+
+
+def _progress_bar(total: float, unit: str):
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, unit=unit, dynamic_ncols=True, leave=True)
+
+
+class Simulation:
+    """One run of the model on a DEM, on the CPU reference or the OpenCL backend.
+
+    Parameters
+    ----------
+    dem : DEM or str or path-like, optional
+        The terrain (:func:`read_dem`'s result, or a path read with default settings). Its
+        ``dem.*`` settings replace those of ``config``. Without it, the config's ``dem.*``
+        keys (or ``dem__path=...``) give the DEM.
+    backend : {"auto", "cpu", "opencl"}, default "auto"
+        ``auto``: an OpenCL GPU, else OpenCL on PoCL, else the CPU reference.
+    config : dict or str or path-like, optional
+        A TOML config file (relative raster paths in it resolve against its folder), or a
+        dict of parameters (nested or dotted keys). Applied before ``params``.
+    **params
+        Parameters by their dotted config names with ``__`` for the dot
+        (``erosion__sediment_capacity=0.1``), or nested dicts (``erosion={"enabled":
+        True}``). Values are numbers in SI units, booleans, strings with a unit
+        (``"20 mm/h"``), or lists, exactly as in TOML.
+
+    Raises
+    ------
+    ValueError
+        A parameter is unknown or out of range (the message names it and the accepted
+        range), or the backend name is unknown or not available.
+    FileNotFoundError
+        The config or DEM file is missing.
+
+    Notes
+    -----
+    Field properties (``bed``, ``water_depth``, ``sediment``, ``velocity_x``,
+    ``velocity_y``, and :meth:`field` for the others) on the CPU backend are numpy views of
+    the simulation's own memory, without copying: writing into ``sim.water_depth[...]``
+    changes the state. A view is valid until the next step (processes write into a second
+    buffer and swap), so take a fresh one after stepping; it keeps the simulation alive. On
+    OpenCL, and for the derived field ``erosion``, they are read-only copies; assigning
+    (``sim.water_depth = a``) uploads on every backend. A change made from Python is not in
+    the ledger's inputs: it shows as closure error.
+
+    Not thread-safe: use one simulation from one thread at a time.
+    """
+
+    def __init__(
+        self,
+        dem: Union[DEM, str, os.PathLike, None] = None,
+        backend: str = "auto",
+        *,
+        config: Union[Mapping[str, Any], str, os.PathLike, None] = None,
+        **params: Any,
+    ):
+        if dem is not None and not isinstance(dem, DEM):
+            dem = read_dem(dem)
+        config_path = ""
+        settings: Settings = []
+        if isinstance(config, Mapping):
+            settings += _settings(config)
+        elif config is not None:
+            config_path = os.fspath(config)
+        kw = _settings(params)
+        if dem is not None:
+            clash = [k for k, _ in kw if k.startswith("dem.")]
+            if clash:
+                raise ValueError(
+                    "parameter '%s': the DEM object gives the dem.* settings; pass it to "
+                    "read_dem() instead" % clash[0]
+                )
+        settings += kw
+        self._dem = dem
+        self._backend_name = backend
+        self._config = config
+        self._params = dict(params)
+        self._sim = _erodem.Simulation(
+            config_path, settings, dem._terrain if dem is not None else None, backend
+        )
+
+    # ---- stepping ----
+
+    #: Wall time (s) of one chunk of steps run with the GIL released; Ctrl-C and progress
+    #: updates are handled between chunks.
+    chunk_seconds = 0.1
+
+    def step(self, n: int = 1) -> None:
+        """Runs ``n`` steps (regardless of the configured end).
+
+        The GIL is released while stepping; Ctrl-C raises KeyboardInterrupt between two
+        whole steps (within about ``chunk_seconds``), leaving a consistent state.
+
+        Parameters
+        ----------
+        n : int, default 1
+            Number of steps, >= 0.
+
+        Raises
+        ------
+        ValueError
+            ``n`` is negative.
+        UnstableError
+            The state turned NaN or negative, or violated the CFL bound (the message names
+            the step, time and cell).
+        """
+        n = int(n)
+        if n < 0:
+            raise ValueError("step: 'n' must be >= 0, got %d" % n)
+        self._sim.advance(n, False, math.inf, None, self.chunk_seconds, False)
+
+    def run(
+        self,
+        steps: Optional[int] = None,
+        duration: Union[None, float, str] = None,
+        output: Union[str, os.PathLike, None] = None,
+        every: Union[None, int, float, str] = None,
+        progress: bool = False,
+        overwrite: bool = False,
+    ) -> Dict[str, float]:
+        """Runs the simulation, optionally writing a result file.
+
+        Parameters
+        ----------
+        steps : int, optional
+            Run this many more steps.
+        duration : float or str, optional
+            Run until ``time`` has advanced by this much (s, or a string such as
+            ``"10 min"``); the last step is not shortened to land on it (set
+            ``time.duration`` for an exact end).
+        output : str or path-like, optional
+            Write an ``.h5`` result file as ``erodem run`` does (a snapshot now, diagnostics
+            every step, snapshots per ``output.every``/``output.interval``, a final
+            snapshot, the ``.xmf`` sidecar). It is written under ``.<name>.partial`` and
+            renamed when the run completes; after Ctrl-C or an unstable step the partial
+            file stays, holding the results so far.
+        every : int or float or str, optional
+            Snapshot interval: an int is steps (``output.every``), a float or a string
+            with a unit is simulated time (``output.interval``, s).
+        progress : bool, default False
+            Show a tqdm progress bar.
+        overwrite : bool, default False
+            Replace an existing ``output``.
+
+        With neither ``steps`` nor ``duration`` it runs to the configured end
+        (``time.steps`` or ``time.duration``).
+
+        Returns
+        -------
+        dict
+            The ledger at the end (see :attr:`ledger`).
+
+        Raises
+        ------
+        KeyboardInterrupt
+            On Ctrl-C, between two steps; the result file stays at its partial name.
+        UnstableError
+            As for :meth:`step`; the partial result file keeps the failing step.
+        ValueError, OSError
+            Bad arguments; an output that exists (without ``overwrite``) or cannot be
+            created.
+        """
+        if steps is not None and duration is not None:
+            raise ValueError("run: give 'steps' or 'duration', not both")
+        if steps is not None and int(steps) < 0:
+            raise ValueError("run: 'steps' must be >= 0, got %d" % int(steps))
+        t_end = None
+        if duration is not None:
+            t_end = self.time + _duration_seconds(duration)
+        writer = None
+        if output is not None:
+            out_settings: Dict[str, Any] = {"output.path": os.fspath(output)}
+            if every is not None:
+                if isinstance(every, (int, np.integer)) and not isinstance(every, bool):
+                    out_settings["output.every"] = int(every)
+                    out_settings["output.interval"] = 0.0
+                else:
+                    out_settings["output.interval"] = every
+            cmd = "python: " + " ".join(shlex.quote(a) for a in (sys.argv or ["python"]))
+            writer = _erodem.ResultWriter(self._sim, _settings(out_settings), overwrite, cmd)
+        elif every is not None:
+            raise ValueError("run: 'every' needs 'output'")
+
+        bar = None
+        try:
+            if progress:
+                if steps is not None:
+                    bar = _progress_bar(int(steps), "step")
+                elif t_end is not None:
+                    bar = _progress_bar(t_end - self.time, "s")
+                elif self._sim.configured_duration > 0:
+                    bar = _progress_bar(self._sim.configured_duration, "s")
+                    bar.update(self.time)
+                else:
+                    bar = _progress_bar(self._sim.configured_steps, "step")
+                    bar.update(self.steps_done)
+            big = 2**62
+            while True:
+                t0, n0 = self.time, self.steps_done
+                if steps is not None:
+                    left = int(steps)
+                    if left <= 0:
+                        break
+                    steps = left - self._sim.advance(
+                        left, False, math.inf, writer, self.chunk_seconds, True
+                    )
+                elif t_end is not None:
+                    if self.time >= t_end:
+                        break
+                    self._sim.advance(big, False, t_end, writer, self.chunk_seconds, True)
+                else:
+                    if self._sim.finished:
+                        break
+                    self._sim.advance(big, True, math.inf, writer, self.chunk_seconds, True)
+                if bar is not None:
+                    bar.update(self.time - t0 if bar.unit == "s" else self.steps_done - n0)
+            if writer is not None:
+                writer.finish(self._sim)
+        except KeyboardInterrupt:
+            if writer is not None and writer.open:
+                writer.snapshot(self._sim)
+                writer.close()
+            raise
+        finally:
+            if bar is not None:
+                bar.close()
+            if writer is not None and writer.open:
+                writer.close()  # an error: the partial file stays
+        return self.ledger
+
+    # ---- state ----
+
+    def field(self, name: str) -> np.ndarray:
+        """Field ``name`` (one of :data:`FIELDS`) as numpy ``(ny, nx)``, SI units.
+
+        A writable view of the simulation's memory on the CPU backend (valid until the
+        next step); a read-only copy on OpenCL and for ``erosion``.
+        """
+        return self._sim.field(name)
+
+    def set_field(self, name: str, values: Any) -> None:
+        """Replaces field ``name`` with ``values`` (array-like of shape ``(ny, nx)``, SI
+        units) on any backend (an upload on OpenCL).
+
+        Raises
+        ------
+        ValueError
+            Unknown field, wrong shape, or the derived field ``erosion``.
+        """
+        self._sim.set_field(name, np.asarray(values, dtype=np.float64))
+
+    bed = property(
+        lambda self: self.field("bed"),
+        lambda self, v: self.set_field("bed", v),
+        doc="Bed elevation (m), (ny, nx).",
+    )
+    water_depth = property(
+        lambda self: self.field("water_depth"),
+        lambda self, v: self.set_field("water_depth", v),
+        doc="Water depth (m), (ny, nx).",
+    )
+    sediment = property(
+        lambda self: self.field("sediment"),
+        lambda self, v: self.set_field("sediment", v),
+        doc="Suspended sediment as an equivalent bed thickness (m), (ny, nx).",
+    )
+    velocity_x = property(
+        lambda self: self.field("velocity_x"),
+        lambda self, v: self.set_field("velocity_x", v),
+        doc="Eastward velocity (m/s), (ny, nx).",
+    )
+    velocity_y = property(
+        lambda self: self.field("velocity_y"),
+        lambda self, v: self.set_field("velocity_y", v),
+        doc="Northward velocity (m/s), (ny, nx).",
+    )
+
+    @property
+    def erosion(self) -> np.ndarray:
+        """Initial bed minus bed (m), (ny, nx); negative where material was deposited. A
+        read-only copy."""
+        return self.field("erosion")
+
+    @property
+    def ledger(self) -> Dict[str, float]:
+        """The conservation ledger (m^3, cumulative since the start): ``water_initial``,
+        ``water``, ``rain``, ``inflow``, ``boundary_out``, ``evaporated``, ``clipped``,
+        ``closure_error``, ``relative_closure_error`` (1), ``material_initial``,
+        ``material``, ``sediment_out``, ``transport_change``, ``material_closure_error``,
+        ``relative_material_closure_error`` (1)."""
+        return dict(self._sim.ledger)
+
+    @property
+    def diagnostics(self) -> Dict[str, float]:
+        """The last step's diagnostics row (as in the result file's ``diagnostics``)."""
+        return dict(self._sim.diagnostics)
+
+    def erosion_volumes(self) -> Tuple[float, float]:
+        """``(eroded, deposited)`` volume (m^3) so far: sums of the positive and negative
+        parts of :attr:`erosion` times the cell areas, over active cells."""
+        return tuple(self._sim.erosion_volumes())
+
+    @property
+    def peak_depth(self) -> float:
+        """The largest ``max_depth`` (m) over the steps run so far."""
+        return self._sim.peak_depth
+
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+        return self._sim.time
+
+    @property
+    def steps_done(self) -> int:
+        """Steps run so far."""
+        return self._sim.steps_done
+
+    @property
+    def finished(self) -> bool:
+        """Whether the configured end (``time.steps`` or ``time.duration``) is reached."""
+        return self._sim.finished
+
+    @property
+    def backend(self) -> str:
+        """``"cpu"`` or ``"opencl"``."""
+        return self._sim.backend
+
+    @property
+    def device(self) -> str:
+        """What runs the kernels, e.g. ``"CPU reference, float32, 2 threads"``."""
+        return self._sim.device
+
+    @property
+    def shape(self) -> Tuple[int, int]:
+        """``(ny, nx)``."""
+        return tuple(self._sim.shape)
+
+    @property
+    def config_toml(self) -> str:
+        """The fully resolved configuration as TOML text (``erodem run --dump-config``)."""
+        return self._sim.config_toml
+
+    def __repr__(self) -> str:
+        if not hasattr(self, "_sim"):
+            return "<erodem.Simulation (not built)>"
+        ny, nx = self.shape
+        return "<erodem.Simulation %d x %d on %s, step %d, t = %.6g s>" % (
+            nx,
+            ny,
+            self.backend,
+            self.steps_done,
+            self.time,
+        )
+
+
+def _duration_seconds(value: Union[float, str]) -> float:
+    """A duration (s, or a string with a unit such as ``"10 min"``) in seconds."""
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
+        v = float(value)
+    else:
+        v = _erodem.duration_seconds("duration", str(value))
+    if not (math.isfinite(v) and v >= 0):
+        raise ValueError("parameter 'duration': expected a time >= 0 (s), got %r" % (value,))
+    return v
+
+
+# ---- result files -----------------------------------------------------------------------
+
+
+def open_run(path: Union[str, os.PathLike], group: Optional[str] = None):
+    """Opens a result file (``.h5``, also a partial one) as an ``xarray.Dataset``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The result file.
+    group : {None, "diagnostics", "gauges"}, optional
+        None: the fields over ``(time, y, x)`` with coordinates, CRS and root attributes
+        (``config_toml``, ``backend``, ...). ``"diagnostics"``: the per-step series over
+        ``step``. ``"gauges"``: the gauge series.
+
+    Returns
+    -------
+    xarray.Dataset
+        Lazily loaded (h5netcdf engine); close it, or use it in a ``with`` block.
+
+    Raises
+    ------
+    FileNotFoundError
+        The file does not exist.
+    """
+    import xarray as xr
+
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise FileNotFoundError("%s: no such result file" % p)
+    return xr.open_dataset(p, engine="h5netcdf", group=group)
+
+
+from .sweep import sweep  # noqa: E402  (needs Simulation above)

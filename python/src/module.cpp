@@ -1,0 +1,22 @@
+// erodem — the Python extension module `erodem._erodem` (pybind11). A thin layer over the
+// C++ API: parameters go through the one schema (apply_setting / load_config / validate),
+// terrain through io::load_terrain, runs through Simulation and io::ResultWriter exactly as
+// `erodem run` drives them. The public Python API is the package `erodem` on top of it
+// (python/erodem/__init__.py); docs/python.md describes both.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+
+namespace py = pybind11;
+
+PYBIND11_MODULE(_erodem, m) {
+  m.doc() =
+      "erodem's C++ core: terrain loading, simulations on the CPU and OpenCL backends, result "
+      "files. Use it through the package `erodem`.";
+  erodem::python::add_error_bindings(m);
+  erodem::python::add_schema_bindings(m);
+  erodem::python::add_terrain_bindings(m);
+  erodem::python::add_simulation_bindings(m);
+}

@@ -1,0 +1,377 @@
+"""The Python API of INTERFACES.md: read_dem, Simulation (both backends), numpy views,
+parameters through the C++ schema, result files identical to the CLI's, Ctrl-C, progress."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import run_cli
+
+# A 64 x 64 crop of Big Tujunga (SRTM 30 m, UTM 11N): steep enough for erosion in a few
+# hundred steps.
+WINDOW = [300, 200, 64, 64]
+
+
+def small_config(dem_path, steps=200, **extra):
+    """A config (dict) of a short storm with erosion, transport and thermal collapse."""
+    cfg = {
+        "dem": {"path": dem_path, "window": WINDOW},
+        "initial": {"water_depth": 0.05},
+        "time": {"steps": steps, "adaptive": True, "cfl": 0.7, "dt_max": "2 s"},
+        "rain": {"rate": "80 mm/h"},
+        "erosion": {
+            "enabled": True,
+            "sediment_capacity": 0.05,
+            "dissolving_rate": 0.05,
+            "deposition_rate": 0.1,
+            "min_tilt": 0.02,
+        },
+        "thermal": {"enabled": True, "talus_angle": 30.0, "rate": 0.05},
+        "boundary": {"east": "open", "south": "open"},
+        "output": {"every": 50},
+        "numerics": {"threads": 1},
+    }
+    for k, v in extra.items():
+        sec, key = k.split("__")
+        cfg.setdefault(sec, {})[key] = v
+    return cfg
+
+
+def toml_text(cfg):
+    """A nested dict as a TOML document (through erodem's own value formatting)."""
+    from erodem import _toml_text
+
+    lines = []
+    for sec, table in cfg.items():
+        lines.append("[%s]" % sec)
+        for k, v in table.items():
+            lines.append("%s = %s" % (k, _toml_text(v, k)))
+    return "\n".join(lines) + "\n"
+
+
+def assert_same_results(a_path, b_path):
+    """Every field at every stored time, and every diagnostics series, bit for bit."""
+    with h5py.File(a_path, "r") as a, h5py.File(b_path, "r") as b:
+        assert np.array_equal(a["time"][:], b["time"][:]), "snapshot times differ"
+        fields = [k for k in ("bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion") if k in a]
+        assert fields, "no fields stored"
+        n = 0
+        for f in fields:
+            assert f in b, f
+            x, y = a[f][:], b[f][:]
+            assert x.shape == y.shape, (f, x.shape, y.shape)
+            diff = np.nanmax(np.abs(x.astype(np.float64) - y)) if x.size else 0.0
+            print("%-12s %s  max |diff| %.3g" % (f, x.shape, diff))
+            assert np.array_equal(x, y, equal_nan=True), "field %s differs" % f
+            n += x.size
+        for k in a["diagnostics"]:
+            x, y = a["diagnostics"][k][:], b["diagnostics"][k][:]
+            assert np.array_equal(x, y, equal_nan=True), "diagnostics/%s differs" % k
+        print("identical: %d field values at %d times, %d diagnostics series of %d steps"
+              % (n, len(a["time"]), len(a["diagnostics"]), len(a["diagnostics"]["time"])))
+
+
+# ---- DEMs -------------------------------------------------------------------------------
+
+
+def test_read_dem_window_and_georeferencing(erodem, tujunga):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    print(dem, "elevation %.1f .. %.1f m" % (np.nanmin(dem.elevation), np.nanmax(dem.elevation)))
+    assert dem.shape == (64, 64)
+    assert dem.elevation.dtype == np.float32 and dem.elevation.shape == (64, 64)
+    assert 315 <= np.nanmin(dem.elevation) and np.nanmax(dem.elevation) <= 2295
+    assert dem.mask.dtype == np.bool_ and dem.mask.all()
+    assert "UTM zone 11N" in dem.crs and not dem.is_geographic
+    assert dem.transform[1] == 30.0 and dem.transform[5] == -30.0
+    assert np.allclose(dem.dx, 30.0) and np.allclose(dem.area, 900.0)
+    full = erodem.read_dem(tujunga)
+    assert np.array_equal(full.elevation[200:264, 300:364], dem.elevation)
+    coarse = erodem.read_dem(tujunga, window=WINDOW, resample="60 m")
+    print("resample 60 m:", coarse.shape, coarse.dx[0])
+    assert coarse.shape == (32, 32) and coarse.dx[0] == 60.0
+    assert np.isclose(coarse.elevation[0, 0], dem.elevation[:2, :2].astype(np.float64).mean(), atol=1e-3)
+
+
+def test_read_dem_errors(erodem, tujunga, volcano, tmp_path):
+    with pytest.raises(FileNotFoundError, match="nope.tif"):
+        erodem.read_dem(str(tmp_path / "nope.tif"))
+    with pytest.raises(ValueError, match="window"):
+        erodem.read_dem(tujunga, window=[0, 0, 5000, 10])
+    with pytest.raises(ValueError, match="dem.cell_size"):
+        erodem.read_dem(volcano)  # no georeferencing: the cell size is required
+    with pytest.raises(ValueError, match="dem.z_scale"):
+        erodem.read_dem(tujunga, z_scale="high")
+
+
+# ---- parameters -------------------------------------------------------------------------
+
+
+def test_bad_parameters_raise_value_error_naming_them(erodem, tujunga):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    cases = [
+        (dict(erosion__sediment_capacity=-1.0), "erosion.sediment_capacity"),
+        (dict(erosion={"sediment_capcity": 1.0}), "did you mean 'erosion.sediment_capacity'"),
+        (dict(rain__rate="20 furlongs/h"), "rain.rate"),
+        (dict(flow__scheme="magic"), "flow.scheme"),
+        (dict(time__steps=object()), "time.steps"),
+        (dict(thermal__talus_angle=[1, 2]), "thermal.talus_angle"),
+        (dict(dem__z_scale=2.0), "dem.z_scale"),
+    ]
+    for kw, needle in cases:
+        with pytest.raises(ValueError) as info:
+            erodem.Simulation(dem, backend="cpu", **kw)
+        print("%-45s -> %s" % (kw, info.value))
+        assert needle in str(info.value)
+    with pytest.raises(ValueError, match="gpu"):
+        erodem.Simulation(dem, backend="gpu")
+    sim = erodem.Simulation(dem, backend="cpu", time__steps=1)
+    with pytest.raises(ValueError, match="'n'"):
+        sim.step(-1)
+    with pytest.raises(ValueError, match=r"water_depth.*\(64, 64\).*\(3, 3\)"):
+        sim.water_depth = np.zeros((3, 3))
+    with pytest.raises(ValueError, match="erosion"):
+        sim.set_field("erosion", np.zeros((64, 64)))
+    with pytest.raises(ValueError, match="duration"):
+        sim.run(duration="5 parsecs")
+
+
+def test_parameter_forms_agree(erodem, tujunga):
+    """Keywords, nested dicts, unit strings and dict configs resolve to the same config."""
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    a = erodem.Simulation(dem, backend="cpu", rain__rate="36 mm/h", erosion__enabled=True,
+                          erosion__sediment_capacity=0.25)
+    b = erodem.Simulation(dem, backend="cpu", rain={"rate": "36 mm/h"},
+                          erosion={"enabled": True, "sediment_capacity": 0.25})
+    c = erodem.Simulation(dem, backend="cpu", config={"rain.rate": "36 mm/h",
+                                                      "erosion": {"enabled": True}},
+                          erosion__sediment_capacity=np.float64(0.25))
+    assert a.config_toml == b.config_toml == c.config_toml
+    rate = [l for l in a.config_toml.splitlines() if l.startswith("rate = ")][0]
+    print("rain.rate = \"36 mm/h\" resolves to", rate, "m/s")
+    assert abs(float(rate.split("=")[1]) - 1e-5) <= 1e-20
+    info = erodem.parameter_info("rain__rate")
+    print(info)
+    assert info["unit"] == "m/s"
+    assert "erosion.sediment_capacity" in erodem.parameter_keys()
+
+
+# ---- numpy views ------------------------------------------------------------------------
+
+
+def test_cpu_fields_are_views_sharing_memory(erodem, tujunga):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", time__steps=10, numerics__threads=1)
+    v = sim.water_depth
+    assert v.dtype == np.float32 and v.shape == (64, 64) and v.flags.writeable
+    assert not v.flags.owndata and v.base is not None
+    assert np.shares_memory(v, sim.water_depth)
+    print("view strides", v.strides, "(padded rows)")
+    assert v.strides[0] > 64 * 4  # the backend's padded row, seen without copying
+    # Writing through the view changes the simulation: 1 m of water in one cell.
+    v[10, 20] = 1.0
+    assert sim.field("water_depth")[10, 20] == 1.0
+    sim.step(1)
+    water = sim.ledger["water"]
+    print("water volume after writing 1 m in one 900 m^2 cell: %.6f m^3 (expected 900)" % water)
+    assert abs(water - 900.0) <= 1e-3
+    # The view keeps the simulation alive.
+    view = sim.bed
+    del sim
+    assert np.isfinite(view).all()
+    # Setters replace the whole field.
+    sim = erodem.Simulation(dem, backend="cpu", time__steps=10, numerics__threads=1)
+    sim.water_depth = np.full((64, 64), 0.25)
+    assert (sim.water_depth == 0.25).all()
+    assert not sim.erosion.flags.writeable  # derived: a copy
+
+
+def test_opencl_getters_copy_and_setters_upload(erodem, tujunga, opencl_available):
+    if not opencl_available:
+        pytest.skip("no OpenCL device")
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="opencl", time__steps=10)
+    print(sim.device)
+    assert sim.backend == "opencl"
+    d = sim.water_depth
+    assert not d.flags.writeable
+    with pytest.raises(ValueError):
+        d[0, 0] = 1.0
+    depth = np.zeros((64, 64))
+    depth[10, 20] = 1.0
+    sim.water_depth = depth
+    assert sim.water_depth[10, 20] == 1.0 and sim.water_depth.sum() == 1.0
+    sim.step(1)
+    print("water volume after uploading 1 m in one cell: %.6f m^3 (expected 900)" % sim.ledger["water"])
+    assert abs(sim.ledger["water"] - 900.0) <= 1e-3
+
+
+# ---- Python against the CLI -------------------------------------------------------------
+
+
+@pytest.mark.parametrize("backend", ["cpu", "opencl"])
+def test_results_match_cli_bit_for_bit(erodem, cli, tujunga, tmp_path, backend, opencl_available):
+    if backend == "opencl" and not opencl_available:
+        pytest.skip("no OpenCL device")
+    cfg_path = tmp_path / "cfg.toml"
+    cfg_path.write_text(toml_text(small_config(tujunga)))
+    t0 = time.perf_counter()
+    r = run_cli(cli, "run", str(cfg_path), "--backend", backend, "--output", str(tmp_path / "cli.h5"))
+    t_cli = time.perf_counter() - t0
+    print(r.stdout.splitlines()[0])
+    sim = erodem.Simulation(config=cfg_path, backend=backend)
+    t0 = time.perf_counter()
+    sim.run(output=tmp_path / "py.h5")
+    t_py = time.perf_counter() - t0
+    print("cli %.2f s (process), python run %.2f s, %d steps" % (t_cli, t_py, sim.steps_done))
+    assert os.path.exists(tmp_path / "py.xmf")
+    assert_same_results(tmp_path / "cli.h5", tmp_path / "py.h5")
+    # The same through a DEM object and a dict config.
+    cfg = small_config(tujunga)
+    del cfg["dem"]
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim2 = erodem.Simulation(dem, backend=backend, config=cfg)
+    sim2.run(output=tmp_path / "py2.h5")
+    assert_same_results(tmp_path / "cli.h5", tmp_path / "py2.h5")
+    # Stepping in pieces gives the same state as one run.
+    sim3 = erodem.Simulation(dem, backend=backend, config=cfg)
+    sim3.step(37)
+    sim3.run(steps=63)
+    sim3.run()
+    assert sim3.steps_done == sim.steps_done
+    for f in ("bed", "water_depth", "sediment"):
+        assert np.array_equal(sim3.field(f), sim.field(f))
+    assert sim3.ledger == sim.ledger
+
+
+def test_open_run_and_run_options(erodem, tujunga, tmp_path):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", config=small_config(tujunga, steps=40))
+    out = tmp_path / "r.h5"
+    sim.run(output=out, every=10)
+    ds = erodem.open_run(out)
+    print(ds)
+    assert ds["water_depth"].dims == ("time", "y", "x")
+    assert ds.sizes["time"] == 5  # t = 0 and every 10 steps
+    assert ds.attrs["backend"] == "cpu"
+    ds.close()
+    diag = erodem.open_run(out, group="diagnostics")
+    assert diag.sizes["step"] == 40
+    diag.close()
+    with pytest.raises(OSError, match="exists"):
+        sim.run(steps=1, output=out)
+    sim.run(steps=5, output=out, overwrite=True)
+    t0 = sim.time
+    sim.run(duration="30 s")
+    print("run(duration=30 s) from %.3f s ended at %.3f s" % (t0, sim.time))
+    assert sim.time >= t0 + 30.0 and sim.time < t0 + 30.0 + 2.0  # dt_max = 2 s
+    with pytest.raises(FileNotFoundError):
+        erodem.open_run(tmp_path / "missing.h5")
+
+
+def test_progress_bar(erodem, tujunga, capsys):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", config=small_config(tujunga, steps=30))
+    sim.run(progress=True)
+    err = capsys.readouterr().err
+    print(err[-200:])
+    assert "30/30" in err and "step" in err
+
+
+# ---- the GIL and Ctrl-C -----------------------------------------------------------------
+
+
+def test_step_releases_the_gil(erodem, tujunga):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", config=small_config(tujunga, steps=100000))
+    counter = [0]
+    t = threading.Thread(target=sim.step, args=(400,))
+    t.start()
+    while t.is_alive():
+        counter[0] += 1
+    t.join()
+    print("main thread loop iterations while step(400) ran: %d" % counter[0])
+    assert sim.steps_done == 400
+    assert counter[0] > 1000
+
+
+CTRL_C_SCRIPT = textwrap.dedent(
+    """
+    import sys, erodem
+    sim = erodem.Simulation(erodem.read_dem(sys.argv[1], window=[0, 0, 512, 512]),
+                            backend="cpu", time__steps=10**7, rain__rate="50 mm/h",
+                            output__every=100000, numerics__threads=1)
+    print("running", flush=True)
+    sim.run(output=sys.argv[2])
+    """
+)
+
+
+def test_ctrl_c_stops_a_run_cleanly(erodem, tujunga, tmp_path):
+    script = tmp_path / "long_run.py"
+    script.write_text(CTRL_C_SCRIPT)
+    out = tmp_path / "long.h5"
+    p = subprocess.Popen([sys.executable, str(script), tujunga, str(out)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env=dict(os.environ))
+    assert p.stdout.readline().strip() == "running"
+    time.sleep(2.0)
+    sent = time.perf_counter()
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    latency = time.perf_counter() - sent
+    print("exit %d %.2f s after SIGINT; stderr tail: %s" % (p.returncode, latency, err.strip().splitlines()[-1]))
+    assert "KeyboardInterrupt" in err
+    assert p.returncode != 0
+    assert latency < 10.0
+    partial = tmp_path / ".long.h5.partial"
+    assert not out.exists() and partial.exists()
+    with h5py.File(partial, "r") as f:
+        steps = len(f["diagnostics"]["time"])
+        times = f["time"][:]
+        print("partial file: %d snapshots at t = %s, %d diagnostics rows" % (len(times), times, steps))
+        assert len(times) == 2 and times[0] == 0.0 and times[1] > 0.0
+        assert steps >= 1 and np.isfinite(f["water_depth"][1]).any()
+
+
+STEP_CTRL_C_SCRIPT = textwrap.dedent(
+    """
+    import sys, erodem
+    sim = erodem.Simulation(erodem.read_dem(sys.argv[1], window=[0, 0, 512, 512]),
+                            backend="cpu", time__steps=10**7, rain__rate="50 mm/h",
+                            numerics__threads=1)
+    print("running", flush=True)
+    try:
+        sim.step(10**7)
+    except KeyboardInterrupt:
+        n = sim.steps_done
+        sim.step(1)  # the state is consistent: the simulation goes on
+        print("interrupted", n, sim.steps_done, sim.ledger["relative_closure_error"], flush=True)
+    """
+)
+
+
+def test_ctrl_c_interrupts_step_between_steps(erodem, tujunga, tmp_path):
+    script = tmp_path / "long_step.py"
+    script.write_text(STEP_CTRL_C_SCRIPT)
+    p = subprocess.Popen([sys.executable, str(script), tujunga], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+    assert p.stdout.readline().strip() == "running"
+    time.sleep(1.5)
+    sent = time.perf_counter()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    latency = time.perf_counter() - sent
+    print("exit %d %.2f s after SIGINT: %s" % (p.returncode, latency, out.strip()))
+    assert p.returncode == 0, err
+    word, before, after, closure = out.split()
+    assert word == "interrupted" and int(after) == int(before) + 1 and int(before) >= 1
+    assert abs(float(closure)) < 1e-5
+    assert latency < 10.0

@@ -1,0 +1,93 @@
+"""erodem.sweep: worker processes and a dask LocalCluster give the serial results; a failing
+member is reported in its row."""
+
+import os
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from test_api import WINDOW, small_config
+
+METRICS = ["eroded_volume", "deposited_volume", "outflow_volume", "max_depth", "closure_error"]
+
+
+def sweep_args(tujunga):
+    cfg = small_config(tujunga, steps=120)
+    del cfg["dem"], cfg["numerics"]
+    grid = {"erosion.sediment_capacity": [0.02, 0.1], "rain__rate": ["40 mm/h", "120 mm/h"]}
+    return cfg, grid
+
+
+def assert_same_tables(a, b):
+    assert list(a["member"]) == list(b["member"])
+    for col in METRICS + ["steps", "time"]:
+        assert np.array_equal(a[col].to_numpy(), b[col].to_numpy()), col
+    for pa, pb in zip(a["output"], b["output"]):
+        with h5py.File(pa, "r") as fa, h5py.File(pb, "r") as fb:
+            for f in ("bed", "water_depth", "sediment", "erosion"):
+                assert np.array_equal(fa[f][:], fb[f][:], equal_nan=True), (pa, f)
+
+
+def test_sweep_two_workers_match_serial(erodem, tujunga, tmp_path):
+    cfg, grid = sweep_args(tujunga)
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    t0 = time.perf_counter()
+    # one thread in the serial run too: a shared 2-core machine makes 2 OpenMP threads slow
+    serial = erodem.sweep(dem, grid=grid, config=cfg, workers=1, threads=1,
+                          output_dir=tmp_path / "serial")
+    t_serial = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    par = erodem.sweep(dem, grid=grid, config=cfg, workers=2, output_dir=tmp_path / "par")
+    t_par = time.perf_counter() - t0
+    print(par[["member", "erosion.sediment_capacity", "rain.rate"] + METRICS + ["wall_time"]].to_string())
+    print("4 members: serial %.2f s, 2 workers %.2f s (process start included)" % (t_serial, t_par))
+    assert len(par) == 4 and (par["error"] == "").all(), par["error"].tolist()
+    assert list(par["rain.rate"]) == ["40 mm/h", "120 mm/h"] * 2
+    assert (par["eroded_volume"] > 0).all() and (par["steps"] == 120).all()
+    assert (par["closure_error"].abs() < 1e-4).all()
+    # more rain, more erosion (same capacity)
+    assert par["eroded_volume"][1] > par["eroded_volume"][0]
+    assert all(os.path.exists(p) for p in par["output"])
+    assert_same_tables(serial, par)
+
+
+def test_failed_member_is_reported_in_its_row(erodem, tujunga, tmp_path):
+    cfg, _ = sweep_args(tujunga)
+    members = [
+        {"erosion.sediment_capacity": 0.05},
+        {"erosion.sediment_capacity": -1.0},  # out of range
+        {"time.adaptive": False, "time.dt": 1000.0},  # violates the CFL bound: unstable
+    ]
+    table = erodem.sweep(erodem.read_dem(tujunga, window=WINDOW), params=members, config=cfg,
+                         workers=2, output_dir=tmp_path)
+    for e in table["error"]:
+        print("error:", e or "(none)")
+    assert table["error"][0] == "" and table["eroded_volume"][0] > 0
+    assert "ValueError" in table["error"][1] and "erosion.sediment_capacity" in table["error"][1]
+    assert np.isnan(table["eroded_volume"][1]) and table["output"][1] == ""
+    assert "UnstableError" in table["error"][2] and "step 1" in table["error"][2]
+    with pytest.raises(ValueError, match="grid"):
+        erodem.sweep(tujunga, grid={"rain.rate": []}, output_dir=tmp_path)
+
+
+def test_sweep_on_dask_local_cluster(erodem, tujunga, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    cfg, grid = sweep_args(tujunga)
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    serial = erodem.sweep(dem, grid=grid, config=cfg, workers=1, threads=1,
+                          output_dir=tmp_path / "serial")
+    t0 = time.perf_counter()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        t_start = time.perf_counter() - t0
+        table = erodem.sweep(dem, grid=grid, config=cfg, client=client,
+                             output_dir=tmp_path / "dask")
+        workers = sorted(client.scheduler_info()["workers"])
+    print("dask: cluster start %.2f s, sweep + start %.2f s on %d workers"
+          % (t_start, time.perf_counter() - t0, len(workers)))
+    assert len(workers) == 2
+    assert (table["error"] == "").all(), table["error"].tolist()
+    assert_same_tables(serial, table)
