@@ -66,8 +66,10 @@ Params bench_params() {
 //   boundary     boundary_fill_cell (boundary.h), cpu/boundary.cpp: halo cells only
 //   sources      rain_cell (sources.h), run_sources: reads kind, depth, rain_factor;
 //                writes depth (points only when it does not rain: nothing per cell)
-//   flow         flow_local_inertial_cell (flow.h), run_flow: reads kind, bed, depth,
-//                manning, 4 fluxes; writes 4 new fluxes. Pipes: no manning.
+//   flow         local_inertial_face + local_inertial_split (flow.h), run_flow: reads
+//                kind, bed, depth, manning, 4 fluxes; writes 4 new fluxes (the CPU keeps
+//                the face discharges in row buffers; the OpenCL face pass also writes and
+//                reads two face fields, 16 B/cell not counted). Pipes: no manning.
 //   water        water_update_cell (water.h), run_water: reads kind, depth, 4 fluxes;
 //                writes depth_next, velocity_x, velocity_y
 //   erosion      erosion_cell (erosion.h), run_erosion: reads kind, bed, sediment, depth,
@@ -83,8 +85,8 @@ Params bench_params() {
 //                depth, wetness; writes depth (when the rate > 0), wetness
 //   stats        CpuBackend::stats, cell_state_ok (stats.h): reads kind, bed, depth,
 //                sediment, velocity_x, velocity_y; the driver runs it after every step
-// The OpenCL backend moves the same fields, plus per-cell scratch tallies that its
-// reductions sum (water, transport, evaporation), not counted here.
+// The OpenCL backend moves the same fields, plus the face fields of its local-inertial face
+// pass and per-group partial tallies (water, transport, evaporation), not counted here.
 struct BytesPerCell {
   int read = 0, write = 0;
   const char* reads;

@@ -499,6 +499,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     flux_[k] = upload(zeros);
     flux_next_[k] = upload(zeros);
   }
+  face_x_ = upload(zeros);
+  face_y_ = upload(zeros);
   velocity_x_ = upload(zeros);
   velocity_y_ = upload(zeros);
   thermal_share_ = upload(zeros);
@@ -530,9 +532,11 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // fixed order).
   const bool cpu = rt_->info.type == "CPU";
   std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
-  for (const char* name : {"sources_rain", "flow_pipes", "flow_local_inertial", "water_update",
-                           "erosion", "transport_conservative", "transport_semi_lagrangian",
-                           "thermal_share", "thermal_apply", "evaporation"}) {
+  for (const char* name :
+       {"sources_rain", "flow_pipes", "flow_local_inertial_faces",
+        "flow_local_inertial_faces_interior", "flow_local_inertial_split",
+        "flow_local_inertial_split_interior", "water_update", "erosion", "transport_conservative",
+        "transport_semi_lagrangian", "thermal_share", "thermal_apply", "evaporation"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -581,6 +585,15 @@ void OpenClBackend::launch_cells(cl_kernel k) {
   const std::size_t global[2] = {groups_x_ * local_x_, groups_y_ * local_y_};
   const std::size_t local[2] = {local_x_, local_y_};
   check(clEnqueueNDRangeKernel(queue_.get(), k, 2, nullptr, global, local, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel");
+}
+
+void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1) {
+  if (y1 <= y0) return;
+  const std::size_t offset[2] = {0, static_cast<std::size_t>(y0)};
+  const std::size_t global[2] = {groups_x_ * local_x_, static_cast<std::size_t>(y1 - y0)};
+  const std::size_t local[2] = {local_x_, 1};
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel");
 }
 
@@ -756,12 +769,23 @@ void OpenClBackend::run_flow(Real dt) {
              static_cast<Real>(f.pipe_area), static_cast<Real>(f.pipe_length));
     launch_cells(k);
   } else {
-    cl_kernel k = kernel("flow_local_inertial");
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_, area_, flux_[0],
-             flux_[1], flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2],
-             flux_next_[3], dt, g, static_cast<Real>(f.theta),
-             static_cast<Real>(params_.numerics.dry_depth));
-    launch_cells(k);
+    // Each face once (face pass), then split into the cells' outflows (cell pass); the
+    // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
+    // edge rows by the general ones. H >= 3.
+    const Real theta = static_cast<Real>(f.theta),
+               dry = static_cast<Real>(params_.numerics.dry_depth);
+    for (const char* name : {"flow_local_inertial_faces_interior", "flow_local_inertial_faces"})
+      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
+               flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, g, theta, dry);
+    launch_rows(kernel("flow_local_inertial_faces_interior"), 1, H_ - 2);
+    launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
+    launch_rows(kernel("flow_local_inertial_faces"), H_ - 2, H_);
+    for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
+      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_,
+               flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], dt);
+    launch_rows(kernel("flow_local_inertial_split_interior"), 1, H_ - 1);
+    launch_rows(kernel("flow_local_inertial_split"), 0, 1);
+    launch_rows(kernel("flow_local_inertial_split"), H_ - 1, H_);
   }
   std::swap(flux_, flux_next_);
 }

@@ -15,8 +15,10 @@
 #define ERODEM_KERNELS_COMMON_COMPAT_H
 
 #ifdef __OPENCL_C_VERSION__
-#define ERODEM_FN static inline
-#define ERODEM_INLINE static inline
+/* always_inline: PoCL (LLVM) otherwise keeps the larger cell functions as calls, and a
+ * work-item loop with a call in it is not vectorised */
+#define ERODEM_FN static inline __attribute__((always_inline))
+#define ERODEM_INLINE static inline __attribute__((always_inline))
 #define GLOBAL __global
 #define ERODEM_EPSILON(T) ((T)FLT_EPSILON)
 #define ERODEM_BEGIN_NAMESPACE
@@ -84,29 +86,47 @@ inline float erodem_bits_float(unsigned int b) {
 #endif
 
 ERODEM_BEGIN_NAMESPACE
+/* u / 3 rounded down, exactly, for every 32-bit u, with shifts, adds and 32-bit multiplies
+ * only (GCC does not vectorise the integer division on x86-64): 2^16 = 3 * 21845 + 1 and
+ * 2^8 = 3 * 85 + 1 fold u into n < 768 with u = 3 (21845 h + 85 m_h) + n, and
+ * n / 3 = (683 n) >> 11 for n < 2048. */
+ERODEM_INLINE unsigned int erodem_div3(unsigned int u) {
+  const unsigned int h = u >> 16, m = h + (u & 0xffffu);
+  const unsigned int m_h = m >> 8, n = m_h + (m & 0xffu);
+  return h * 21845u + m_h * 85u + ((n * 683u) >> 11);
+}
+
+/* Cube root of a positive, finite x (NaN gives NaN): the body of cbrt_f32 without its
+ * special cases, branch-free, so loops over cells vectorise. */
+ERODEM_INLINE float cbrt_f32_positive(float x) {
+  /* keep y^3 clear of underflow (x by 2^72, the root by 2^-24) and of overflow (x by
+   * 2^-72, the root by 2^24); the scalings by powers of two are exact */
+  const int tiny = x<1.0e-30f, huge = x> 1.0e30f;
+  const float xs = x * (tiny ? 4722366482869645213696.0f : huge ? 2.1175823681357508e-22f : 1.0f);
+  const float scale = tiny ? 5.9604644775390625e-08f : huge ? 16777216.0f : 1.0f;
+  float y = erodem_bits_float(erodem_div3(erodem_float_bits(xs)) + 709958130u); /* ~3 % */
+  /* three Halley steps, written out: PoCL does not vectorise a work-item loop that holds
+   * an inner loop */
+  float y3 = y * y * y;
+  y = y - y * ((y3 - xs) / (y3 + y3 + xs));
+  y3 = y * y * y;
+  y = y - y * ((y3 - xs) / (y3 + y3 + xs));
+  y3 = y * y * y;
+  y = y - y * ((y3 - xs) / (y3 + y3 + xs));
+  return y * scale;
+}
+
 ERODEM_INLINE float cbrt_f32(float a) {
   const float x = fabs(a);
   if (!(x > 0.0f) || !isfinite(x)) return a; /* 0, inf and NaN as they are */
-  float xs = x, scale = 1.0f;
-  if (xs < 1.0e-30f) { /* keep y^3 clear of underflow: x by 2^72, the root by 2^-24 */
-    xs = xs * 4722366482869645213696.0f;
-    scale = 5.9604644775390625e-08f;
-  } else if (xs > 1.0e30f) { /* and of overflow: x by 2^-72, the root by 2^24 */
-    xs = xs * 2.1175823681357508e-22f;
-    scale = 16777216.0f;
-  }
-  float y = erodem_bits_float(erodem_float_bits(xs) / 3u + 709958130u); /* within ~3 % */
-  for (int k = 0; k < 3; ++k) {
-    const float y3 = y * y * y;
-    y = y - y * ((y3 - xs) / (y3 + y3 + xs));
-  }
-  y = y * scale;
+  const float y = cbrt_f32_positive(x);
   return a < 0.0f ? -y : y;
 }
 ERODEM_END_NAMESPACE
 
 #ifdef __OPENCL_C_VERSION__
 #define erodem_cbrt(x) cbrt_f32(x)
+#define erodem_cbrt_positive(x) cbrt_f32_positive(x)
 #else
 namespace erodem {
 namespace cell {
@@ -114,6 +134,14 @@ inline float erodem_cbrt(float x) {
   return cbrt_f32(x);
 }
 inline double erodem_cbrt(double x) {
+  return std::cbrt(x);
+}
+/* The cube root of a positive, finite x: cbrt_f32_positive for float (the same bits as
+ * erodem_cbrt there), the C library's cbrt for double. */
+inline float erodem_cbrt_positive(float x) {
+  return cbrt_f32_positive(x);
+}
+inline double erodem_cbrt_positive(double x) {
   return std::cbrt(x);
 }
 }  // namespace cell

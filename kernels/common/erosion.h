@@ -15,14 +15,18 @@ ERODEM_FN real bed_tilt_sin(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   const int has_r = kind[i + 1] == ERODEM_CELL_ACTIVE;
   const int has_t = kind[i - W] == ERODEM_CELL_ACTIVE;
   const int has_b = kind[i + W] == ERODEM_CELL_ACTIVE;
-  const real b_l = has_l ? bed[i - 1] : bed[i];
-  const real b_r = has_r ? bed[i + 1] : bed[i];
-  const real b_t = has_t ? bed[i - W] : bed[i];
-  const real b_b = has_b ? bed[i + W] : bed[i];
+  /* every load unconditional and every choice a select: branch-free, so loops vectorise */
+  const real b_c = bed[i], b_w = bed[i - 1], b_e = bed[i + 1], b_n = bed[i - W], b_s = bed[i + W];
+  const real b_l = has_l ? b_w : b_c;
+  const real b_r = has_r ? b_e : b_c;
+  const real b_t = has_t ? b_n : b_c;
+  const real b_b = has_b ? b_s : b_c;
   const real span_x = (real)(has_l + has_r) * dx[y];
   const real span_y = (real)(has_t + has_b) * dy[y];
-  const real gx = span_x > 0 ? (b_r - b_l) / span_x : (real)0;
-  const real gy = span_y > 0 ? (b_b - b_t) / span_y : (real)0;
+  const real gx_raw = (b_r - b_l) / (span_x > 0 ? span_x : (real)1);
+  const real gy_raw = (b_b - b_t) / (span_y > 0 ? span_y : (real)1);
+  const real gx = span_x > 0 ? gx_raw : (real)0;
+  const real gy = span_y > 0 ? gy_raw : (real)0;
   const real tan2 = gx * gx + gy * gy;
   return sqrt(tan2 / ((real)1 + tan2));
 }
@@ -33,21 +37,25 @@ ERODEM_FN real bed_tilt_sin(int x, int y, int W, GLOBAL const erodem_kind_t* kin
  * (m) > 0, else 1. */
 ERODEM_FN real transport_capacity(real capacity_k, real tilt_sin, real min_tilt, real speed,
                                   real depth, real min_depth) {
-  const real limiter = min_depth > 0 ? fmin((real)1, depth / min_depth) : (real)1;
-  return capacity_k * fmax(tilt_sin, min_tilt) * speed * limiter;
+  const int limited = min_depth > 0;
+  const real ratio = depth / (limited ? min_depth : (real)1);
+  const real limiter = limited & (ratio < (real)1) ? ratio : (real)1;
+  return capacity_k * (tilt_sin > min_tilt ? tilt_sin : min_tilt) * speed * limiter;
 }
 
 /* Erosion / deposition of active padded cell (x, y). If C > s, erode
  * min(1, K_s R dt) (C - s) from bed into suspension, never below `bedrock` (m); else
- * deposit min(1, K_d dt) (s - C). Reads bed (for the tilt) and writes bed_out; updates
- * sediment in place (only this cell's). Rates K_s, K_d (1/s); hardness R in [0, 1]. */
-ERODEM_FN void erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                            GLOBAL const real* bed, GLOBAL real* bed_out, GLOBAL real* sediment,
+ * deposit min(1, K_d dt) (s - C). Reads bed (for the tilt); returns the new bed (m) and
+ * writes the new suspended sediment (m) through *sediment_out. Rates K_s, K_d (1/s);
+ * hardness R in [0, 1]. Branch-free (both cases evaluated, one selected), so loops over
+ * cells vectorise. */
+ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                            GLOBAL const real* bed, GLOBAL const real* sediment,
                             GLOBAL const real* depth, GLOBAL const real* velocity_x,
                             GLOBAL const real* velocity_y, GLOBAL const real* hardness,
                             GLOBAL const real* dx, GLOBAL const real* dy, real dt, real capacity_k,
                             real dissolving_rate, real deposition_rate, real min_tilt,
-                            real min_depth, real bedrock) {
+                            real min_depth, real bedrock, real* sediment_out) {
   const int i = x + y * W;
   const real u = velocity_x[i];
   const real v = velocity_y[i];
@@ -55,16 +63,16 @@ ERODEM_FN void erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   const real tilt = bed_tilt_sin(x, y, W, kind, bed, dx, dy);
   const real capacity = transport_capacity(capacity_k, tilt, min_tilt, speed, depth[i], min_depth);
   const real s = sediment[i];
-  real b = bed[i];
-  real moved;
-  if (capacity > s) {
-    moved = fmin((real)1, dissolving_rate * hardness[i] * dt) * (capacity - s);
-    moved = fmin(moved, fmax((real)0, b - bedrock));
-  } else {
-    moved = -fmin((real)1, deposition_rate * dt) * (s - capacity);
-  }
-  bed_out[i] = b - moved;
-  sediment[i] = s + moved;
+  const real b = bed[i];
+  const real k_erode = dissolving_rate * hardness[i] * dt;
+  const real erode = (k_erode < (real)1 ? k_erode : (real)1) * (capacity - s);
+  const real above_rock = b - bedrock > 0 ? b - bedrock : (real)0;
+  const real eroded = erode < above_rock ? erode : above_rock;
+  const real k_deposit = deposition_rate * dt;
+  const real deposited = -(k_deposit < (real)1 ? k_deposit : (real)1) * (s - capacity);
+  const real moved = capacity > s ? eroded : deposited;
+  *sediment_out = s + moved;
+  return b - moved;
 }
 
 ERODEM_END_NAMESPACE

@@ -19,26 +19,28 @@ ERODEM_INLINE int kind_at(GLOBAL const erodem_kind_t* kind, int x, int y, int W,
   return (x < 0 || y < 0 || x >= W || y >= H) ? ERODEM_CELL_WALL : (int)kind[x + y * W];
 }
 
-/* Whether a cell of kind `from` gives water to a neighbour of kind `to`. Active cells give
- * to anything but walls; fixed-level ghosts give to active cells; walls and open ghosts
- * give nothing. */
+/* Whether a cell of kind `from` gives water to a neighbour of kind `to` (1 or 0). Active
+ * cells give to anything but walls; fixed-level ghosts give to active cells; walls and open
+ * ghosts give nothing. Branch-free (bitwise), so cell loops vectorise. */
 ERODEM_INLINE int gives_water(int from, int to) {
-  if (from == ERODEM_CELL_ACTIVE) return to != ERODEM_CELL_WALL;
-  if (from == ERODEM_CELL_FIXED) return to == ERODEM_CELL_ACTIVE;
-  return 0;
+  return ((from == ERODEM_CELL_ACTIVE) & (to != ERODEM_CELL_WALL)) |
+         ((from == ERODEM_CELL_FIXED) & (to == ERODEM_CELL_ACTIVE));
 }
 
-/* Whether any water crosses the face between kinds a and b. */
+/* Whether any water crosses the face between kinds a and b (1 or 0). */
 ERODEM_INLINE int face_open(int a, int b) {
-  return gives_water(a, b) || gives_water(b, a);
+  return gives_water(a, b) | gives_water(b, a);
 }
 
 /* Scale factor K of Mei et al. (2007): a cell holding `depth` (m) over `cell_area` (m^2)
- * gives at most what it holds in one step of `dt` (s) at total outflow `total_out` (m^3/s). */
+ * gives at most what it holds in one step of `dt` (s) at total outflow `total_out` (m^3/s).
+ * Branch-free: the division runs on a safe denominator and the result is selected. */
 ERODEM_FN real outflow_limit(real depth, real cell_area, real total_out, real dt) {
   const real demand = total_out * dt;
   const real held = depth * cell_area;
-  return demand > held ? held / demand : (real)1;
+  const int limited = demand > held;
+  const real ratio = held / (limited ? demand : (real)1);
+  return limited ? ratio : (real)1;
 }
 
 /* ---- pipes (Mei, Decaudin & Hu 2007) ------------------------------------------------ */
@@ -98,6 +100,18 @@ ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_k
 }
 
 /* ---- local inertial (Bates et al. 2010, de Almeida et al. 2012) ---------------------- */
+/* The discharge is a face quantity: each face is computed once (local_inertial_face), from
+ * the outflows of the previous step, and then split into the outflows of the cells beside it
+ * and limited (local_inertial_split). The CPU loop (kernels/cpu/flow.cpp) computes a row of
+ * faces at a time; the OpenCL kernels (kernels/opencl/flow.cl) a face pass and a cell pass.
+ * Both evaluate the same expressions on the same numbers, so they agree bit for bit. */
+
+/* Discharge per unit width (m^2/s) across a face at the old time, from the outflow of the
+ * cell before it towards the cell after it, out_ab, the outflow back, out_ba (m^3/s), and
+ * the face width (m). */
+ERODEM_FN real face_unit_discharge(real out_ab, real out_ba, real width) {
+  return (out_ab - out_ba) / width;
+}
 
 /* New discharge per unit width q (m^2/s) across one face, positive from a to b:
  *   q <- (theta q + (1 - theta)/2 (q_up + q_down) - g h_f dt (eta_b - eta_a) / dist)
@@ -105,97 +119,203 @@ ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_k
  * q, q_up, q_down: this face and its two neighbours in the same direction at the old time
  * (m^2/s); eta, b: water surface and bed of both cells (m); n: Manning n of the face
  * (s m^-1/3); dist between cell centres (m); dt (s); gravity (m/s^2); theta in [0, 1];
- * faces with h_f <= dry_depth (m) carry nothing. */
+ * faces with h_f <= dry_depth (m) carry nothing. Branch-free: a dry face is evaluated on
+ * h_f = 1 and its result replaced by 0. */
 ERODEM_FN real local_inertial_q(real q, real q_up, real q_down, real eta_a, real eta_b, real b_a,
                                 real b_b, real n, real dist, real dt, real gravity, real theta,
                                 real dry_depth) {
-  const real h_f = fmax(eta_a, eta_b) - fmax(b_a, b_b);
-  if (!(h_f > dry_depth)) return (real)0;
+  const real h_raw = (eta_a > eta_b ? eta_a : eta_b) - (b_a > b_b ? b_a : b_b);
+  const int wet = h_raw > dry_depth;
+  const real h_f = wet ? h_raw : (real)1;
   const real numerator = theta * q + ((real)1 - theta) * (real)0.5 * (q_up + q_down) -
                          gravity * h_f * dt * (eta_b - eta_a) / dist;
-  const real h_f_7_3 = h_f * h_f * erodem_cbrt(h_f);
+  const real h_f_7_3 = h_f * h_f * erodem_cbrt_positive(h_f); /* h_f > 0 */
   const real denominator = (real)1 + gravity * dt * n * n * fabs(q) / h_f_7_3;
-  return numerator / denominator;
+  const real q_new = numerator / denominator;
+  return wet ? q_new : (real)0;
 }
 
-/* Discharge (m^3/s) across the face between (x, y) and (x + 1, y), positive eastwards. */
+/* Discharge (m^3/s) across one face, positive from cell a to cell b, from the unit
+ * discharges of the previous step: q of this face, q_up of the face before a and q_down of
+ * the face after b (m^2/s), each used when the cell beyond is no wall (up_open, down_open;
+ * else q stands in). open: whether water crosses the face at all (face_open). Surfaces
+ * eta = bed + depth and beds b (m), Manning n of both cells (s m^-1/3), face width and
+ * distance between the cell centres (m), dt (s), gravity (m/s^2), theta (1), dry_depth (m). */
+ERODEM_FN real local_inertial_face(int open, int up_open, int down_open, real q, real q_up,
+                                   real q_down, real eta_a, real eta_b, real b_a, real b_b,
+                                   real n_a, real n_b, real width, real dist, real dt, real gravity,
+                                   real theta, real dry_depth) {
+  const real n = (real)0.5 * (n_a + n_b);
+  const real discharge =
+      width * local_inertial_q(q, up_open ? q_up : q, down_open ? q_down : q, eta_a, eta_b, b_a,
+                               b_b, n, dist, dt, gravity, theta, dry_depth);
+  return open ? discharge : (real)0;
+}
+
+/* Discharge (m^3/s) across the face from padded cell a to padded cell b (the OpenCL face
+ * pass): out_ab, out_ba are the outflow fields towards b and back (f_right, f_left or
+ * f_bottom, f_top); `up` is the cell before a and `down` the cell after b in the same
+ * direction (any index inside the raster where up_open / down_open is 0); width_up, width,
+ * width_down the widths of the faces up-a, a-b, b-down and dist the distance a-b (m). */
+ERODEM_FN real local_inertial_face_at(int a, int b, int up, int down, int up_open, int down_open,
+                                      real width_up, real width, real width_down, real dist,
+                                      GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
+                                      GLOBAL const real* depth, GLOBAL const real* manning,
+                                      GLOBAL const real* out_ab, GLOBAL const real* out_ba, real dt,
+                                      real gravity, real theta, real dry_depth) {
+  return local_inertial_face(face_open(kind[a], kind[b]), up_open, down_open,
+                             face_unit_discharge(out_ab[a], out_ba[b], width),
+                             face_unit_discharge(out_ab[up], out_ba[a], width_up),
+                             face_unit_discharge(out_ab[b], out_ba[down], width_down),
+                             bed[a] + depth[a], bed[b] + depth[b], bed[a], bed[b], manning[a],
+                             manning[b], width, dist, dt, gravity, theta, dry_depth);
+}
+
+/* Discharge (m^3/s) across the face between padded cells (x, y) and (x + 1, y), positive
+ * eastwards, in a row 1 <= y <= H - 2, for 0 <= x <= W - 2 (any value for x = W - 1: no such
+ * face). Every index it reads lies inside the raster in these rows, so it reads without
+ * clamping (consecutive loads across x, which OpenCL CPU compilers vectorise), masking the
+ * edge columns by x. */
+ERODEM_FN real local_inertial_face_x_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                              GLOBAL const real* bed, GLOBAL const real* depth,
+                                              GLOBAL const real* manning, GLOBAL const real* dx,
+                                              GLOBAL const real* dy, GLOBAL const real* f_left,
+                                              GLOBAL const real* f_right, real dt, real gravity,
+                                              real theta, real dry_depth) {
+  const real width = dy[y];
+  const int a = x + y * W; /* a - 1 >= 0 and a + 2 < W * H */
+  return local_inertial_face_at(
+      a, a + 1, a - 1, a + 2, (x >= 1) & (kind[a - 1] != ERODEM_CELL_WALL),
+      (x + 2 <= W - 1) & (kind[a + 2] != ERODEM_CELL_WALL), width, width, width, dx[y], kind, bed,
+      depth, manning, f_right, f_left, dt, gravity, theta, dry_depth);
+}
+
+/* The same for any row 0 <= y <= H - 1: rows 0 and H - 1 clamp their indices. */
 ERODEM_FN real local_inertial_face_x(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
                                      GLOBAL const real* bed, GLOBAL const real* depth,
                                      GLOBAL const real* manning, GLOBAL const real* dx,
                                      GLOBAL const real* dy, GLOBAL const real* f_left,
                                      GLOBAL const real* f_right, real dt, real gravity, real theta,
                                      real dry_depth) {
-  if (!face_open(kind_at(kind, x, y, W, H), kind_at(kind, x + 1, y, W, H))) return (real)0;
-  const int a = x + y * W;
-  const int b = a + 1;
+  if (y >= 1 && y <= H - 2)
+    return local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_left,
+                                          f_right, dt, gravity, theta, dry_depth);
   const real width = dy[y];
-  const real q = (f_right[a] - f_left[b]) / width;
-  const real q_up =
-      kind_at(kind, x - 1, y, W, H) != ERODEM_CELL_WALL ? (f_right[a - 1] - f_left[a]) / width : q;
-  const real q_down =
-      kind_at(kind, x + 2, y, W, H) != ERODEM_CELL_WALL ? (f_right[b] - f_left[b + 1]) / width : q;
-  const real n = (real)0.5 * (manning[a] + manning[b]);
-  return width * local_inertial_q(q, q_up, q_down, bed[a] + depth[a], bed[b] + depth[b], bed[a],
-                                  bed[b], n, dx[y], dt, gravity, theta, dry_depth);
+  const int xc = x <= W - 2 ? x : W - 2;
+  const int a = xc + y * W;
+  return local_inertial_face_at(a, a + 1, xc >= 1 ? a - 1 : a, xc + 2 <= W - 1 ? a + 2 : a + 1,
+                                kind_at(kind, xc - 1, y, W, H) != ERODEM_CELL_WALL,
+                                kind_at(kind, xc + 2, y, W, H) != ERODEM_CELL_WALL, width, width,
+                                width, dx[y], kind, bed, depth, manning, f_right, f_left, dt,
+                                gravity, theta, dry_depth);
 }
 
-/* Discharge (m^3/s) across the face between (x, y) and (x, y + 1), positive southwards. */
+/* Discharge (m^3/s) across the face between padded cells (x, y) and (x, y + 1), positive
+ * southwards, in a row 1 <= y <= H - 3 (every index inside the raster: no clamping). */
+ERODEM_FN real local_inertial_face_y_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                              GLOBAL const real* bed, GLOBAL const real* depth,
+                                              GLOBAL const real* manning, GLOBAL const real* dx,
+                                              GLOBAL const real* dy, GLOBAL const real* f_top,
+                                              GLOBAL const real* f_bottom, real dt, real gravity,
+                                              real theta, real dry_depth) {
+  const int a = x + y * W; /* a - W >= 0 and a + 2 W < W * H */
+  return local_inertial_face_at(a, a + W, a - W, a + 2 * W, kind[a - W] != ERODEM_CELL_WALL,
+                                kind[a + 2 * W] != ERODEM_CELL_WALL,
+                                (real)0.5 * (dx[y - 1] + dx[y]), (real)0.5 * (dx[y] + dx[y + 1]),
+                                (real)0.5 * (dx[y + 1] + dx[y + 2]),
+                                (real)0.5 * (dy[y] + dy[y + 1]), kind, bed, depth, manning,
+                                f_bottom, f_top, dt, gravity, theta, dry_depth);
+}
+
+/* The same for any row 0 <= y <= H - 1 (any value for y = H - 1: no such face); rows 0,
+ * H - 2 and H - 1 clamp their indices. */
 ERODEM_FN real local_inertial_face_y(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
                                      GLOBAL const real* bed, GLOBAL const real* depth,
                                      GLOBAL const real* manning, GLOBAL const real* dx,
                                      GLOBAL const real* dy, GLOBAL const real* f_top,
                                      GLOBAL const real* f_bottom, real dt, real gravity, real theta,
                                      real dry_depth) {
-  if (!face_open(kind_at(kind, x, y, W, H), kind_at(kind, x, y + 1, W, H))) return (real)0;
-  const int a = x + y * W;
-  const int b = a + W;
-  const real width = (real)0.5 * (dx[y] + dx[y + 1]);
-  const real dist = (real)0.5 * (dy[y] + dy[y + 1]);
-  const real q = (f_bottom[a] - f_top[b]) / width;
-  const real q_up = kind_at(kind, x, y - 1, W, H) != ERODEM_CELL_WALL
-                        ? (f_bottom[a - W] - f_top[a]) / ((real)0.5 * (dx[y - 1] + dx[y]))
-                        : q;
-  const real q_down = kind_at(kind, x, y + 2, W, H) != ERODEM_CELL_WALL
-                          ? (f_bottom[b] - f_top[b + W]) / ((real)0.5 * (dx[y + 1] + dx[y + 2]))
-                          : q;
-  const real n = (real)0.5 * (manning[a] + manning[b]);
-  return width * local_inertial_q(q, q_up, q_down, bed[a] + depth[a], bed[b] + depth[b], bed[a],
-                                  bed[b], n, dist, dt, gravity, theta, dry_depth);
+  if (y >= 1 && y <= H - 3)
+    return local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_top,
+                                          f_bottom, dt, gravity, theta, dry_depth);
+  const int yc = y <= H - 2 ? y : H - 2;
+  const int a = x + yc * W;
+  const int y_up = yc >= 1 ? yc - 1 : yc;           /* clamped: unused at the edge */
+  const int y_down = yc + 2 <= H - 1 ? yc + 1 : yc; /* clamped: unused at the edge */
+  return local_inertial_face_at(
+      a, a + W, x + y_up * W, x + (y_down + 1) * W,
+      kind_at(kind, x, yc - 1, W, H) != ERODEM_CELL_WALL,
+      kind_at(kind, x, yc + 2, W, H) != ERODEM_CELL_WALL, (real)0.5 * (dx[y_up] + dx[y_up + 1]),
+      (real)0.5 * (dx[yc] + dx[yc + 1]), (real)0.5 * (dx[y_down] + dx[y_down + 1]),
+      (real)0.5 * (dy[yc] + dy[yc + 1]), kind, bed, depth, manning, f_bottom, f_top, dt, gravity,
+      theta, dry_depth);
 }
 
-/* Local-inertial scheme for padded cell (x, y): the four faces around the cell, split into
- * this cell's outflows and limited like the pipes so no cell gives more than it holds. */
-ERODEM_FN void flow_local_inertial_cell(
-    int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
-    GLOBAL const real* depth, GLOBAL const real* manning, GLOBAL const real* dx,
-    GLOBAL const real* dy, GLOBAL const real* area, GLOBAL const real* f_left,
-    GLOBAL const real* f_right, GLOBAL const real* f_top, GLOBAL const real* f_bottom,
-    GLOBAL real* out_left, GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom,
-    real dt, real gravity, real theta, real dry_depth) {
+/* The four face discharges around a cell of kind k (m^3/s; q_left, q_top positive into the
+ * cell, q_right, q_bottom positive out of it) split into the cell's outflows, limited like
+ * the pipes so that an active cell gives no more than its depth (m) over cell_area (m^2)
+ * holds in dt (s). k_*: the neighbours' kinds. Writes the outflows (m^3/s, >= 0). */
+ERODEM_FN void local_inertial_split(int k, int k_left, int k_right, int k_top, int k_bottom,
+                                    real q_left, real q_right, real q_top, real q_bottom,
+                                    real depth, real cell_area, real dt, real* out_left,
+                                    real* out_right, real* out_top, real* out_bottom) {
+  const real fl = gives_water(k, k_left) & (-q_left > 0) ? -q_left : (real)0;
+  const real fr = gives_water(k, k_right) & (q_right > 0) ? q_right : (real)0;
+  const real ft = gives_water(k, k_top) & (-q_top > 0) ? -q_top : (real)0;
+  const real fb = gives_water(k, k_bottom) & (q_bottom > 0) ? q_bottom : (real)0;
+  const real K =
+      k == ERODEM_CELL_ACTIVE ? outflow_limit(depth, cell_area, fl + fr + ft + fb, dt) : (real)1;
+  *out_left = fl * K;
+  *out_right = fr * K;
+  *out_top = ft * K;
+  *out_bottom = fb * K;
+}
+
+/* Cell pass of the local-inertial scheme for padded cell (x, y) in a row 1 <= y <= H - 2
+ * (the OpenCL cell kernel): reads the face discharges face_x (the face east of each cell, 0
+ * in the last column) and face_y (south of each cell) of the face pass without clamping,
+ * masking the edge columns by x; writes the cell's four outflows. */
+ERODEM_FN void flow_local_inertial_cell_interior(int x, int y, int W,
+                                                 GLOBAL const erodem_kind_t* kind,
+                                                 GLOBAL const real* depth, GLOBAL const real* area,
+                                                 GLOBAL const real* face_x,
+                                                 GLOBAL const real* face_y, GLOBAL real* out_left,
+                                                 GLOBAL real* out_right, GLOBAL real* out_top,
+                                                 GLOBAL real* out_bottom, real dt) {
   const int i = x + y * W;
-  const int k = kind[i];
-  real fl = 0, fr = 0, ft = 0, fb = 0;
-  if (k == ERODEM_CELL_ACTIVE || k == ERODEM_CELL_FIXED) {
-    if (gives_water(k, kind_at(kind, x - 1, y, W, H)))
-      fl = fmax((real)0, -local_inertial_face_x(x - 1, y, W, H, kind, bed, depth, manning, dx, dy,
-                                                f_left, f_right, dt, gravity, theta, dry_depth));
-    if (gives_water(k, kind_at(kind, x + 1, y, W, H)))
-      fr = fmax((real)0, local_inertial_face_x(x, y, W, H, kind, bed, depth, manning, dx, dy,
-                                               f_left, f_right, dt, gravity, theta, dry_depth));
-    if (gives_water(k, kind_at(kind, x, y - 1, W, H)))
-      ft = fmax((real)0, -local_inertial_face_y(x, y - 1, W, H, kind, bed, depth, manning, dx, dy,
-                                                f_top, f_bottom, dt, gravity, theta, dry_depth));
-    if (gives_water(k, kind_at(kind, x, y + 1, W, H)))
-      fb = fmax((real)0, local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, dx, dy, f_top,
-                                               f_bottom, dt, gravity, theta, dry_depth));
-    if (k == ERODEM_CELL_ACTIVE) {
-      const real K = outflow_limit(depth[i], area[y], fl + fr + ft + fb, dt);
-      fl *= K;
-      fr *= K;
-      ft *= K;
-      fb *= K;
-    }
+  const real q_left = face_x[i - 1];
+  const int k_left = kind[i - 1], k_right = kind[i + 1];
+  real fl, fr, ft, fb;
+  local_inertial_split(kind[i], x >= 1 ? k_left : ERODEM_CELL_WALL,
+                       x <= W - 2 ? k_right : ERODEM_CELL_WALL, (int)kind[i - W], (int)kind[i + W],
+                       x >= 1 ? q_left : (real)0, face_x[i], face_y[i - W], face_y[i], depth[i],
+                       area[y], dt, &fl, &fr, &ft, &fb);
+  out_left[i] = fl;
+  out_right[i] = fr;
+  out_top[i] = ft;
+  out_bottom[i] = fb;
+}
+
+/* The same for any padded cell (rows 0 and H - 1 clamp their indices). */
+ERODEM_FN void flow_local_inertial_cell(int x, int y, int W, int H,
+                                        GLOBAL const erodem_kind_t* kind, GLOBAL const real* depth,
+                                        GLOBAL const real* area, GLOBAL const real* face_x,
+                                        GLOBAL const real* face_y, GLOBAL real* out_left,
+                                        GLOBAL real* out_right, GLOBAL real* out_top,
+                                        GLOBAL real* out_bottom, real dt) {
+  if (y >= 1 && y <= H - 2) {
+    flow_local_inertial_cell_interior(x, y, W, kind, depth, area, face_x, face_y, out_left,
+                                      out_right, out_top, out_bottom, dt);
+    return;
   }
+  const int i = x + y * W;
+  const real q_left = x > 0 ? face_x[x > 0 ? i - 1 : i] : (real)0;
+  const real q_top = y > 0 ? face_y[y > 0 ? i - W : i] : (real)0;
+  const real q_bottom = y < H - 1 ? face_y[i] : (real)0;
+  real fl, fr, ft, fb;
+  local_inertial_split(kind[i], kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
+                       kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H), q_left,
+                       face_x[i], q_top, q_bottom, depth[i], area[y], dt, &fl, &fr, &ft, &fb);
   out_left[i] = fl;
   out_right[i] = fr;
   out_top[i] = ft;

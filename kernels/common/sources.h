@@ -14,7 +14,8 @@ ERODEM_FN real rain_cell(real depth, real dt, real rate, real factor) {
 /* Evaporation of one active cell: d *= 1 - min(1, K_e dt). Returns the new depth and writes
  * the volume evaporated (m^3) through *lost; rate K_e (1/s), cell_area (m^2). */
 ERODEM_FN real evaporation_cell(real depth, real dt, real rate, real cell_area, real* lost) {
-  const real fraction = fmin((real)1, rate * dt);
+  const real k = rate * dt;
+  const real fraction = k < (real)1 ? k : (real)1;
   const real taken = depth * fraction;
   *lost = taken * cell_area;
   return depth - taken;
@@ -23,7 +24,8 @@ ERODEM_FN real evaporation_cell(real depth, real dt, real rate, real cell_area, 
 /* Running mean of depth with time constant tau (s): the wetness that drives mud and
  * vegetation classes (m). */
 ERODEM_FN real wetness_cell(real wetness, real depth, real dt, real tau) {
-  return wetness + (depth - wetness) * fmin((real)1, dt / tau);
+  const real k = dt / tau;
+  return wetness + (depth - wetness) * (k < (real)1 ? k : (real)1);
 }
 
 ERODEM_END_NAMESPACE

@@ -9,7 +9,8 @@ ERODEM_BEGIN_NAMESPACE
 /* Height (m) by which the bed drop from `from` to `to` over `dist` (m) exceeds the talus
  * slope tan_talus (1); 0 when it does not. */
 ERODEM_FN real talus_excess(real from, real to, real dist, real tan_talus) {
-  return fmax((real)0, from - to - dist * tan_talus);
+  const real excess = from - to - dist * tan_talus;
+  return excess > 0 ? excess : (real)0;
 }
 
 /* Pass 1, active padded cell (x, y): the volume to move,
@@ -24,19 +25,24 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real b = bed[i];
   const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
   const real dist_b = (real)0.5 * (dy[y] + dy[y + 1]);
-  const real e_l =
-      kind[i - 1] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i - 1], dx[y], tan_talus) : (real)0;
-  const real e_r =
-      kind[i + 1] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i + 1], dx[y], tan_talus) : (real)0;
-  const real e_t =
-      kind[i - W] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i - W], dist_t, tan_talus) : (real)0;
-  const real e_b =
-      kind[i + W] == ERODEM_CELL_ACTIVE ? talus_excess(b, bed[i + W], dist_b, tan_talus) : (real)0;
+  /* every load unconditional and every choice a select: branch-free, so loops vectorise */
+  const real b_l = bed[i - 1], b_r = bed[i + 1], b_t = bed[i - W], b_b = bed[i + W];
+  const real x_l = talus_excess(b, b_l, dx[y], tan_talus);
+  const real x_r = talus_excess(b, b_r, dx[y], tan_talus);
+  const real x_t = talus_excess(b, b_t, dist_t, tan_talus);
+  const real x_b = talus_excess(b, b_b, dist_b, tan_talus);
+  const real e_l = kind[i - 1] == ERODEM_CELL_ACTIVE ? x_l : (real)0;
+  const real e_r = kind[i + 1] == ERODEM_CELL_ACTIVE ? x_r : (real)0;
+  const real e_t = kind[i - W] == ERODEM_CELL_ACTIVE ? x_t : (real)0;
+  const real e_b = kind[i + W] == ERODEM_CELL_ACTIVE ? x_b : (real)0;
   const real total = e_l + e_r + e_t + e_b;
-  if (!(total > 0)) return (real)0;
-  const real e_max = fmax(fmax(e_l, e_r), fmax(e_t, e_b));
-  const real volume = fmin((real)1, rate * dt) * area[y] * e_max * (real)0.5;
-  return volume / total;
+  const int moves = total > 0;
+  const real m_lr = e_l > e_r ? e_l : e_r, m_tb = e_t > e_b ? e_t : e_b;
+  const real e_max = m_lr > m_tb ? m_lr : m_tb;
+  const real k = rate * dt;
+  const real volume = (k < (real)1 ? k : (real)1) * area[y] * e_max * (real)0.5;
+  const real per_excess = volume / (moves ? total : (real)1);
+  return moves ? per_excess : (real)0;
 }
 
 /* Pass 2, active padded cell (x, y): bed after the transfers of pass 1,
@@ -50,24 +56,21 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real b = bed[i];
   const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
   const real dist_b = (real)0.5 * (dy[y] + dy[y + 1]);
-  real given = 0, taken = 0;
-  if (kind[i - 1] == ERODEM_CELL_ACTIVE) {
-    given += talus_excess(b, bed[i - 1], dx[y], tan_talus);
-    taken += share[i - 1] * talus_excess(bed[i - 1], b, dx[y], tan_talus);
-  }
-  if (kind[i + 1] == ERODEM_CELL_ACTIVE) {
-    given += talus_excess(b, bed[i + 1], dx[y], tan_talus);
-    taken += share[i + 1] * talus_excess(bed[i + 1], b, dx[y], tan_talus);
-  }
-  if (kind[i - W] == ERODEM_CELL_ACTIVE) {
-    given += talus_excess(b, bed[i - W], dist_t, tan_talus);
-    taken += share[i - W] * talus_excess(bed[i - W], b, dist_t, tan_talus);
-  }
-  if (kind[i + W] == ERODEM_CELL_ACTIVE) {
-    given += talus_excess(b, bed[i + W], dist_b, tan_talus);
-    taken += share[i + W] * talus_excess(bed[i + W], b, dist_b, tan_talus);
-  }
-  return b + (taken - share[i] * given) / area[y];
+  const real dist_x = dx[y], cell_area = area[y]; /* loaded unconditionally */
+  /* inactive neighbours add +0 (branch-free, the same sums as skipping them) */
+  const int has_l = kind[i - 1] == ERODEM_CELL_ACTIVE, has_r = kind[i + 1] == ERODEM_CELL_ACTIVE;
+  const int has_t = kind[i - W] == ERODEM_CELL_ACTIVE, has_b = kind[i + W] == ERODEM_CELL_ACTIVE;
+  const real b_l = bed[i - 1], b_r = bed[i + 1], b_t = bed[i - W], b_b = bed[i + W];
+  const real given = (has_l ? talus_excess(b, b_l, dist_x, tan_talus) : (real)0) +
+                     (has_r ? talus_excess(b, b_r, dist_x, tan_talus) : (real)0) +
+                     (has_t ? talus_excess(b, b_t, dist_t, tan_talus) : (real)0) +
+                     (has_b ? talus_excess(b, b_b, dist_b, tan_talus) : (real)0);
+  const real s_l = share[i - 1], s_r = share[i + 1], s_t = share[i - W], s_b = share[i + W];
+  const real taken = (has_l ? s_l * talus_excess(b_l, b, dist_x, tan_talus) : (real)0) +
+                     (has_r ? s_r * talus_excess(b_r, b, dist_x, tan_talus) : (real)0) +
+                     (has_t ? s_t * talus_excess(b_t, b, dist_t, tan_talus) : (real)0) +
+                     (has_b ? s_b * talus_excess(b_b, b, dist_b, tan_talus) : (real)0);
+  return b + (taken - share[i] * given) / cell_area;
 }
 
 ERODEM_END_NAMESPACE

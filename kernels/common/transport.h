@@ -9,7 +9,9 @@ ERODEM_BEGIN_NAMESPACE
 /* Sediment carried per unit of water (m/m): suspended layer s over the water depth that the
  * flow step moved, 0 for a dry cell. */
 ERODEM_FN real sediment_concentration(real sediment, real depth) {
-  return depth > 0 ? sediment / depth : (real)0;
+  const int wet = depth > 0;
+  const real c = sediment / (wet ? depth : (real)1);
+  return wet ? c : (real)0;
 }
 
 /* Conservative (flux-form upwind) transport for active padded cell (x, y): sediment leaves
@@ -17,10 +19,10 @@ ERODEM_FN real sediment_concentration(real sediment, real depth) {
  * is the depth the flow step limited its outflows by (before the water update), so a cell
  * never gives more sediment than it holds:
  *   s_i <- s_i + dt / area_i * (sum_n c_n f_{n->i} - c_i sum_n f_{i->n}),  c = s / d.
- * Writes sediment_out; returns through *boundary_out the volume (m^3) carried out of the
- * domain. Conserves sum(s * area) to rounding. */
-ERODEM_FN void transport_conservative_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                                           GLOBAL const real* sediment, GLOBAL real* sediment_out,
+ * Returns the new sediment (m) and through *boundary_out the volume (m^3) carried out of
+ * the domain. Conserves sum(s * area) to rounding. Branch-free. */
+ERODEM_FN real transport_conservative_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                           GLOBAL const real* sediment,
                                            GLOBAL const real* depth_flow, GLOBAL const real* f_left,
                                            GLOBAL const real* f_right, GLOBAL const real* f_top,
                                            GLOBAL const real* f_bottom, GLOBAL const real* area,
@@ -32,13 +34,14 @@ ERODEM_FN void transport_conservative_cell(int x, int y, int W, GLOBAL const ero
                       sediment_concentration(sediment[i - W], depth_flow[i - W]) * f_bottom[i - W] +
                       sediment_concentration(sediment[i + W], depth_flow[i + W]) * f_top[i + W];
   const real given = c * (f_left[i] + f_right[i] + f_top[i] + f_bottom[i]);
-  sediment_out[i] = sediment[i] + dt * (gained - given) / area[y];
-  real to_ghosts = 0;
-  if (kind[i - 1] != ERODEM_CELL_ACTIVE) to_ghosts += f_left[i];
-  if (kind[i + 1] != ERODEM_CELL_ACTIVE) to_ghosts += f_right[i];
-  if (kind[i - W] != ERODEM_CELL_ACTIVE) to_ghosts += f_top[i];
-  if (kind[i + W] != ERODEM_CELL_ACTIVE) to_ghosts += f_bottom[i];
+  const real s_new = sediment[i] + dt * (gained - given) / area[y];
+  /* faces with active neighbours add +0 (branch-free, the same sum as skipping them) */
+  const real to_ghosts = (real)0 + (kind[i - 1] != ERODEM_CELL_ACTIVE ? f_left[i] : (real)0) +
+                         (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] : (real)0) +
+                         (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] : (real)0) +
+                         (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] : (real)0);
   *boundary_out = dt * c * to_ghosts;
+  return s_new;
 }
 
 /* Semi-Lagrangian transport (Mei et al. 2007) for active padded cell (x, y):

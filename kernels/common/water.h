@@ -12,7 +12,7 @@ ERODEM_BEGIN_NAMESPACE
  * loops over cells vectorise. */
 ERODEM_FN real face_velocity(real through_a, real through_b, real width, real mean_depth,
                              real min_depth) {
-  const int flowing = mean_depth >= min_depth && mean_depth > 0;
+  const int flowing = (mean_depth >= min_depth) & (mean_depth > 0);
   const real safe_depth = flowing ? mean_depth : (real)1;
   const real v = (through_a + through_b) * (real)0.5 / (width * safe_depth);
   return flowing ? v : (real)0;
@@ -46,9 +46,10 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   /* The outflow limit keeps d_raw >= 0 up to rounding: lift such a rounding-level negative
    * to 0 and book the volume; anything deeper is left for the stability check to stop. */
   const real rounding = (real)64 * ERODEM_EPSILON(real) * (d_old + dt * inflow / area[y]);
-  const int lift = d_raw < 0 && d_raw >= -rounding;
+  const int lift = (d_raw < 0) & (d_raw >= -rounding);
   const real d_new = lift ? (real)0 : d_raw;
-  *clipped = active && lift ? -d_raw * area[y] : (real)0;
+  const real clip = active & lift ? -d_raw * area[y] : (real)0;
+  *clipped = clip;
   depth_out[i] = active ? d_new : d_old;
 
   /* net outflow through faces shared with ghosts (walls carry nothing) */

@@ -1,4 +1,6 @@
-// CPU loop of the erosion process: kernels/common/erosion.h over the active cells.
+// CPU loop of the erosion process: kernels/common/erosion.h over the interior cells; the
+// active ones take the new bed and sediment, the others keep theirs (branch-free, so the
+// loop vectorises).
 #include "common/erosion.h"
 
 #include <limits>
@@ -15,12 +17,26 @@ void CpuBackend<Real>::run_erosion(Real dt) {
              dmin = static_cast<Real>(e.min_depth);
   const Real bedrock = e.bedrock_level ? static_cast<Real>(*e.bedrock_level)
                                        : -std::numeric_limits<Real>::infinity();
-  for_rows(1, H_ - 1, [&](int y) {
-    for (int x = 1; x < W_ - 1; ++x) {
-      if (kind_[at(x, y)] != ERODEM_CELL_ACTIVE) continue;
-      cell::erosion_cell(x, y, W_, kind_.data(), bed_.data(), bed_next_.data(), sediment_.data(),
-                         depth_.data(), velocity_x_.data(), velocity_y_.data(), hardness_.data(),
-                         dx_.data(), dy_.data(), dt, kc, ks, kd, tilt, dmin, bedrock);
+  const Kind* kind = kind_.data();
+  const Real *bed = bed_.data(), *depth = depth_.data(), *u = velocity_x_.data(),
+             *v = velocity_y_.data(), *hardness = hardness_.data(), *dx = dx_.data(),
+             *dy = dy_.data();
+  Real *bed_out = bed_next_.data(), *sediment = sediment_.data();
+  const int W = W_;
+  for_rows(1, H_ - 1, [=](int y) {
+    const Real step = dt, k_c = kc, k_s = ks, k_d = kd, min_tilt = tilt, min_depth = dmin,
+               rock = bedrock;
+    ERODEM_IVDEP
+    for (int x = 1; x < W - 1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+      const Real b_old = bed[i], s_old = sediment[i];  // unconditional loads: if-convertible
+      Real s_new;
+      const Real b_new =
+          cell::erosion_cell(x, y, W, kind, bed, sediment, depth, u, v, hardness, dx, dy, step, k_c,
+                             k_s, k_d, min_tilt, min_depth, rock, &s_new);
+      const bool active = kind[i] == ERODEM_CELL_ACTIVE;
+      bed_out[i] = active ? b_new : b_old;
+      sediment[i] = active ? s_new : s_old;
     }
   });
   std::swap(bed_, bed_next_);

@@ -2,6 +2,8 @@
 // kernels/common/sources.h.
 #include "common/sources.h"
 
+#include <vector>
+
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
@@ -11,11 +13,18 @@ void CpuBackend<Real>::run_sources(const StepInputs& in) {
   const Real dt = static_cast<Real>(in.dt);
   const Real rate = static_cast<Real>(in.rain_rate);
   if (rate != Real(0)) {
-    for_rows(1, H_ - 1, [&](int y) {
-      for (int x = 1; x < W_ - 1; ++x) {
-        const auto i = at(x, y);
-        if (kind_[i] == ERODEM_CELL_ACTIVE)
-          depth_[i] = cell::rain_cell(depth_[i], dt, rate, rain_factor_[i]);
+    const Kind* kind = kind_.data();
+    const Real* factor = rain_factor_.data();
+    Real* depth = depth_.data();
+    const int W = W_;
+    for_rows(1, H_ - 1, [=](int y) {
+      const Real step = dt, r = rate;
+      ERODEM_IVDEP
+      for (int x = 1; x < W - 1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+        const Real d = depth[i];
+        const Real wet = cell::rain_cell(d, step, r, factor[i]);
+        depth[i] = kind[i] == ERODEM_CELL_ACTIVE ? wet : d;
       }
     });
   }
@@ -30,19 +39,29 @@ template <class Real>
 void CpuBackend<Real>::run_evaporation(Real dt, StepTally& tally) {
   const Real rate = static_cast<Real>(params_.evaporation.rate);
   const Real tau = static_cast<Real>(params_.numerics.wetness_time);
-  for_rows(1, H_ - 1, [&](int y) {
-    double lost_row = 0.0;
-    for (int x = 1; x < W_ - 1; ++x) {
-      const auto i = at(x, y);
-      if (kind_[i] != ERODEM_CELL_ACTIVE) continue;
-      if (rate > Real(0)) {
-        Real lost = 0;
-        depth_[i] = cell::evaporation_cell(depth_[i], dt, rate, area_[y], &lost);
-        lost_row += lost;
-      }
-      wetness_[i] = cell::wetness_cell(wetness_[i], depth_[i], dt, tau);
+  const Kind* kind = kind_.data();
+  const Real* area = area_.data();
+  Real *depth = depth_.data(), *wetness = wetness_.data();
+  const int W = W_;
+  const bool evaporate = rate > Real(0);
+  for_rows(1, H_ - 1, [=](int y) {
+    const Real step = dt, k = rate, t = tau, a = area[y];
+    const auto lost_row = row_scratch(W);
+    Real* lost = lost_row.get();
+    ERODEM_IVDEP
+    for (int x = 1; x < W - 1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+      const bool active = kind[i] == ERODEM_CELL_ACTIVE;
+      const Real d = depth[i];
+      Real taken = 0;
+      const Real dried = cell::evaporation_cell(d, step, k, a, &taken);
+      const Real d_new = active && evaporate ? dried : d;
+      depth[i] = d_new;
+      lost[x] = active && evaporate ? taken : Real(0);
+      const Real w = wetness[i];  // an unconditional load: if-convertible
+      wetness[i] = active ? cell::wetness_cell(w, d_new, step, t) : w;
     }
-    row_sums_a_[y] = lost_row;
+    row_sums_a_[y] = sum_row(lost, static_cast<std::size_t>(W));
   });
   tally.evaporated += sum_rows(row_sums_a_);
 }

@@ -1,4 +1,5 @@
-// CPU loops of the thermal process: the two passes of kernels/common/thermal.h.
+// CPU loops of the thermal process: the two passes of kernels/common/thermal.h over the
+// interior cells, branch-free (inactive cells: share 0, bed kept), so the loops vectorise.
 #include "common/thermal.h"
 
 #include <cmath>
@@ -12,24 +13,27 @@ void CpuBackend<Real>::run_thermal(Real dt) {
   const double pi = 3.14159265358979323846;
   const Real tan_talus = static_cast<Real>(std::tan(params_.thermal.talus_angle * pi / 180.0));
   const Real rate = static_cast<Real>(params_.thermal.rate);
-  for_rows(1, H_ - 1, [&](int y) {
-    for (int x = 1; x < W_ - 1; ++x) {
-      const auto i = at(x, y);
-      thermal_share_[i] =
-          kind_[i] == ERODEM_CELL_ACTIVE
-              ? cell::thermal_share_cell(x, y, W_, kind_.data(), bed_.data(), dx_.data(),
-                                         dy_.data(), area_.data(), dt, rate, tan_talus)
-              : Real(0);
+  const Kind* kind = kind_.data();
+  const Real *bed = bed_.data(), *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
+  Real *share = thermal_share_.data(), *bed_out = bed_next_.data();
+  const int W = W_;
+  for_rows(1, H_ - 1, [=](int y) {
+    const Real step = dt, k = rate, tan_t = tan_talus;
+    ERODEM_IVDEP
+    for (int x = 1; x < W - 1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+      const Real s = cell::thermal_share_cell(x, y, W, kind, bed, dx, dy, area, step, k, tan_t);
+      share[i] = kind[i] == ERODEM_CELL_ACTIVE ? s : Real(0);
     }
   });
-  for_rows(1, H_ - 1, [&](int y) {
-    for (int x = 1; x < W_ - 1; ++x) {
-      const auto i = at(x, y);
-      bed_next_[i] =
-          kind_[i] == ERODEM_CELL_ACTIVE
-              ? cell::thermal_apply_cell(x, y, W_, kind_.data(), bed_.data(), thermal_share_.data(),
-                                         dx_.data(), dy_.data(), area_.data(), tan_talus)
-              : bed_[i];
+  for_rows(1, H_ - 1, [=](int y) {
+    const Real tan_t = tan_talus;
+    ERODEM_IVDEP
+    for (int x = 1; x < W - 1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+      const Real b_old = bed[i];  // an unconditional load: if-convertible
+      const Real b = cell::thermal_apply_cell(x, y, W, kind, bed, share, dx, dy, area, tan_t);
+      bed_out[i] = kind[i] == ERODEM_CELL_ACTIVE ? b : b_old;
     }
   });
   std::swap(bed_, bed_next_);

@@ -1,5 +1,9 @@
-// CPU loops of the transport process: kernels/common/transport.h over the active cells.
+// CPU loops of the transport process: kernels/common/transport.h over the interior cells;
+// the active ones take the new sediment, the others keep theirs. Per-cell tallies go to a
+// row buffer summed after the row (sum_row), so the cell loops vectorise.
 #include "common/transport.h"
+
+#include <vector>
 
 #include "cpu/cpu_backend.hpp"
 
@@ -7,31 +11,42 @@ namespace erodem {
 
 template <class Real>
 void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
+  const Kind* kind = kind_.data();
+  const Real *sediment = sediment_.data(), *area = area_.data();
+  Real* sediment_out = sediment_next_.data();
+  const int W = W_, H = H_;
   if (params_.transport.scheme == TransportScheme::conservative) {
-    for_rows(1, H_ - 1, [&](int y) {
-      double out_row = 0.0;
-      for (int x = 1; x < W_ - 1; ++x) {
-        if (kind_[at(x, y)] != ERODEM_CELL_ACTIVE) continue;
-        Real out = 0;
-        cell::transport_conservative_cell(x, y, W_, kind_.data(), sediment_.data(),
-                                          sediment_next_.data(), depth_next_.data(),
-                                          flux_[0].data(), flux_[1].data(), flux_[2].data(),
-                                          flux_[3].data(), area_.data(), dt, &out);
-        out_row += out;
+    const Real *depth_flow = depth_next_.data(), *fl = flux_[0].data(), *fr = flux_[1].data(),
+               *ft = flux_[2].data(), *fb = flux_[3].data();
+    for_rows(1, H - 1, [=](int y) {
+      const Real step = dt;
+      const auto out_row = row_scratch(W);
+      Real* out = out_row.get();
+      ERODEM_IVDEP
+      for (int x = 1; x < W - 1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+        const bool active = kind[i] == ERODEM_CELL_ACTIVE;
+        Real gone;
+        const Real s_new = cell::transport_conservative_cell(x, y, W, kind, sediment, depth_flow,
+                                                             fl, fr, ft, fb, area, step, &gone);
+        const Real s_old = sediment[i];  // an unconditional load: if-convertible
+        sediment_out[i] = active ? s_new : s_old;
+        out[x] = active ? gone : Real(0);
       }
-      row_sums_a_[y] = out_row;
+      row_sums_a_[y] = sum_row(out, static_cast<std::size_t>(W));
     });
     tally.sediment_out += sum_rows(row_sums_a_);
   } else {
-    for_rows(1, H_ - 1, [&](int y) {
+    const Real *u = velocity_x_.data(), *v = velocity_y_.data(), *dx = dx_.data(), *dy = dy_.data();
+    for_rows(1, H - 1, [=](int y) {
+      const Real step = dt;
       double change_row = 0.0;
-      for (int x = 1; x < W_ - 1; ++x) {
-        const auto i = at(x, y);
-        if (kind_[i] != ERODEM_CELL_ACTIVE) continue;
-        sediment_next_[i] =
-            cell::transport_semi_lagrangian_cell(x, y, W_, H_, sediment_.data(), velocity_x_.data(),
-                                                 velocity_y_.data(), dx_.data(), dy_.data(), dt);
-        change_row += (static_cast<double>(sediment_next_[i]) - sediment_[i]) * area_[y];
+      for (int x = 1; x < W - 1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
+        if (kind[i] != ERODEM_CELL_ACTIVE) continue;
+        sediment_out[i] =
+            cell::transport_semi_lagrangian_cell(x, y, W, H, sediment, u, v, dx, dy, step);
+        change_row += (static_cast<double>(sediment_out[i]) - sediment[i]) * area[y];
       }
       row_sums_a_[y] = change_row;
     });

@@ -19,14 +19,15 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
   for_rows(1, H_ - 1, [=](int y) {
     // Locals, not closure members: stores to Real arrays could alias those.
     const Real step = dt, min_depth = d_min;
-    std::vector<Real> exchange(W), clipped(W);
-    Real* ex = exchange.data();
-    Real* cl = clipped.data();
+    const auto exchange = row_scratch(W), clipped = row_scratch(W);
+    Real* ex = exchange.get();
+    Real* cl = clipped.get();
+    ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
       cell::water_update_cell(x, y, W, kind, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u, v,
                               step, min_depth, ex + x, cl + x);
-    row_sums_a_[y] = sum_row(exchange);
-    row_sums_b_[y] = sum_row(clipped);
+    row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
+    row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
   });
   tally.boundary_water_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
   tally.clipped += sum_rows(row_sums_b_);

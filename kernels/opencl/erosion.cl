@@ -12,7 +12,13 @@ __kernel void erosion(int W, int H, __global const uchar* kind, __global const r
                       real deposition_rate, real min_tilt, real min_depth, real bedrock) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (x < 1 || y < 1 || x > W - 2 || y > H - 2) return;
-  if (kind[x + y * W] != ERODEM_CELL_ACTIVE) return;
-  erosion_cell(x, y, W, kind, bed, bed_out, sediment, depth, velocity_x, velocity_y, hardness, dx,
-               dy, dt, capacity_k, dissolving_rate, deposition_rate, min_tilt, min_depth, bedrock);
+  /* PoCL does not vectorise this kernel (the bed tilt stops it), so inactive cells return
+   * early rather than compute and discard */
+  const int i = x + y * W;
+  if (kind[i] != ERODEM_CELL_ACTIVE) return;
+  real s_new;
+  bed_out[i] = erosion_cell(x, y, W, kind, bed, sediment, depth, velocity_x, velocity_y, hardness,
+                            dx, dy, dt, capacity_k, dissolving_rate, deposition_rate, min_tilt,
+                            min_depth, bedrock, &s_new);
+  sediment[i] = s_new;
 }

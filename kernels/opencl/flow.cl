@@ -18,18 +18,69 @@ __kernel void flow_pipes(int W, int H, __global const uchar* kind, __global cons
                   out_left, out_right, out_top, out_bottom, dt, gravity, pipe_area, pipe_length);
 }
 
-__kernel void flow_local_inertial(int W, int H, __global const uchar* kind,
-                                  __global const real* bed, __global const real* depth,
-                                  __global const real* manning, __global const real* dx,
-                                  __global const real* dy, __global const real* area,
-                                  __global const real* f_left, __global const real* f_right,
-                                  __global const real* f_top, __global const real* f_bottom,
-                                  __global real* out_left, __global real* out_right,
-                                  __global real* out_top, __global real* out_bottom, real dt,
-                                  real gravity, real theta, real dry_depth) {
+/* Local inertial, face pass: one work-item per padded cell computes the face east of it
+ * (face_x, x <= W - 2) and the face south of it (face_y, y <= H - 2), each face once; the
+ * last column and row have no face east / south: computed on what is there, stored as 0.
+ * The host runs flow_local_inertial_faces_interior on rows 1 .. H - 3 (global offset 1) and
+ * this one on the other rows. */
+__kernel void flow_local_inertial_faces(int W, int H, __global const uchar* kind,
+                                        __global const real* bed, __global const real* depth,
+                                        __global const real* manning, __global const real* dx,
+                                        __global const real* dy, __global const real* f_left,
+                                        __global const real* f_right, __global const real* f_top,
+                                        __global const real* f_bottom, __global real* face_x,
+                                        __global real* face_y, real dt, real gravity, real theta,
+                                        real dry_depth) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (x >= W || y >= H) return;
-  flow_local_inertial_cell(x, y, W, H, kind, bed, depth, manning, dx, dy, area, f_left, f_right,
-                           f_top, f_bottom, out_left, out_right, out_top, out_bottom, dt, gravity,
-                           theta, dry_depth);
+  const int i = x + y * W;
+  const real qx = local_inertial_face_x(x, y, W, H, kind, bed, depth, manning, dx, dy, f_left,
+                                        f_right, dt, gravity, theta, dry_depth);
+  const real qy = local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, dx, dy, f_top,
+                                        f_bottom, dt, gravity, theta, dry_depth);
+  face_x[i] = x < W - 1 ? qx : (real)0;
+  face_y[i] = y < H - 1 ? qy : (real)0;
+}
+
+/* The face pass on rows 1 .. H - 3: no clamping, no branches but the column mask. */
+__kernel void flow_local_inertial_faces_interior(
+    int W, int H, __global const uchar* kind, __global const real* bed, __global const real* depth,
+    __global const real* manning, __global const real* dx, __global const real* dy,
+    __global const real* f_left, __global const real* f_right, __global const real* f_top,
+    __global const real* f_bottom, __global real* face_x, __global real* face_y, real dt,
+    real gravity, real theta, real dry_depth) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (x >= W || y > H - 3) return;
+  const int i = x + y * W;
+  const real qx = local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_left,
+                                                 f_right, dt, gravity, theta, dry_depth);
+  face_x[i] = x < W - 1 ? qx : (real)0;
+  face_y[i] = local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_top,
+                                             f_bottom, dt, gravity, theta, dry_depth);
+}
+
+/* Local inertial, cell pass: the four faces around each padded cell split into its
+ * outflows (flow_local_inertial_cell); the host runs flow_local_inertial_split_interior on
+ * rows 1 .. H - 2 and this one on rows 0 and H - 1. */
+__kernel void flow_local_inertial_split(int W, int H, __global const uchar* kind,
+                                        __global const real* depth, __global const real* area,
+                                        __global const real* face_x, __global const real* face_y,
+                                        __global real* out_left, __global real* out_right,
+                                        __global real* out_top, __global real* out_bottom,
+                                        real dt) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (x >= W || y >= H) return;
+  flow_local_inertial_cell(x, y, W, H, kind, depth, area, face_x, face_y, out_left, out_right,
+                           out_top, out_bottom, dt);
+}
+
+/* The cell pass on rows 1 .. H - 2. */
+__kernel void flow_local_inertial_split_interior(
+    int W, int H, __global const uchar* kind, __global const real* depth, __global const real* area,
+    __global const real* face_x, __global const real* face_y, __global real* out_left,
+    __global real* out_right, __global real* out_top, __global real* out_bottom, real dt) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (x >= W || y > H - 2) return;
+  flow_local_inertial_cell_interior(x, y, W, kind, depth, area, face_x, face_y, out_left, out_right,
+                                    out_top, out_bottom, dt);
 }

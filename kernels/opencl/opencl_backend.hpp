@@ -137,6 +137,9 @@ class OpenClBackend final : public Backend {
   /// Runs a cell kernel over the padded raster: work-groups of (local_x_, local_y_), the global
   /// size rounded up to whole groups (the kernels bound-check).
   void launch_cells(cl_kernel k);
+  /// Runs a cell kernel over the padded rows [y0, y1) only (global offset y0; work-groups of
+  /// (local_x_, 1)); nothing when the range is empty.
+  void launch_rows(cl_kernel k, int y0, int y1);
   /// Runs a reduction kernel with `groups` groups of reduce_local_ work-items.
   void launch_reduction(cl_kernel k, std::size_t groups);
   /// Enqueues a read of `bytes` of `b` into `dst`; blocking or not.
@@ -171,6 +174,7 @@ class OpenClBackend final : public Backend {
   Buffer kind_, dx_, dy_, area_;
   Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;
   std::array<Buffer, 4> flux_, flux_next_;
+  Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   Buffer partial_a_, partial_b_, partial_cells_;
   Buffer tally_partials_, tally_sums_;  // [slot][cell group] partials, [slot] sums

@@ -15,8 +15,8 @@ __kernel void transport_conservative(int W, int H, __global const uchar* kind,
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real out = 0;
   if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[x + y * W] == ERODEM_CELL_ACTIVE)
-    transport_conservative_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left, f_right,
-                                f_top, f_bottom, area, dt, &out);
+    sediment_out[x + y * W] = transport_conservative_cell(
+        x, y, W, kind, sediment, depth_flow, f_left, f_right, f_top, f_bottom, area, dt, &out);
   cell_group_sum(s, (acc_t)out, partials + ERODEM_TALLY_SEDIMENT * groups + cell_group_index());
 }
 
