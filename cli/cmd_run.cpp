@@ -62,9 +62,9 @@ std::size_t restart_index(const io::ResultReader& reader, std::optional<double> 
   if (std::abs(times[i] - *time) <= std::max(1e-3, 1e-6 * std::abs(*time))) return i;
   std::string list;
   for (std::size_t k = 0; k < times.size(); ++k) {
-    if (times.size() > 12 && k == 6) {
+    if (times.size() > 50 && k == 25) {  // long lists: the first and last 25
       list += ", ...";
-      k = times.size() - 6;
+      k = times.size() - 25;
     }
     list += fmt::format("{}{:.10g}", list.empty() ? "" : ", ", times[k]);
   }
