@@ -4,6 +4,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_boundary() {
@@ -21,4 +22,5 @@ void CpuBackend<Real>::run_boundary() {
 template void CpuBackend<float>::run_boundary();
 template void CpuBackend<double>::run_boundary();
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

@@ -17,6 +17,7 @@
 #include "erodem/initial_state.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
@@ -62,8 +63,9 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
 
 template <class Real>
 std::string CpuBackend<Real>::device() const {
-  return fmt::format("CPU reference, {}, {} thread{}", sizeof(Real) == 4 ? "float32" : "float64",
-                     threads_, threads_ == 1 ? "" : "s");
+  return fmt::format("CPU reference, {}, {} thread{}, {}",
+                     sizeof(Real) == 4 ? "float32" : "float64", threads_, threads_ == 1 ? "" : "s",
+                     cpu_isa_label);
 }
 
 template <class Real>
@@ -255,10 +257,21 @@ HostView CpuBackend<Real>::host_view(FieldId id) {
 template class CpuBackend<float>;
 template class CpuBackend<double>;
 
-std::unique_ptr<Backend> make_cpu_backend(const Terrain& terrain, const Params& params) {
+#if defined(ERODEM_CPU_NATIVE)
+const char* const cpu_isa_label = "native";
+#elif ERODEM_CPU_ISA_LEVEL == 4
+const char* const cpu_isa_label = "AVX-512";
+#elif ERODEM_CPU_ISA_LEVEL == 3
+const char* const cpu_isa_label = "AVX2";
+#else
+const char* const cpu_isa_label = "SSE4.2";
+#endif
+
+std::unique_ptr<Backend> make_cpu_backend_isa(const Terrain& terrain, const Params& params) {
   if (params.numerics.precision == Precision::float64)
     return std::make_unique<CpuBackend<double>>(terrain, params);
   return std::make_unique<CpuBackend<float>>(terrain, params);
 }
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

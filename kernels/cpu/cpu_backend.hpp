@@ -1,6 +1,9 @@
 // erodem — the CPU reference backend: the per-cell functions of kernels/common/*.h run over
 // a padded raster by OpenMP threads, one row per iteration. Reductions are summed per row
 // and then in row order, so results do not depend on the number of threads.
+//
+// Compiled once per x86-64 level into namespace erodem::ERODEM_CPU_NAMESPACE (cpu_v2,
+// cpu_v3, cpu_v4; see cpu/isa_prelude.hpp, force-included); cpu/dispatch.cpp chooses.
 #pragma once
 
 #include <array>
@@ -23,6 +26,15 @@
 #endif
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
+
+/// The name of this build's instruction set in Backend::device(): "SSE4.2" (x86-64-v2),
+/// "AVX2" (x86-64-v3), "AVX-512" (x86-64-v4), "native" (ERODEM_NATIVE).
+extern const char* const cpu_isa_label;
+
+/// This build's CPU backend in the precision of params.numerics.precision (the body of
+/// erodem::make_cpu_backend, which picks the build).
+std::unique_ptr<Backend> make_cpu_backend_isa(const Terrain& terrain, const Params& params);
 
 template <class Real>
 class CpuBackend final : public Backend {
@@ -104,4 +116,5 @@ class CpuBackend final : public Backend {
   std::vector<double> row_sums_a_, row_sums_b_;  // scratch for per-row reductions
 };
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

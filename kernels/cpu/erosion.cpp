@@ -8,6 +8,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_erosion(Real dt) {
@@ -45,4 +46,5 @@ void CpuBackend<Real>::run_erosion(Real dt) {
 template void CpuBackend<float>::run_erosion(float);
 template void CpuBackend<double>::run_erosion(double);
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

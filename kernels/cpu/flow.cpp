@@ -18,6 +18,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 namespace {
 
@@ -226,4 +227,5 @@ void CpuBackend<Real>::run_flow(Real dt) {
 template void CpuBackend<float>::run_flow(float);
 template void CpuBackend<double>::run_flow(double);
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

@@ -7,6 +7,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_sources(const StepInputs& in) {
@@ -71,4 +72,5 @@ template void CpuBackend<double>::run_sources(const StepInputs&);
 template void CpuBackend<float>::run_evaporation(float, StepTally&);
 template void CpuBackend<double>::run_evaporation(double, StepTally&);
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

@@ -7,6 +7,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_thermal(Real dt) {
@@ -42,4 +43,5 @@ void CpuBackend<Real>::run_thermal(Real dt) {
 template void CpuBackend<float>::run_thermal(float);
 template void CpuBackend<double>::run_thermal(double);
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

@@ -8,6 +8,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
@@ -58,4 +59,5 @@ void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
 template void CpuBackend<float>::run_transport(float, StepTally&);
 template void CpuBackend<double>::run_transport(double, StepTally&);
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

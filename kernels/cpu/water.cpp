@@ -6,6 +6,7 @@
 #include "cpu/cpu_backend.hpp"
 
 namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
@@ -38,4 +39,5 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
 template void CpuBackend<float>::run_water(float, StepTally&);
 template void CpuBackend<double>::run_water(double, StepTally&);
 
+}  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem
