@@ -112,6 +112,7 @@ int devices(const DevicesOptions& o) {
   const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
   const std::string selector = env ? env : "";
   const BackendChoice choice = auto_backend_choice(list, selector);
+  const CpuIsaInfo isa = cpu_isa_info();
   const std::string cpu = cpu_model();
   const int threads = cpu_threads();
 #ifdef ERODEM_HAVE_OPENCL
@@ -147,8 +148,9 @@ int devices(const DevicesOptions& o) {
     }
     std::printf(
         "%s],\n \"cpu_reference\": {\"device\": %s, \"threads\": %d, \"precisions\": "
-        "[\"float32\", \"float64\"], \"auto\": %s},\n",
+        "[\"float32\", \"float64\"], \"isa\": %s, \"isa_built\": %s, \"auto\": %s},\n",
         list.empty() ? "" : "\n ", json_string(cpu).c_str(), threads,
+        json_string(isa.level).c_str(), json_string(isa.built).c_str(),
         choice.backend == "cpu" ? "true" : "false");
     std::printf(
         " \"auto\": {\"backend\": %s, \"device\": %s, \"reason\": %s, \"float64\": \"cpu\"}}\n",
@@ -181,8 +183,11 @@ int devices(const DevicesOptions& o) {
         std::printf("        %s, driver %s\n", e.version.c_str(), e.driver.c_str());
     }
   }
-  std::printf("CPU reference:\n  %s [cpu] %s, %d OpenMP thread%s, float32 and float64\n",
-              choice.backend == "cpu" ? "*" : " ", cpu.c_str(), threads, threads == 1 ? "" : "s");
+  std::printf(
+      "CPU reference:\n  %s [cpu] %s, %d OpenMP thread%s, float32 and float64, %s (built: "
+      "%s; ERODEM_CPU_ISA chooses)\n",
+      choice.backend == "cpu" ? "*" : " ", cpu.c_str(), threads, threads == 1 ? "" : "s",
+      isa.level.c_str(), isa.built.c_str());
   std::printf("ERODEM_OPENCL_DEVICE: %s\n",
               env ? ("'" + selector + "'").c_str() : "unset (\"<platform>:<device>\" substrings)");
   if (choice.backend.empty())

@@ -58,6 +58,9 @@ TEST_F(CliTools, DevicesListsTheCpuReferenceAndWhatAutoPicks) {
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "CPU reference")) << r.output;
   EXPECT_TRUE(contains(r.output, "auto picks")) << r.output;
+  // The CPU reference's instruction-set level, as its device() names it.
+  const auto isa = erodem::cpu_isa_info();
+  EXPECT_TRUE(contains(r.output, isa.level + " (built: " + isa.built)) << r.output;
   const auto devices = erodem::list_opencl_devices();
   if (erodem::opencl_available()) {
     ASSERT_FALSE(devices.empty());
@@ -69,6 +72,7 @@ TEST_F(CliTools, DevicesListsTheCpuReferenceAndWhatAutoPicks) {
   ASSERT_FALSE(j.output.empty());
   EXPECT_EQ(j.output.front(), '{') << j.output;
   EXPECT_TRUE(contains(j.output, "\"cpu_reference\"")) << j.output;
+  EXPECT_TRUE(contains(j.output, "\"isa\": \"" + isa.level + "\"")) << j.output;
   EXPECT_TRUE(contains(j.output, "\"opencl_devices\"")) << j.output;
   EXPECT_TRUE(contains(j.output, "\"auto\": {\"backend\": ")) << j.output;
   if (erodem::opencl_available()) {

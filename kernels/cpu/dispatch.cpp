@@ -119,6 +119,19 @@ const CpuIsa& choose_cpu_isa(const std::vector<CpuIsa>& isas) {
 
 }  // namespace
 
+CpuIsaInfo cpu_isa_info() {
+  const auto isas = cpu_isas();
+  CpuIsaInfo info;
+  for (const auto& isa : isas)
+    info.built += (info.built.empty() ? "" : ", ") + std::string(isa.name);
+  try {
+    info.level = choose_cpu_isa(isas).description;
+  } catch (const Error& e) {
+    info.level = e.what();
+  }
+  return info;
+}
+
 std::unique_ptr<Backend> make_cpu_backend(const Terrain& terrain, const Params& params) {
   const auto isas = cpu_isas();
   return choose_cpu_isa(isas).make(terrain, params);

@@ -22,6 +22,15 @@ std::unique_ptr<Backend> make_cpu_backend(const Terrain& terrain, const Params& 
 std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& terrain,
                                       const Params& params);
 
+/// The instruction-set level the CPU reference runs at here (ERODEM_CPU_ISA, else the best
+/// this CPU supports), e.g. "x86-64-v4 (AVX-512)", and the levels built into this binary
+/// ("v2, v3, v4"). A bad ERODEM_CPU_ISA gives its error message as the level.
+struct CpuIsaInfo {
+  std::string level;
+  std::string built;
+};
+CpuIsaInfo cpu_isa_info();
+
 /// An OpenCL device as list_opencl_devices() reports it.
 struct ClDeviceInfo {
   std::string platform;             ///< platform name, e.g. "Portable Computing Language"
