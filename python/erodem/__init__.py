@@ -662,7 +662,7 @@ class Simulation:
 
     @property
     def device(self) -> str:
-        """What runs the kernels, e.g. ``"CPU reference, float32, 2 threads"``."""
+        """What runs the kernels, e.g. ``"CPU reference, float32, 2 threads, AVX-512"``."""
         return self._sim.device
 
     @property
