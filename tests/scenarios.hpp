@@ -2,6 +2,7 @@
 // the physics tests of every backend.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <ostream>
@@ -29,6 +30,38 @@ inline Simulation make_simulation(Terrain terrain, Params params, const Target& 
   params.numerics.precision = target.precision;
   auto backend = make_backend(target.backend, terrain, params);
   return Simulation(std::move(terrain), std::move(params), std::move(backend));
+}
+
+/// Big Tujunga (SRTM 30 m, UTM 11N) from the shared DEMs.
+inline std::string tujunga_path() {
+  return std::string(ERODEM_SHARED_DIR) + "/data/dem/big_tujunga/srtm_bigtujunga30m_utm11.tif";
+}
+
+/// A storm on a 256 x 256 crop of Big Tujunga with every process on: 720 mm/h of rain (it
+/// makes channels flow within 1,000 steps), erosion, `transport`, thermal collapse,
+/// evaporation, open edges; fixed steps of `dt` seconds, or adaptive ones up to `dt`.
+/// The scenario the backend-agreement and instruction-set tests compare fields on.
+inline Params tujunga_storm(FlowScheme flow, TransportScheme transport, bool adaptive, double dt,
+                            Precision precision) {
+  Params p;
+  p.dem.path = tujunga_path();
+  p.dem.window = std::array<int, 4>{420, 180, 256, 256};
+  p.flow.scheme = flow;
+  p.flow.manning_n.value = 0.035;
+  p.time.adaptive = adaptive;
+  p.time.dt = dt;
+  p.time.dt_max = dt;
+  p.rain.rate = 2e-4;  // m/s (720 mm/h)
+  p.erosion.enabled = true;
+  p.erosion.sediment_capacity = 0.5;
+  p.transport.scheme = transport;
+  p.thermal.enabled = true;
+  p.thermal.talus_angle = 35.0;
+  p.evaporation.rate = 1e-6;
+  p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
+  p.numerics.precision = precision;
+  p.numerics.wetness_time = 600.0;
+  return p;
 }
 
 /// A flat projected grid of nx x ny square cells of `cell` metres, bed at 0 m.

@@ -12,12 +12,12 @@
 #include "erodem/backends.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/simulation.hpp"
+#include "scenarios.hpp"
 
 namespace erodem::test {
 namespace {
 
-const std::string kTujunga =
-    std::string(ERODEM_SHARED_DIR) + "/data/dem/big_tujunga/srtm_bigtujunga30m_utm11.tif";
+const std::string kTujunga = tujunga_path();
 
 struct AgreementCase {
   std::string name;
@@ -28,25 +28,7 @@ struct AgreementCase {
 };
 
 Params agreement_params(const AgreementCase& c) {
-  Params p;
-  p.dem.path = kTujunga;
-  p.dem.window = std::array<int, 4>{420, 180, 256, 256};
-  p.flow.scheme = c.flow;
-  p.flow.manning_n.value = 0.035;
-  p.time.adaptive = c.adaptive;
-  p.time.dt = c.dt;
-  p.time.dt_max = c.dt;
-  p.rain.rate = 2e-4;  // 720 mm/h: a storm that makes channels flow within 1,000 steps
-  p.erosion.enabled = true;
-  p.erosion.sediment_capacity = 0.5;
-  p.transport.scheme = c.transport;
-  p.thermal.enabled = true;
-  p.thermal.talus_angle = 35.0;
-  p.evaporation.rate = 1e-6;
-  p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
-  p.numerics.precision = Precision::float32;
-  p.numerics.wetness_time = 600.0;
-  return p;
+  return tujunga_storm(c.flow, c.transport, c.adaptive, c.dt, Precision::float32);
 }
 
 /// ||a - b|| / ||b||, 0 when both vanish.

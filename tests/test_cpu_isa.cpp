@@ -16,12 +16,10 @@
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/simulation.hpp"
+#include "scenarios.hpp"
 
 namespace erodem::test {
 namespace {
-
-const std::string kTujunga =
-    std::string(ERODEM_SHARED_DIR) + "/data/dem/big_tujunga/srtm_bigtujunga30m_utm11.tif";
 
 /// Sets ERODEM_CPU_ISA for its lifetime and restores the previous value (or its absence).
 class ScopedCpuIsa {
@@ -55,25 +53,7 @@ struct IsaCase {
 /// The storm of tests/test_agreement.cpp on the 256 x 256 Big Tujunga crop: rain, flow,
 /// erosion, transport, thermal erosion and evaporation all active.
 Params isa_params(const IsaCase& c) {
-  Params p;
-  p.dem.path = kTujunga;
-  p.dem.window = std::array<int, 4>{420, 180, 256, 256};
-  p.flow.scheme = c.flow;
-  p.flow.manning_n.value = 0.035;
-  p.time.adaptive = c.adaptive;
-  p.time.dt = c.dt;
-  p.time.dt_max = c.dt;
-  p.rain.rate = 2e-4;  // m/s (720 mm/h)
-  p.erosion.enabled = true;
-  p.erosion.sediment_capacity = 0.5;
-  p.transport.scheme = c.transport;
-  p.thermal.enabled = true;
-  p.thermal.talus_angle = 35.0;
-  p.evaporation.rate = 1e-6;
-  p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
-  p.numerics.precision = c.precision;
-  p.numerics.wetness_time = 600.0;
-  return p;
+  return tujunga_storm(c.flow, c.transport, c.adaptive, c.dt, c.precision);
 }
 
 /// The case of the tests of the choice itself (no steps are run).
