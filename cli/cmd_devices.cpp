@@ -29,57 +29,6 @@ struct DevicesOptions {
   bool json = false;
 };
 
-/// What list_opencl_devices() does not report (yet), queried here in the same order.
-struct ClExtra {
-  std::size_t max_work_group = 0;  ///< CL_DEVICE_MAX_WORK_GROUP_SIZE; 0: unknown
-  std::string version;             ///< CL_DEVICE_VERSION
-  std::string driver;              ///< CL_DRIVER_VERSION
-};
-
-#ifdef ERODEM_HAVE_OPENCL
-std::string cl_device_string(cl_device_id d, cl_device_info what) {
-  std::size_t size = 0;
-  if (clGetDeviceInfo(d, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
-  std::string s(size, '\0');
-  if (clGetDeviceInfo(d, what, size, s.data(), nullptr) != CL_SUCCESS) return {};
-  while (!s.empty() && s.back() == '\0') s.pop_back();
-  return s;
-}
-#endif
-
-/// The extras of every device, in list_opencl_devices()'s order (platforms, then their
-/// devices of CL_DEVICE_TYPE_ALL). An entry whose device name does not match `devices`
-/// stays unknown.
-std::vector<ClExtra> query_extras(const std::vector<ClDeviceInfo>& devices) {
-  std::vector<ClExtra> out(devices.size());
-#ifdef ERODEM_HAVE_OPENCL
-  cl_uint np = 0;
-  if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) return out;
-  std::vector<cl_platform_id> platforms(np);
-  if (clGetPlatformIDs(np, platforms.data(), nullptr) != CL_SUCCESS) return out;
-  std::size_t k = 0;
-  for (cl_platform_id p : platforms) {
-    cl_uint nd = 0;
-    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS || nd == 0) continue;
-    std::vector<cl_device_id> ids(nd);
-    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, nd, ids.data(), nullptr) != CL_SUCCESS) continue;
-    for (cl_device_id d : ids) {
-      if (k >= out.size()) return out;
-      if (cl_device_string(d, CL_DEVICE_NAME) == devices[k].device) {
-        std::size_t wg = 0;
-        if (clGetDeviceInfo(d, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof wg, &wg, nullptr) ==
-            CL_SUCCESS)
-          out[k].max_work_group = wg;
-        out[k].version = cl_device_string(d, CL_DEVICE_VERSION);
-        out[k].driver = cl_device_string(d, CL_DRIVER_VERSION);
-      }
-      ++k;
-    }
-  }
-#endif
-  return out;
-}
-
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
   for (std::string line; std::getline(in, line);)
@@ -108,7 +57,6 @@ std::string gib(std::uint64_t bytes) {
 
 int devices(const DevicesOptions& o) {
   const auto list = list_opencl_devices();
-  const auto extras = query_extras(list);
   const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
   const std::string selector = env ? env : "";
   const BackendChoice choice = auto_backend_choice(list, selector);
@@ -133,7 +81,6 @@ int devices(const DevicesOptions& o) {
                 built ? "true" : "false", env ? json_string(selector).c_str() : "null");
     for (std::size_t k = 0; k < list.size(); ++k) {
       const auto& d = list[k];
-      const auto& e = extras[k];
       std::printf(
           "%s\n  {\"index\": %zu, \"platform\": %s, \"vendor\": %s, \"device\": %s, "
           "\"type\": %s, \"compute_units\": %u, \"global_memory_bytes\": %llu, "
@@ -142,8 +89,8 @@ int devices(const DevicesOptions& o) {
           k == 0 ? "" : ",", k, json_string(d.platform).c_str(), json_string(d.vendor).c_str(),
           json_string(d.device).c_str(), json_string(d.type).c_str(), d.compute_units,
           static_cast<unsigned long long>(d.global_memory),
-          e.max_work_group ? std::to_string(e.max_work_group).c_str() : "null",
-          d.fp64 ? "true" : "false", json_string(e.version).c_str(), json_string(e.driver).c_str(),
+          d.max_work_group ? std::to_string(d.max_work_group).c_str() : "null",
+          d.fp64 ? "true" : "false", json_string(d.version).c_str(), json_string(d.driver).c_str(),
           choice.backend == "opencl" && choice.device == static_cast<int>(k) ? "true" : "false");
     }
     std::printf(
@@ -168,7 +115,6 @@ int devices(const DevicesOptions& o) {
     std::string platform;
     for (std::size_t k = 0; k < list.size(); ++k) {
       const auto& d = list[k];
-      const auto& e = extras[k];
       if (d.platform != platform) {
         std::printf("  platform %s (%s)\n", d.platform.c_str(), d.vendor.c_str());
         platform = d.platform;
@@ -177,10 +123,10 @@ int devices(const DevicesOptions& o) {
       std::printf("  %s [%zu] %s\n", picked ? "*" : " ", k, d.device.c_str());
       std::printf("        %s, %u compute units, %s global memory, max work-group %s, fp64 %s\n",
                   d.type.c_str(), d.compute_units, gib(d.global_memory).c_str(),
-                  e.max_work_group ? std::to_string(e.max_work_group).c_str() : "?",
+                  d.max_work_group ? std::to_string(d.max_work_group).c_str() : "?",
                   d.fp64 ? "yes" : "no");
-      if (!e.version.empty())
-        std::printf("        %s, driver %s\n", e.version.c_str(), e.driver.c_str());
+      if (!d.version.empty())
+        std::printf("        %s, driver %s\n", d.version.c_str(), d.driver.c_str());
     }
   }
   std::printf(

@@ -131,11 +131,6 @@ void check(cl_int code, const char* what) {
 
 namespace {
 
-std::string lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 std::string platform_string(cl_platform_id p, cl_platform_info what) {
   std::size_t size = 0;
   if (clGetPlatformInfo(p, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
@@ -193,6 +188,11 @@ std::vector<DeviceEntry> enumerate_devices() {
       e.info.compute_units = device_value<cl_uint>(d, CL_DEVICE_MAX_COMPUTE_UNITS);
       const std::string ext = " " + device_string(d, CL_DEVICE_EXTENSIONS) + " ";
       e.info.fp64 = ext.find(" cl_khr_fp64 ") != std::string::npos;
+      std::size_t wg = 0;
+      if (clGetDeviceInfo(d, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof wg, &wg, nullptr) == CL_SUCCESS)
+        e.info.max_work_group = wg;
+      e.info.version = device_string(d, CL_DEVICE_VERSION);
+      e.info.driver = device_string(d, CL_DRIVER_VERSION);
       out.push_back(std::move(e));
     }
   }
@@ -205,18 +205,6 @@ std::string describe(const std::vector<DeviceEntry>& devices) {
     s += fmt::format("{}'{}:{}' ({})", s.empty() ? "" : ", ", d.info.platform, d.info.device,
                      d.info.type);
   return s.empty() ? "none" : s;
-}
-
-/// Whether `entry` matches "<platform>:<device>" (substrings, case-insensitive; the platform
-/// part matches the platform's name or vendor). Without ':' the selector names the device.
-bool matches(const DeviceEntry& entry, const std::string& selector) {
-  const auto colon = selector.find(':');
-  const std::string plat = colon == std::string::npos ? "" : lower(selector.substr(0, colon));
-  const std::string dev = lower(colon == std::string::npos ? selector : selector.substr(colon + 1));
-  const bool plat_ok = plat.empty() || lower(entry.info.platform).find(plat) != std::string::npos ||
-                       lower(entry.info.vendor).find(plat) != std::string::npos;
-  const bool dev_ok = dev.empty() || lower(entry.info.device).find(dev) != std::string::npos;
-  return plat_ok && dev_ok;
 }
 
 const EmbeddedSource* find_embedded(const std::string& name) {
@@ -363,7 +351,7 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector) {
   const DeviceEntry* chosen = nullptr;
   if (!selector.empty()) {
     for (const auto& d : devices)
-      if (matches(d, selector)) {
+      if (opencl_selector_matches(d.info, selector)) {
         chosen = &d;
         break;
       }

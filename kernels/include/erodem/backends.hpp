@@ -1,6 +1,7 @@
 // erodem — building compute backends.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -39,7 +40,10 @@ struct ClDeviceInfo {
   std::string type;                 ///< "GPU", "CPU", "accelerator" or "other"
   std::uint64_t global_memory = 0;  ///< bytes
   unsigned compute_units = 0;
-  bool fp64 = false;  ///< cl_khr_fp64: the ledger reductions run in double
+  bool fp64 = false;               ///< cl_khr_fp64: the ledger reductions run in double
+  std::size_t max_work_group = 0;  ///< CL_DEVICE_MAX_WORK_GROUP_SIZE; 0: unknown
+  std::string version;             ///< CL_DEVICE_VERSION
+  std::string driver;              ///< CL_DRIVER_VERSION
   bool gpu() const { return type == "GPU"; }
 };
 
