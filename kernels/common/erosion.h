@@ -21,12 +21,17 @@ ERODEM_FN real bed_tilt_sin(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   const real b_r = has_r ? b_e : b_c;
   const real b_t = has_t ? b_n : b_c;
   const real b_b = has_b ? b_s : b_c;
-  const real span_x = (real)(has_l + has_r) * dx[y];
-  const real span_y = (real)(has_t + has_b) * dy[y];
-  const real gx_raw = (b_r - b_l) / (span_x > 0 ? span_x : (real)1);
-  const real gy_raw = (b_b - b_t) / (span_y > 0 ? span_y : (real)1);
-  const real gx = span_x > 0 ? gx_raw : (real)0;
-  const real gy = span_y > 0 ? gy_raw : (real)0;
+  /* the central difference spans two cells, a one-sided one one cell, none no cell (then
+   * the gradient is 0). Written with the neighbour counts selecting the span, not as
+   * count * spacing: that form lets PoCL's SLP vectoriser pack the x and y parts into a
+   * 2-vector, and PoCL does not vectorise a kernel across work-items after that (the same
+   * numbers: 2 dx = dx + dx and 1 dx = dx exactly) */
+  const int n_x = has_l + has_r, n_y = has_t + has_b;
+  const real dx_y = dx[y], dy_y = dy[y];
+  const real span_x = n_x == 2 ? dx_y + dx_y : (n_x == 1 ? dx_y : (real)1);
+  const real span_y = n_y == 2 ? dy_y + dy_y : (n_y == 1 ? dy_y : (real)1);
+  const real gx = n_x > 0 ? (b_r - b_l) / span_x : (real)0;
+  const real gy = n_y > 0 ? (b_b - b_t) / span_y : (real)0;
   const real tan2 = gx * gx + gy * gy;
   return sqrt(tan2 / ((real)1 + tan2));
 }

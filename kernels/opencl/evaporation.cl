@@ -9,7 +9,7 @@
 __kernel void evaporation(int W, int H, __global const uchar* kind, __global real* depth,
                           __global real* wetness, __global const real* area, real dt, real rate,
                           real tau, int evaporate, __global acc_t* partials, int groups) {
-  __local acc_t s[ERODEM_CELL_GROUP_MAX];
+  __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   const int i = x + y * W;
   real lost = 0;
@@ -17,5 +17,5 @@ __kernel void evaporation(int W, int H, __global const uchar* kind, __global rea
     if (evaporate) depth[i] = evaporation_cell(depth[i], dt, rate, area[y], &lost);
     wetness[i] = wetness_cell(wetness[i], depth[i], dt, tau);
   }
-  cell_group_sum(s, (acc_t)lost, partials + ERODEM_TALLY_EVAPORATED * groups + cell_group_index());
+  cell_group_sum(s, lost, partials + ERODEM_TALLY_EVAPORATED * groups + cell_group_index());
 }

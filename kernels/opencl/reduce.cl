@@ -10,8 +10,12 @@
 #ifdef ERODEM_HAVE_FP64
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double acc_t;
+typedef double8 acc8_t;
+#define convert_acc8 convert_double8
 #else
 typedef float acc_t;
+typedef float8 acc8_t;
+#define convert_acc8 convert_float8
 #endif
 
 /* The largest work-group of the cell kernels (the host's local size is at most this). */
@@ -29,18 +33,44 @@ static inline int cell_group_index(void) {
   return (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
 }
 
+/* The sum in acc_t of the n per-cell tallies s[0 .. n), n a power of two (the local size):
+ * eight running sums, lane j over the indices j mod 8, as one 8-vector, then added pairwise;
+ * a fixed order. (One running sum makes every add wait for the one before: on CPU devices
+ * that chain, not the memory traffic, would set the speed of the tally kernels.) */
+static inline acc_t cell_tallies_sum(__local const real* s, int n) {
+  if (n < 8) {
+    acc_t a = 0;
+    for (int k = 0; k < n; ++k) a += (acc_t)s[k];
+    return a;
+  }
+  acc8_t a = convert_acc8(vload8(0, s));
+  for (int k = 1; k < n / 8; ++k) a += convert_acc8(vload8(k, s));
+  return ((a.s0 + a.s1) + (a.s2 + a.s3)) + ((a.s4 + a.s5) + (a.s6 + a.s7));
+}
+
 /* Sums v over the work-group into *out, in local-id order (one work-item adds them: on CPU
- * devices the barrier costs more than the adds). Every work-item must call it; `s` holds
- * at least the local size. */
-static inline void cell_group_sum(__local acc_t* s, acc_t v, __global acc_t* out) {
+ * devices the barrier costs more than the adds). Every work-item must call it, once per
+ * kernel; `s` holds at least the local size. The per-cell tallies are stored as `real` (they
+ * are real numbers; the sum widens them exactly): PoCL vectorises a kernel whose local stores
+ * are float and not one whose stores are double. */
+static inline void cell_group_sum(__local real* s, real v, __global acc_t* out) {
   const int l = (int)get_local_id(0) + (int)get_local_id(1) * (int)get_local_size(0);
-  barrier(CLK_LOCAL_MEM_FENCE); /* s may still be read by an earlier call */
   s[l] = v;
   barrier(CLK_LOCAL_MEM_FENCE);
+  if (l == 0) *out = cell_tallies_sum(s, (int)(get_local_size(0) * get_local_size(1)));
+}
+
+/* cell_group_sum of two tallies behind one barrier (a second barrier costs PoCL a second
+ * work-item loop): v0 into *out0, v1 into *out1; `s` holds twice the local size. */
+static inline void cell_group_sum2(__local real* s, real v0, real v1, __global acc_t* out0,
+                                   __global acc_t* out1) {
+  const int l = (int)get_local_id(0) + (int)get_local_id(1) * (int)get_local_size(0);
+  const int n = (int)(get_local_size(0) * get_local_size(1));
+  s[l] = v0;
+  s[n + l] = v1;
+  barrier(CLK_LOCAL_MEM_FENCE);
   if (l == 0) {
-    const int n = (int)(get_local_size(0) * get_local_size(1));
-    acc_t a = 0;
-    for (int k = 0; k < n; ++k) a += s[k];
-    *out = a;
+    *out0 = cell_tallies_sum(s, n);
+    *out1 = cell_tallies_sum(s + n, n);
   }
 }

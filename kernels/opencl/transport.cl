@@ -11,13 +11,13 @@ __kernel void transport_conservative(int W, int H, __global const uchar* kind,
                                      __global const real* f_right, __global const real* f_top,
                                      __global const real* f_bottom, __global const real* area,
                                      real dt, __global acc_t* partials, int groups) {
-  __local acc_t s[ERODEM_CELL_GROUP_MAX];
+  __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real out = 0;
   if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[x + y * W] == ERODEM_CELL_ACTIVE)
     sediment_out[x + y * W] = transport_conservative_cell(
         x, y, W, kind, sediment, depth_flow, f_left, f_right, f_top, f_bottom, area, dt, &out);
-  cell_group_sum(s, (acc_t)out, partials + ERODEM_TALLY_SEDIMENT * groups + cell_group_index());
+  cell_group_sum(s, out, partials + ERODEM_TALLY_SEDIMENT * groups + cell_group_index());
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */

@@ -13,13 +13,13 @@ __kernel void water_update(int W, int H, __global const uchar* kind, __global co
                            __global const real* dy, __global const real* area,
                            __global real* velocity_x, __global real* velocity_y, real dt,
                            real velocity_min_depth, __global acc_t* partials, int groups) {
-  __local acc_t s[ERODEM_CELL_GROUP_MAX];
+  __local real s[2 * ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real exchange = 0, clipped = 0;
   if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[x + y * W] == ERODEM_CELL_ACTIVE)
     water_update_cell(x, y, W, kind, depth, depth_out, f_left, f_right, f_top, f_bottom, dx, dy,
                       area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped);
   const int g = cell_group_index();
-  cell_group_sum(s, (acc_t)exchange, partials + ERODEM_TALLY_EXCHANGE * groups + g);
-  cell_group_sum(s, (acc_t)clipped, partials + ERODEM_TALLY_CLIPPED * groups + g);
+  cell_group_sum2(s, exchange, clipped, partials + ERODEM_TALLY_EXCHANGE * groups + g,
+                  partials + ERODEM_TALLY_CLIPPED * groups + g);
 }
