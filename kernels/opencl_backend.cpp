@@ -340,9 +340,16 @@ void build_program(Runtime& rt) {
 
 }  // namespace
 
-std::shared_ptr<Runtime> runtime_for(const std::string& selector) {
+std::size_t whole_row_group(std::size_t W, std::size_t limit) {
+  const std::size_t cap = std::min<std::size_t>(limit, 1024);  // ERODEM_CELL_GROUP_MAX
+  for (std::size_t d = std::min(W, cap); d > 1; --d)
+    if (W % d == 0) return d;
+  return 1;
+}
+
+std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width) {
   static std::mutex mutex;
-  static std::map<cl_device_id, std::shared_ptr<Runtime> > cache;
+  static std::map<std::pair<cl_device_id, bool>, std::shared_ptr<Runtime> > cache;
   const auto devices = enumerate_devices();
   if (devices.empty())
     throw Error(ExitCode::usage,
@@ -369,14 +376,21 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector) {
     if (!chosen) chosen = &devices.front();
   }
 
+  // Whole rows on CPU devices (PoCL vectorises across a row's work-items only where no
+  // per-work-item condition guards the loads), unless a tuning size is set.
+  const char* wg_env = std::getenv("ERODEM_OPENCL_WG");
+  const bool whole_rows = chosen->info.type == "CPU" && !(wg_env && *wg_env) &&
+                          whole_row_group(row_width, chosen->info.max_work_group) >=
+                              std::min<std::size_t>(32, row_width);
   std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[chosen->device];
+  auto& slot = cache[{chosen->device, whole_rows}];
   if (slot) return slot;
   auto rt = std::make_shared<Runtime>();
   rt->info = chosen->info;
   rt->platform = chosen->platform;
   rt->device = chosen->device;
   rt->fp64 = chosen->info.fp64;
+  rt->whole_rows = whole_rows;
   rt->max_work_group = device_value<std::size_t>(rt->device, CL_DEVICE_MAX_WORK_GROUP_SIZE);
   const cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
                                          reinterpret_cast<cl_context_properties>(rt->platform), 0};
@@ -388,6 +402,7 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector) {
   // where the device offers them; the kernels switch FP_CONTRACT off.
   rt->options = "-cl-std=CL1.2 -D real=float";
   if (rt->fp64) rt->options += " -D ERODEM_HAVE_FP64=1";
+  if (rt->whole_rows) rt->options += " -D ERODEM_WHOLE_ROWS=1";
   const auto fp = device_value<cl_device_fp_config>(rt->device, CL_DEVICE_SINGLE_FP_CONFIG);
   if (fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
     rt->options += " -cl-fp32-correctly-rounded-divide-sqrt";
@@ -456,7 +471,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                                             nx_, ny_));
   const PaddedState state = build_padded_state(terrain, params);
 
-  rt_ = runtime_for(selector);
+  rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
   cl_int err = CL_SUCCESS;
   queue_ = Queue(clCreateCommandQueue(rt_->context.get(), rt_->device, 0, &err));
   check(err, "clCreateCommandQueue");
@@ -536,11 +551,19 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     while (p * 2 <= v) p *= 2;
     return p;
   };
-  local_x_ = pow2_at_most(std::min(cell_limit, env_size("ERODEM_OPENCL_WG", cpu ? 64 : 128)));
-  local_y_ = pow2_at_most(std::min(cell_limit / local_x_, env_size("ERODEM_OPENCL_WG_Y", 1)));
+  if (rt_->whole_rows) {
+    // the program was built for it: a local size that divides the row (any divisor keeps
+    // the kernels correct; the largest is the fastest)
+    local_x_ = whole_row_group(static_cast<std::size_t>(W_), cell_limit);
+    local_y_ = 1;
+  } else {
+    local_x_ = pow2_at_most(std::min(cell_limit, env_size("ERODEM_OPENCL_WG", cpu ? 64 : 128)));
+    local_y_ = pow2_at_most(std::min(cell_limit / local_x_, env_size("ERODEM_OPENCL_WG_Y", 1)));
+  }
   groups_x_ = (static_cast<std::size_t>(W_) + local_x_ - 1) / local_x_;
   groups_y_ = (static_cast<std::size_t>(H_) + local_y_ - 1) / local_y_;
   cell_groups_ = groups_x_ * groups_y_;
+  interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
   tally_partials_ = make_buffer(kTallySlots * cell_groups_ * acc_size_);
   tally_sums_ = make_buffer(kTallySlots * acc_size_);
   run_boundary();
@@ -574,6 +597,10 @@ void OpenClBackend::launch_cells(cl_kernel k) {
   const std::size_t local[2] = {local_x_, local_y_};
   check(clEnqueueNDRangeKernel(queue_.get(), k, 2, nullptr, global, local, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel");
+}
+
+void OpenClBackend::launch_interior(cl_kernel k) {
+  launch_rows(k, 1, H_ - 1);
 }
 
 void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1) {
@@ -622,7 +649,7 @@ void OpenClBackend::defer(StepTally& tally, unsigned bits) {
 void OpenClBackend::enqueue_tally_reduction() {
   if (!(pending_ & kTallyBits)) return;
   cl_kernel k = kernel("reduce_tallies");
-  set_args(k, static_cast<cl_int>(cell_groups_), tally_partials_, tally_sums_);
+  set_args(k, static_cast<cl_int>(interior_groups_), tally_partials_, tally_sums_);
   launch_reduction(k, kTallySlots);
 }
 
@@ -705,7 +732,7 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   if (rate != Real(0)) {
     cl_kernel k = kernel("sources_rain");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, rain_factor_, dt, rate);
-    launch_cells(k);
+    launch_interior(k);
   }
   if (in.points.empty()) return;
   std::vector<cl_int> cells;
@@ -783,10 +810,10 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, depth_next_, flux_[0], flux_[1], flux_[2],
            flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
            static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
-           static_cast<cl_int>(cell_groups_));
+           static_cast<cl_int>(interior_groups_));
   defer(tally, kExchangeBit | kClippedBit);
   pending_water_dt_ = dt;
-  launch_cells(k);
+  launch_interior(k);
   // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
   std::swap(depth_, depth_next_);
 }
@@ -800,7 +827,7 @@ void OpenClBackend::run_erosion(Real dt) {
            velocity_y_, hardness_, dx_, dy_, dt, static_cast<Real>(e.sediment_capacity),
            static_cast<Real>(e.dissolving_rate), static_cast<Real>(e.deposition_rate),
            static_cast<Real>(e.min_tilt), static_cast<Real>(e.min_depth), bedrock);
-  launch_cells(k);
+  launch_interior(k);
   std::swap(bed_, bed_next_);
 }
 
@@ -809,14 +836,14 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
     cl_kernel k = kernel("transport_conservative");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
              flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
-             static_cast<cl_int>(cell_groups_));
+             static_cast<cl_int>(interior_groups_));
     defer(tally, kSedimentBit);
-    launch_cells(k);
+    launch_interior(k);
   } else {
     cl_kernel k = kernel("transport_semi_lagrangian");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
              dx_, dy_, dt);
-    launch_cells(k);
+    launch_interior(k);
     cl_kernel r = kernel("reduce_change");
     set_args(r, cl_int{W_}, cl_int{H_}, kind_, sediment_next_, sediment_, area_, partial_b_);
     defer(tally, kChangeBit);
@@ -832,11 +859,11 @@ void OpenClBackend::run_thermal(Real dt) {
   cl_kernel share = kernel("thermal_share");
   set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, dx_, dy_, area_, thermal_share_, dt, rate,
            tan_talus);
-  launch_cells(share);
+  launch_interior(share);
   cl_kernel apply = kernel("thermal_apply");
   set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, thermal_share_, dx_, dy_, area_, bed_next_,
            tan_talus);
-  launch_cells(apply);
+  launch_interior(apply);
   std::swap(bed_, bed_next_);
 }
 
@@ -845,9 +872,9 @@ void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
   const Real tau = static_cast<Real>(params_.numerics.wetness_time);
   cl_kernel k = kernel("evaporation");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, rate, tau,
-           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(cell_groups_));
+           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(interior_groups_));
   defer(tally, kEvaporatedBit);
-  launch_cells(k);
+  launch_interior(k);
 }
 
 void OpenClBackend::finish() {

@@ -3,7 +3,9 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "erosion.h"
 
-/* One work-item per padded cell (the global size may be rounded up). */
+/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch). Every work-item
+ * computes (in the first and last column on neighbours across the row ends, inside the
+ * buffer) and active cells keep the result: no per-work-item branch, so PoCL vectorises it. */
 __kernel void erosion(int W, int H, __global const uchar* kind, __global const real* bed,
                       __global real* bed_out, __global real* sediment, __global const real* depth,
                       __global const real* velocity_x, __global const real* velocity_y,
@@ -11,14 +13,14 @@ __kernel void erosion(int W, int H, __global const uchar* kind, __global const r
                       __global const real* dy, real dt, real capacity_k, real dissolving_rate,
                       real deposition_rate, real min_tilt, real min_depth, real bedrock) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x < 1 || y < 1 || x > W - 2 || y > H - 2) return;
-  /* PoCL does not vectorise this kernel (the bed tilt stops it), so inactive cells return
-   * early rather than compute and discard */
+  if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
-  if (kind[i] != ERODEM_CELL_ACTIVE) return;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  const real b = bed[i], s = sediment[i];
   real s_new;
-  bed_out[i] = erosion_cell(x, y, W, kind, bed, sediment, depth, velocity_x, velocity_y, hardness,
-                            dx, dy, dt, capacity_k, dissolving_rate, deposition_rate, min_tilt,
-                            min_depth, bedrock, &s_new);
-  sediment[i] = s_new;
+  const real b_new = erosion_cell(x, y, W, kind, bed, sediment, depth, velocity_x, velocity_y,
+                                  hardness, dx, dy, dt, capacity_k, dissolving_rate,
+                                  deposition_rate, min_tilt, min_depth, bedrock, &s_new);
+  bed_out[i] = active ? b_new : b;
+  sediment[i] = active ? s_new : s;
 }

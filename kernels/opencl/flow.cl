@@ -3,7 +3,8 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "flow.h"
 
-/* One work-item per padded cell (the global size may be rounded up). */
+/* One work-item per padded cell (where the global size is rounded up, the work-items past
+ * the raster stop). */
 __kernel void flow_pipes(int W, int H, __global const uchar* kind, __global const real* bed,
                          __global const real* depth, __global const real* dx,
                          __global const real* dy, __global const real* area,
@@ -13,7 +14,7 @@ __kernel void flow_pipes(int W, int H, __global const uchar* kind, __global cons
                          __global real* out_bottom, real dt, real gravity, real pipe_area,
                          real pipe_length) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x >= W || y >= H) return;
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   flow_pipes_cell(x, y, W, H, kind, bed, depth, dx, dy, area, f_left, f_right, f_top, f_bottom,
                   out_left, out_right, out_top, out_bottom, dt, gravity, pipe_area, pipe_length);
 }
@@ -32,7 +33,7 @@ __kernel void flow_local_inertial_faces(int W, int H, __global const uchar* kind
                                         __global real* face_y, real dt, real gravity, real theta,
                                         real dry_depth) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x >= W || y >= H) return;
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   const int i = x + y * W;
   const real qx = local_inertial_face_x(x, y, W, H, kind, bed, depth, manning, dx, dy, f_left,
                                         f_right, dt, gravity, theta, dry_depth);
@@ -50,7 +51,7 @@ __kernel void flow_local_inertial_faces_interior(
     __global const real* f_bottom, __global real* face_x, __global real* face_y, real dt,
     real gravity, real theta, real dry_depth) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x >= W || y > H - 3) return;
+  if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
   const real qx = local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_left,
                                                  f_right, dt, gravity, theta, dry_depth);
@@ -69,7 +70,7 @@ __kernel void flow_local_inertial_split(int W, int H, __global const uchar* kind
                                         __global real* out_top, __global real* out_bottom,
                                         real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x >= W || y >= H) return;
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   flow_local_inertial_cell(x, y, W, H, kind, depth, area, face_x, face_y, out_left, out_right,
                            out_top, out_bottom, dt);
 }
@@ -80,7 +81,7 @@ __kernel void flow_local_inertial_split_interior(
     __global const real* face_x, __global const real* face_y, __global real* out_left,
     __global real* out_right, __global real* out_top, __global real* out_bottom, real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x >= W || y > H - 2) return;
+  if (ERODEM_PAST_ROW(x, W)) return;
   flow_local_inertial_cell_interior(x, y, W, kind, depth, area, face_x, face_y, out_left, out_right,
                                     out_top, out_bottom, dt);
 }

@@ -94,13 +94,23 @@ struct Runtime {
   Program program;
   bool fp64 = false;
   std::size_t max_work_group = 1;
+  /// Built for launches of whole rows (ERODEM_WHOLE_ROWS: every cell kernel's local size
+  /// divides the row; the kernels then need no per-work-item bound check).
+  bool whole_rows = false;
   std::string options;  ///< the build options
 };
 
+/// The cell kernels' largest work-group of at most `limit` work-items (and of 1024, the
+/// local arrays of reduce.cl) that divides a padded row of W cells: W itself up to there.
+std::size_t whole_row_group(std::size_t W, std::size_t limit);
+
 /// The runtime of the device chosen by ERODEM_OPENCL_DEVICE ("<platform>:<device>"
 /// substrings, case-insensitive; either may be empty), else the first GPU, else the first
-/// device; built once per process and device. Throws Error(usage) when there is none.
-std::shared_ptr<Runtime> runtime_for(const std::string& selector);
+/// device; built once per process, device and launch kind. `row_width` is the padded row of
+/// the grid to run: on CPU devices the kernels are built for whole-row launches when a
+/// work-group of at least min(32, row_width) divides it (and ERODEM_OPENCL_WG is not set).
+/// Throws Error(usage) when there is no device.
+std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width);
 
 /// The CPU reference's algorithms on an OpenCL device, float32 only. State stays on the
 /// device; field() reads back, set_field() uploads, stats() reduces on the device.
@@ -137,6 +147,9 @@ class OpenClBackend final : public Backend {
   /// Runs a cell kernel over the padded raster: work-groups of (local_x_, local_y_), the global
   /// size rounded up to whole groups (the kernels bound-check).
   void launch_cells(cl_kernel k);
+  /// Runs a cell kernel over the padded rows 1 .. H - 2, the rows with DEM cells (what the
+  /// processes but flow touch), in interior_groups_ work-groups of (local_x_, 1).
+  void launch_interior(cl_kernel k);
   /// Runs a cell kernel over the padded rows [y0, y1) only (global offset y0; work-groups of
   /// (local_x_, 1)); nothing when the range is empty.
   void launch_rows(cl_kernel k, int y0, int y1);
@@ -168,8 +181,11 @@ class OpenClBackend final : public Backend {
   int nx_, ny_, W_, H_;
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
-  // The cell kernels' groups: (local_x_, local_y_) work-items, groups_x_ * groups_y_ of them.
-  std::size_t local_x_ = 1, local_y_ = 1, groups_x_ = 1, groups_y_ = 1, cell_groups_ = 1;
+  // The cell kernels' groups: (local_x_, local_y_) work-items, groups_x_ * groups_y_ of them
+  // over the padded raster, interior_groups_ over its rows 1 .. H - 2 (launch_interior; the
+  // tally kernels: one partial per group).
+  std::size_t local_x_ = 1, local_y_ = 1, groups_x_ = 1, groups_y_ = 1, cell_groups_ = 1,
+              interior_groups_ = 1;
   std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
   Buffer kind_, dx_, dy_, area_;
   Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;

@@ -18,6 +18,18 @@ typedef float8 acc8_t;
 #define convert_acc8 convert_float8
 #endif
 
+/* Whether work-item column x lies past the padded row of W cells. Where the host launches
+ * whole rows (ERODEM_WHOLE_ROWS, on CPU devices: the local size divides W) there is no such
+ * work-item, and a cell kernel has no per-work-item condition left: every load is
+ * unconditional, which PoCL needs to vectorise a kernel with loads of per-row values (under a
+ * per-work-item condition it gathers them). Elsewhere the global size is rounded up to whole
+ * work-groups and those work-items stop here. */
+#ifdef ERODEM_WHOLE_ROWS
+#define ERODEM_PAST_ROW(x, W) 0
+#else
+#define ERODEM_PAST_ROW(x, W) ((x) >= (W))
+#endif
+
 /* The largest work-group of the cell kernels (the host's local size is at most this). */
 #define ERODEM_CELL_GROUP_MAX 1024
 
@@ -33,19 +45,21 @@ static inline int cell_group_index(void) {
   return (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
 }
 
-/* The sum in acc_t of the n per-cell tallies s[0 .. n), n a power of two (the local size):
- * eight running sums, lane j over the indices j mod 8, as one 8-vector, then added pairwise;
- * a fixed order. (One running sum makes every add wait for the one before: on CPU devices
- * that chain, not the memory traffic, would set the speed of the tally kernels.) */
+/* The sum in acc_t of the n per-cell tallies s[0 .. n) (n the local size): eight running
+ * sums, lane j over the indices j mod 8 below the last multiple of 8, as one 8-vector, added
+ * pairwise, then the rest in order; a fixed order. (One running sum makes every add wait for
+ * the one before: on CPU devices that chain, not the memory traffic, would set the speed of
+ * the tally kernels.) */
 static inline acc_t cell_tallies_sum(__local const real* s, int n) {
-  if (n < 8) {
-    acc_t a = 0;
-    for (int k = 0; k < n; ++k) a += (acc_t)s[k];
-    return a;
+  const int blocks = n / 8;
+  acc_t sum = 0;
+  if (blocks > 0) {
+    acc8_t a = convert_acc8(vload8(0, s));
+    for (int k = 1; k < blocks; ++k) a += convert_acc8(vload8(k, s));
+    sum = ((a.s0 + a.s1) + (a.s2 + a.s3)) + ((a.s4 + a.s5) + (a.s6 + a.s7));
   }
-  acc8_t a = convert_acc8(vload8(0, s));
-  for (int k = 1; k < n / 8; ++k) a += convert_acc8(vload8(k, s));
-  return ((a.s0 + a.s1) + (a.s2 + a.s3)) + ((a.s4 + a.s5) + (a.s6 + a.s7));
+  for (int k = 8 * blocks; k < n; ++k) sum += (acc_t)s[k];
+  return sum;
 }
 
 /* Sums v over the work-group into *out, in local-id order (one work-item adds them: on CPU

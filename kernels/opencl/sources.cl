@@ -3,13 +3,15 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "sources.h"
 
-/* One work-item per padded cell (the global size may be rounded up). */
+/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep their
+ * depth. */
 __kernel void sources_rain(int W, int H, __global const uchar* kind, __global real* depth,
                            __global const real* rain_factor, real dt, real rate) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x < 1 || y < 1 || x > W - 2 || y > H - 2) return;
+  if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
-  if (kind[i] == ERODEM_CELL_ACTIVE) depth[i] = rain_cell(depth[i], dt, rate, rain_factor[i]);
+  const real d = depth[i];
+  depth[i] = kind[i] == ERODEM_CELL_ACTIVE ? rain_cell(d, dt, rate, rain_factor[i]) : d;
 }
 
 /* Point and line inflows, one work-item adding them in order (a cell may appear twice):

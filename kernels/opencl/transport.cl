@@ -3,8 +3,9 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "transport.h"
 
-/* One work-item per padded cell (the global size is rounded up to whole work-groups); the
- * sediment carried out of the domain is summed per work-group into the tally partials. */
+/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
+ * is rounded up, every work-item still reaches the group sums); ghosts keep their sediment.
+ * The sediment carried out of the domain is summed per work-group into the tally partials. */
 __kernel void transport_conservative(int W, int H, __global const uchar* kind,
                                      __global const real* sediment, __global real* sediment_out,
                                      __global const real* depth_flow, __global const real* f_left,
@@ -14,9 +15,15 @@ __kernel void transport_conservative(int W, int H, __global const uchar* kind,
   __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real out = 0;
-  if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[x + y * W] == ERODEM_CELL_ACTIVE)
-    sediment_out[x + y * W] = transport_conservative_cell(
-        x, y, W, kind, sediment, depth_flow, f_left, f_right, f_top, f_bottom, area, dt, &out);
+  if (!ERODEM_PAST_ROW(x, W)) {
+    const int i = x + y * W;
+    const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+    real carried;
+    const real s_new = transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left,
+                                                   f_right, f_top, f_bottom, area, dt, &carried);
+    sediment_out[i] = active ? s_new : sediment[i];
+    out = active ? carried : (real)0;
+  }
   cell_group_sum(s, out, partials + ERODEM_TALLY_SEDIMENT * groups + cell_group_index());
 }
 
@@ -27,9 +34,10 @@ __kernel void transport_semi_lagrangian(int W, int H, __global const uchar* kind
                                         __global const real* velocity_y, __global const real* dx,
                                         __global const real* dy, real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (x < 1 || y < 1 || x > W - 2 || y > H - 2) return;
+  if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
-  if (kind[i] != ERODEM_CELL_ACTIVE) return;
-  sediment_out[i] =
+  const real s_new =
       transport_semi_lagrangian_cell(x, y, W, H, sediment, velocity_x, velocity_y, dx, dy, dt);
+  sediment_out[i] =
+      (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s_new : sediment[i];
 }

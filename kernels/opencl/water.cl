@@ -4,8 +4,9 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "water.h"
 
-/* One work-item per padded cell (the global size is rounded up to whole work-groups; every
- * work-item reaches the group sums). */
+/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
+ * is rounded up, every work-item still reaches the group sums). water_update_cell is
+ * branch-free and leaves ghosts as they are (the first and last column are ghosts). */
 __kernel void water_update(int W, int H, __global const uchar* kind, __global const real* depth,
                            __global real* depth_out, __global const real* f_left,
                            __global const real* f_right, __global const real* f_top,
@@ -16,7 +17,7 @@ __kernel void water_update(int W, int H, __global const uchar* kind, __global co
   __local real s[2 * ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real exchange = 0, clipped = 0;
-  if (x >= 1 && y >= 1 && x <= W - 2 && y <= H - 2 && kind[x + y * W] == ERODEM_CELL_ACTIVE)
+  if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, depth, depth_out, f_left, f_right, f_top, f_bottom, dx, dy,
                       area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped);
   const int g = cell_group_index();
