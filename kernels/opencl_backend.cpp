@@ -515,7 +515,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
   // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
   std::size_t limit = std::min(kReduceMax, rt_->max_work_group);
-  for (const char* name : {"reduce_tallies", "reduce_change", "field_stats"}) {
+  for (const char* name : {"reduce_tallies", "reduce_change"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -526,20 +526,18 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   while (reduce_local_ * 2 <= limit) reduce_local_ *= 2;
   reduce_groups_ =
       std::clamp<std::size_t>((n_ + reduce_local_ - 1) / reduce_local_, 1, kReduceGroupsMax);
-  partial_a_ = make_buffer(reduce_groups_ * 5 * acc_size_);
   partial_b_ = make_buffer(reduce_groups_ * acc_size_);
-  partial_cells_ = make_buffer(reduce_groups_ * 3 * sizeof(cl_long));
 
   // Cell kernels: work-groups of (local_x_, local_y_), powers of two every cell kernel
   // accepts; a fixed number of groups for this grid (the tallies' partials, summed in a
   // fixed order).
   const bool cpu = rt_->info.type == "CPU";
   std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
-  for (const char* name :
-       {"sources_rain", "flow_pipes", "flow_local_inertial_faces",
-        "flow_local_inertial_faces_interior", "flow_local_inertial_split",
-        "flow_local_inertial_split_interior", "water_update", "erosion", "transport_conservative",
-        "transport_semi_lagrangian", "thermal_share", "thermal_apply", "evaporation"}) {
+  for (const char* name : {"sources_rain", "flow_pipes", "flow_local_inertial_faces",
+                           "flow_local_inertial_faces_interior", "flow_local_inertial_split",
+                           "flow_local_inertial_split_interior", "water_update", "erosion",
+                           "transport_conservative", "transport_semi_lagrangian", "thermal_share",
+                           "thermal_apply", "evaporation", "field_stats"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -564,6 +562,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   groups_y_ = (static_cast<std::size_t>(H_) + local_y_ - 1) / local_y_;
   cell_groups_ = groups_x_ * groups_y_;
   interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
+  partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
+  partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
   tally_partials_ = make_buffer(kTallySlots * cell_groups_ * acc_size_);
   tally_sums_ = make_buffer(kTallySlots * acc_size_);
   run_boundary();
@@ -886,24 +886,24 @@ FieldStats OpenClBackend::stats() {
   cl_kernel k = kernel("field_stats");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, velocity_x_, velocity_y_,
            area_, partial_a_, partial_cells_);
-  launch_reduction(k, reduce_groups_);
+  launch_interior(k);
   // The step's tallies with the statistics: one wait per step (the queue is in order).
   enqueue_tally_reduction();
   tally_raw_.resize(kTallySlots * acc_size_);
   change_raw_.resize(reduce_groups_ * acc_size_);
   if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
   if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
-  std::vector<cl_long> cells(reduce_groups_ * 3);
+  std::vector<cl_long> cells(interior_groups_ * 3);
   read(partial_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
-  stats_sums_raw_.resize(reduce_groups_ * 5 * acc_size_);
+  stats_sums_raw_.resize(interior_groups_ * 5 * acc_size_);
   read(partial_a_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
   deliver_tallies();
-  const auto sums = acc_values(stats_sums_raw_, reduce_groups_ * 5);
+  const auto sums = acc_values(stats_sums_raw_, interior_groups_ * 5);
   // Groups in order; the maxima keep the first cell of the largest value (as the CPU's
   // row-order scan does), whatever group holds it.
   FieldStats st;
   double max_d = -1, max_v = -1;
-  for (std::size_t g = 0; g < reduce_groups_; ++g) {
+  for (std::size_t g = 0; g < interior_groups_; ++g) {
     st.water_volume += sums[5 * g + 0];
     st.material_volume += sums[5 * g + 1];
     st.sediment_volume += sums[5 * g + 2];

@@ -88,6 +88,38 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
   EXPECT_NEAR(M.water, L.water, 1e-5 * L.water);
   EXPECT_NEAR(M.material, L.material, 1e-6 * std::abs(L.material));
   EXPECT_NEAR(M.boundary_out, L.boundary_out, 1e-5 * std::abs(L.boundary_out) + 1e-9);
+
+  // The statistics: the same maxima at the same cells.
+  const FieldStats& S = cpu.last_stats();
+  const FieldStats& T = ocl.last_stats();
+  std::printf(
+      "[agreement] %s stats: max depth %.9g m at cell %lld / %.9g m at %lld; max speed %.9g m/s "
+      "at %lld / %.9g m/s at %lld\n",
+      c.name.c_str(), S.max_depth, static_cast<long long>(S.max_depth_cell), T.max_depth,
+      static_cast<long long>(T.max_depth_cell), S.max_speed,
+      static_cast<long long>(S.max_speed_cell), T.max_speed,
+      static_cast<long long>(T.max_speed_cell));
+  EXPECT_EQ(T.max_depth_cell, S.max_depth_cell);
+  EXPECT_EQ(T.max_speed_cell, S.max_speed_cell);
+  EXPECT_NEAR(T.max_depth, S.max_depth, 1e-6 * S.max_depth);
+  EXPECT_NEAR(T.max_speed, S.max_speed, 1e-6 * S.max_speed);
+  EXPECT_EQ(T.bad_cell, -1);
+  EXPECT_EQ(S.bad_cell, -1);
+  // A state that is not physical is found at its cell, the first of two, by both.
+  const std::int64_t nx = terrain.grid.nx, ny = terrain.grid.ny;
+  const std::int64_t first = (ny / 2) * nx + nx / 3, second = (ny / 2) * nx + nx / 3 + 11;
+  auto depth = cpu.field(FieldId::water_depth);
+  depth[static_cast<std::size_t>(second)] = -1.0;
+  depth[static_cast<std::size_t>(first)] = NAN;
+  for (Simulation* sim : {&cpu, &ocl}) {
+    sim->backend().set_field(FieldId::water_depth, depth);
+    const FieldStats bad = sim->backend().stats();
+    std::printf(
+        "[agreement] %s stats on %s: first state not physical at cell %lld (expected %lld)\n",
+        c.name.c_str(), sim->backend().name().c_str(), static_cast<long long>(bad.bad_cell),
+        static_cast<long long>(first));
+    EXPECT_EQ(bad.bad_cell, first) << sim->backend().name();
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(

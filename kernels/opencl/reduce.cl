@@ -11,11 +11,15 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double acc_t;
 typedef double8 acc8_t;
+typedef long8 acc8_mask_t; /* what comparing two acc8_t gives */
 #define convert_acc8 convert_double8
+#define convert_acc8_mask convert_long8
 #else
 typedef float acc_t;
 typedef float8 acc8_t;
+typedef int8 acc8_mask_t;
 #define convert_acc8 convert_float8
+#define convert_acc8_mask convert_int8
 #endif
 
 /* Whether work-item column x lies past the padded row of W cells. Where the host launches

@@ -2,8 +2,9 @@
  * reference (CpuBackend::stats and the per-row sums of the processes), accumulated in double
  * where the device has cl_khr_fp64 (see reduce.cl). Each work-group writes one partial
  * result; the host combines the partials in group order, so a result does not depend on
- * timing. Work-groups are a power of two of at most ERODEM_REDUCE_MAX work-items; each
- * work-item first walks its cells with a fixed stride. */
+ * timing. The reduction kernels' work-groups are a power of two of at most ERODEM_REDUCE_MAX
+ * work-items, each work-item first walking its cells with a fixed stride; field_stats is a
+ * cell kernel (one work-item per cell). */
 #pragma OPENCL FP_CONTRACT OFF
 #include "stats.h"
 /* acc_t, the tally slots and the cell kernels' group sums: reduce.cl. */
@@ -60,88 +61,120 @@ __kernel void reduce_change(int W, int H, __global const uchar* kind, __global c
   if (l == 0) partials[get_group_id(0)] = s[0];
 }
 
-/* The field statistics over the active cells. Per group: sums[5 g + k] = water, material,
- * sediment volume, max depth, max speed (hypot, as on the CPU; -1 where the group saw no
- * candidate); cells[3 g + k] = the DEM cell (row * nx + col) of the max depth, of the max speed,
- * and the first cell whose state is not physical (-1: none). */
+/* The field statistics over the active cells: a cell kernel over rows 1 .. H - 2 (the host's
+ * launch), one work-item per padded cell, work-groups of (L, 1) inside one row (L <=
+ * ERODEM_CELL_GROUP_MAX). Per group g: sums[5 g + k] = water, material, sediment volume, max
+ * depth, max speed (hypot, as on the CPU; -1 where the group has no active cell); cells[3 g +
+ * k] = the DEM cell (row * nx + col) of the max depth, of the max speed, and the first cell
+ * whose state is not physical (-1: none). Each work-item stores its cell's values in local
+ * memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
+ * cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row. */
 __kernel void field_stats(int W, int H, __global const uchar* kind, __global const real* bed,
                           __global const real* depth, __global const real* sediment,
                           __global const real* velocity_x, __global const real* velocity_y,
                           __global const real* area, __global acc_t* sums, __global long* cells) {
-  __local acc_t s_water[ERODEM_REDUCE_MAX], s_material[ERODEM_REDUCE_MAX],
-      s_sediment[ERODEM_REDUCE_MAX], s_max_d[ERODEM_REDUCE_MAX], s_max_v[ERODEM_REDUCE_MAX];
-  __local long s_arg_d[ERODEM_REDUCE_MAX], s_arg_v[ERODEM_REDUCE_MAX], s_bad[ERODEM_REDUCE_MAX];
-  const int l = (int)get_local_id(0);
-  acc_t water = 0, material = 0, sed = 0, max_d = -1, max_v = -1;
-  long arg_d = -1, arg_v = -1, bad = -1;
-  /* group g: rows 1 + g, 1 + g + groups, ...; work-item l: columns 1 + l, 1 + l + local size,
-   * ... (each work-item meets its cells in row-major order) */
-  for (int y = 1 + (int)get_group_id(0); y <= H - 2; y += (int)get_num_groups(0))
-    for (int x = 1 + l; x <= W - 2; x += (int)get_local_size(0)) {
-      const int i = x + y * W;
-      if (kind[i] != ERODEM_CELL_ACTIVE) continue;
-      const real d = depth[i], b = bed[i], sd = sediment[i];
-      const acc_t a = (acc_t)area[y];
-      const long cell = (long)(y - 1) * (long)(W - 2) + (long)(x - 1);
-      if (bad < 0 && !cell_state_ok(b, d, sd)) bad = cell;
-      water += (acc_t)d * a;
-      material += ((acc_t)b + (acc_t)sd) * a;
-      sed += (acc_t)sd * a;
-      if ((acc_t)d > max_d) {
-        max_d = (acc_t)d;
-        arg_d = cell;
-      }
-      /* the speed's square ranks the cells (products of floats are exact in double); the
-       * winner's speed is hypot below, as on the CPU */
-      const acc_t vx = (acc_t)velocity_x[i], vy = (acc_t)velocity_y[i];
-      const acc_t v = vx * vx + vy * vy;
-      if (v > max_v) {
-        max_v = v;
-        arg_v = cell;
-      }
-    }
-  s_water[l] = water;
-  s_material[l] = material;
-  s_sediment[l] = sed;
-  s_max_d[l] = max_d;
-  s_max_v[l] = max_v;
-  s_arg_d[l] = arg_d;
-  s_arg_v[l] = arg_v;
-  s_bad[l] = bad;
-  for (int stride = (int)get_local_size(0) / 2; stride > 0; stride >>= 1) {
-    barrier(CLK_LOCAL_MEM_FENCE);
-    if (l < stride) {
-      const int o = l + stride;
-      s_water[l] += s_water[o];
-      s_material[l] += s_material[o];
-      s_sediment[l] += s_sediment[o];
-      if (beats(s_max_d[o], s_arg_d[o], s_max_d[l], s_arg_d[l])) {
-        s_max_d[l] = s_max_d[o];
-        s_arg_d[l] = s_arg_d[o];
-      }
-      if (beats(s_max_v[o], s_arg_v[o], s_max_v[l], s_arg_v[l])) {
-        s_max_v[l] = s_max_v[o];
-        s_arg_v[l] = s_arg_v[o];
-      }
-      if (s_bad[o] >= 0 && (s_bad[l] < 0 || s_bad[o] < s_bad[l])) s_bad[l] = s_bad[o];
-    }
-  }
+  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX],
+      s_s[ERODEM_CELL_GROUP_MAX], s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
+  __local int s_state[ERODEM_CELL_GROUP_MAX];
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
+  const int n = (int)get_local_size(0);
+  /* work-items past the row (rounded global sizes only) read the row's first cell */
+  const int i = ERODEM_PAST_ROW(x, W) ? y * W : x + y * W;
+  const int active = !ERODEM_PAST_ROW(x, W) & (x >= 1) & (x <= W - 2) &
+                     (kind[i] == ERODEM_CELL_ACTIVE);
+  const real d = depth[i], b = bed[i], sd = sediment[i];
+  /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
+  s_d[l] = active ? d : (real)0;
+  s_b[l] = active ? b : (real)0;
+  s_s[l] = active ? sd : (real)0;
+  s_u[l] = active ? velocity_x[i] : (real)0;
+  s_v[l] = active ? velocity_y[i] : (real)0;
+  s_state[l] = active ? (cell_state_ok(b, d, sd) ? 1 : 2) : 0; /* 0 ghost, 1 ok, 2 not physical */
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (l == 0) {
-    const int g = (int)get_group_id(0);
-    sums[5 * g + 0] = s_water[0];
-    sums[5 * g + 1] = s_material[0];
-    sums[5 * g + 2] = s_sediment[0];
-    sums[5 * g + 3] = s_max_d[0];
-    const long c = s_arg_v[0];
-    acc_t speed = -1;
-    if (c >= 0) {
-      const int i = (int)(c % (W - 2)) + 1 + ((int)(c / (W - 2)) + 1) * W;
-      speed = hypot((acc_t)velocity_x[i], (acc_t)velocity_y[i]);
+  if (l != 0) return;
+  const int x0 = (int)get_global_id(0) - l; /* the group's first column */
+  const int last = min(n, W - x0);          /* work-items inside the row */
+  const acc_t a = (acc_t)area[y];
+  const long row_cell = (long)(y - 1) * (long)(W - 2) - 1 + (long)x0; /* cell of local id 0 */
+  acc_t water = cell_tallies_sum(s_d, last), bed_sum = cell_tallies_sum(s_b, last);
+  const acc_t sed = cell_tallies_sum(s_s, last);
+  /* maxima: the first largest value in local-id (= row) order, active cells only; lane j of
+   * the 8-vectors keeps the first largest among the local ids j mod 8 (strictly larger
+   * replaces), the lanes are then merged (as large and earlier wins), and the rest after the
+   * last multiple of 8 comes in order. The squared speed in acc_t is exact for float
+   * velocities, so it ranks the cells as the CPU ranks them. bad: the first state 2. */
+  acc_t max_d = -1, max_v = -1;
+  long arg_d = -1, arg_v = -1, bad = -1;
+  const int blocks = last / 8;
+  if (blocks > 0) {
+    float8 best_d = (float8)(-1); /* real is float on OpenCL devices */
+    acc8_t best_v = (acc8_t)(-1);
+    int8 at_d = (int8)(-1), at_v = (int8)(-1), at_bad = (int8)(-1);
+    const int8 lane = (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+    for (int k = 0; k < blocks; ++k) {
+      const int8 state = vload8(k, s_state), id = lane + (int8)(8 * k);
+      const int8 act = state != (int8)(0);
+      const float8 d8 = vload8(k, s_d);
+      const int8 deeper = act & (d8 > best_d);
+      best_d = select(best_d, d8, deeper);
+      at_d = select(at_d, id, deeper);
+      const acc8_t u8 = convert_acc8(vload8(k, s_u)), v8 = convert_acc8(vload8(k, s_v));
+      const acc8_t v2 = u8 * u8 + v8 * v8;
+      const acc8_mask_t faster = convert_acc8_mask(act) & (v2 > best_v);
+      best_v = select(best_v, v2, faster);
+      at_v = select(at_v, id, convert_int8(faster));
+      at_bad = select(at_bad, id, (state == (int8)(2)) & (at_bad < (int8)(0)));
     }
-    sums[5 * g + 4] = speed;
-    cells[3 * g + 0] = s_arg_d[0];
-    cells[3 * g + 1] = s_arg_v[0];
-    cells[3 * g + 2] = s_bad[0];
+    const real bd[8] = {best_d.s0, best_d.s1, best_d.s2, best_d.s3,
+                        best_d.s4, best_d.s5, best_d.s6, best_d.s7};
+    const acc_t bv[8] = {best_v.s0, best_v.s1, best_v.s2, best_v.s3,
+                         best_v.s4, best_v.s5, best_v.s6, best_v.s7};
+    const int ad[8] = {at_d.s0, at_d.s1, at_d.s2, at_d.s3, at_d.s4, at_d.s5, at_d.s6, at_d.s7};
+    const int av[8] = {at_v.s0, at_v.s1, at_v.s2, at_v.s3, at_v.s4, at_v.s5, at_v.s6, at_v.s7};
+    const int ab[8] = {at_bad.s0, at_bad.s1, at_bad.s2, at_bad.s3,
+                       at_bad.s4, at_bad.s5, at_bad.s6, at_bad.s7};
+    int kd = -1, kv = -1, kb = -1;
+    for (int j = 0; j < 8; ++j) {
+      if (ad[j] >= 0 && (kd < 0 || (acc_t)bd[j] > max_d || ((acc_t)bd[j] == max_d && ad[j] < kd))) {
+        max_d = (acc_t)bd[j];
+        kd = ad[j];
+      }
+      if (av[j] >= 0 && (kv < 0 || bv[j] > max_v || (bv[j] == max_v && av[j] < kv))) {
+        max_v = bv[j];
+        kv = av[j];
+      }
+      if (ab[j] >= 0 && (kb < 0 || ab[j] < kb)) kb = ab[j];
+    }
+    arg_d = kd < 0 ? -1 : row_cell + kd;
+    arg_v = kv < 0 ? -1 : row_cell + kv;
+    bad = kb < 0 ? -1 : row_cell + kb;
   }
+  for (int k = 8 * blocks; k < last; ++k) {
+    if (s_state[k] == 0) continue;
+    if (bad < 0 && s_state[k] == 2) bad = row_cell + k;
+    if ((acc_t)s_d[k] > max_d) {
+      max_d = (acc_t)s_d[k];
+      arg_d = row_cell + k;
+    }
+    const acc_t vx = (acc_t)s_u[k], vy = (acc_t)s_v[k];
+    const acc_t v = vx * vx + vy * vy;
+    if (v > max_v) {
+      max_v = v;
+      arg_v = row_cell + k;
+    }
+  }
+  const int g = (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
+  sums[5 * g + 0] = water * a;
+  sums[5 * g + 1] = (bed_sum + sed) * a;
+  sums[5 * g + 2] = sed * a;
+  sums[5 * g + 3] = max_d;
+  acc_t speed = -1;
+  if (arg_v >= 0) {
+    const int c = (int)(arg_v - row_cell) + x0 + y * W;
+    speed = hypot((acc_t)velocity_x[c], (acc_t)velocity_y[c]);
+  }
+  sums[5 * g + 4] = speed;
+  cells[3 * g + 0] = arg_d;
+  cells[3 * g + 1] = arg_v;
+  cells[3 * g + 2] = bad;
 }
