@@ -73,15 +73,15 @@ __kernel void field_stats(int W, int H, __global const uchar* kind, __global con
                           __global const real* depth, __global const real* sediment,
                           __global const real* velocity_x, __global const real* velocity_y,
                           __global const real* area, __global acc_t* sums, __global long* cells) {
-  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX],
-      s_s[ERODEM_CELL_GROUP_MAX], s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
+  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_s[ERODEM_CELL_GROUP_MAX],
+      s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
   __local int s_state[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
   const int n = (int)get_local_size(0);
   /* work-items past the row (rounded global sizes only) read the row's first cell */
   const int i = ERODEM_PAST_ROW(x, W) ? y * W : x + y * W;
-  const int active = !ERODEM_PAST_ROW(x, W) & (x >= 1) & (x <= W - 2) &
-                     (kind[i] == ERODEM_CELL_ACTIVE);
+  const int active =
+      !ERODEM_PAST_ROW(x, W) & (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   const real d = depth[i], b = bed[i], sd = sediment[i];
   /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
   s_d[l] = active ? d : (real)0;

@@ -38,6 +38,5 @@ __kernel void transport_semi_lagrangian(int W, int H, __global const uchar* kind
   const int i = x + y * W;
   const real s_new =
       transport_semi_lagrangian_cell(x, y, W, H, sediment, velocity_x, velocity_y, dx, dy, dt);
-  sediment_out[i] =
-      (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s_new : sediment[i];
+  sediment_out[i] = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s_new : sediment[i];
 }
