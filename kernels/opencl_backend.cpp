@@ -254,7 +254,7 @@ ProgramSource assemble_program() {
   // other embedded .cl after.
   std::vector<std::string> order = {"reduce.cl",      "boundary.cl", "sources.cl",   "flow.cl",
                                     "water.cl",       "erosion.cl",  "transport.cl", "thermal.cl",
-                                    "evaporation.cl", "stats.cl"};
+                                    "evaporation.cl", "edges.cl",    "stats.cl"};
   for (std::size_t k = 0; k < kEmbeddedSourceCount; ++k) {
     const std::string name = kEmbeddedSources[k].name;
     if (name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0 &&
@@ -435,6 +435,8 @@ constexpr std::size_t kReduceMax = 256;      // ERODEM_REDUCE_MAX of stats.cl
 constexpr std::size_t kCellGroupMax = 1024;  // ERODEM_CELL_GROUP_MAX of reduce.cl
 constexpr std::size_t kReduceGroupsMax = 1024;
 constexpr std::size_t kTallySlots = 4;  // ERODEM_TALLY_SLOTS of reduce.cl
+constexpr int kTallyExchange = 0;       // ERODEM_TALLY_EXCHANGE of reduce.cl
+constexpr int kTallySediment = 2;       // ERODEM_TALLY_SEDIMENT of reduce.cl
 constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
                    kEvaporatedBit = 1u << 3, kTallyBits = 0xfu, kChangeBit = 1u << 4;
 
@@ -564,7 +566,25 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
   partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
   partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
-  tally_partials_ = make_buffer(kTallySlots * cell_groups_ * acc_size_);
+  // The active cells beside a ghost, row-major: the only ones with a water exchange or a
+  // sediment outflow through the domain's faces (edges.cl). The kinds never change.
+  std::vector<cl_int> edges;
+  for (int y = 1; y < H_ - 1; ++y)
+    for (int x = 1; x < W_ - 1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
+      if (kind[i] != ERODEM_CELL_ACTIVE) continue;
+      if (kind[i - 1] != ERODEM_CELL_ACTIVE || kind[i + 1] != ERODEM_CELL_ACTIVE ||
+          kind[i - W_] != ERODEM_CELL_ACTIVE || kind[i + W_] != ERODEM_CELL_ACTIVE)
+        edges.push_back(static_cast<cl_int>(i));
+    }
+  edge_count_ = edges.size();
+  edge_cells_ = upload(edges);
+  edge_local_ = pow2_at_most(std::min<std::size_t>(cell_limit, 64));
+  edge_groups_ = std::max<std::size_t>(1, (edge_count_ + edge_local_ - 1) / edge_local_);
+  // Every slot holds tally_stride_ partials; what no kernel writes stays 0.
+  tally_stride_ = std::max(interior_groups_, edge_groups_);
+  const std::vector<unsigned char> no_partials(kTallySlots * tally_stride_ * acc_size_, 0);
+  tally_partials_ = upload(no_partials);
   tally_sums_ = make_buffer(kTallySlots * acc_size_);
   run_boundary();
 }
@@ -612,6 +632,17 @@ void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1) {
         "clEnqueueNDRangeKernel");
 }
 
+void OpenClBackend::launch_edge_tallies(int slot, Real dt) {
+  if (edge_count_ == 0) return;
+  cl_kernel k = kernel("edge_tallies");
+  set_args(k, cl_int{W_}, kind_, edge_cells_, static_cast<cl_int>(edge_count_), flux_[0], flux_[1],
+           flux_[2], flux_[3], sediment_, depth_next_, dt, cl_int{slot}, tally_partials_,
+           static_cast<cl_int>(tally_stride_));
+  const std::size_t global = edge_groups_ * edge_local_, local = edge_local_;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(edge_tallies)");
+}
+
 void OpenClBackend::launch_reduction(cl_kernel k, std::size_t groups) {
   const std::size_t global = groups * reduce_local_, local = reduce_local_;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
@@ -649,7 +680,7 @@ void OpenClBackend::defer(StepTally& tally, unsigned bits) {
 void OpenClBackend::enqueue_tally_reduction() {
   if (!(pending_ & kTallyBits)) return;
   cl_kernel k = kernel("reduce_tallies");
-  set_args(k, static_cast<cl_int>(interior_groups_), tally_partials_, tally_sums_);
+  set_args(k, static_cast<cl_int>(tally_stride_), tally_partials_, tally_sums_);
   launch_reduction(k, kTallySlots);
 }
 
@@ -810,10 +841,11 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, depth_next_, flux_[0], flux_[1], flux_[2],
            flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
            static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
-           static_cast<cl_int>(interior_groups_));
+           static_cast<cl_int>(tally_stride_));
   defer(tally, kExchangeBit | kClippedBit);
   pending_water_dt_ = dt;
   launch_interior(k);
+  launch_edge_tallies(kTallyExchange, dt);
   // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
   std::swap(depth_, depth_next_);
 }
@@ -835,10 +867,10 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
   if (params_.transport.scheme == TransportScheme::conservative) {
     cl_kernel k = kernel("transport_conservative");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
-             flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
-             static_cast<cl_int>(interior_groups_));
+             flux_[1], flux_[2], flux_[3], area_, dt);
     defer(tally, kSedimentBit);
     launch_interior(k);
+    launch_edge_tallies(kTallySediment, dt);  // reads sediment_ before the swap
   } else {
     cl_kernel k = kernel("transport_semi_lagrangian");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
@@ -872,7 +904,7 @@ void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
   const Real tau = static_cast<Real>(params_.numerics.wetness_time);
   cl_kernel k = kernel("evaporation");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, rate, tau,
-           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(interior_groups_));
+           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(tally_stride_));
   defer(tally, kEvaporatedBit);
   launch_interior(k);
 }

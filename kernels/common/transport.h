@@ -14,6 +14,23 @@ ERODEM_FN real sediment_concentration(real sediment, real depth) {
   return wet ? c : (real)0;
 }
 
+/* Sediment volume (m^3) that padded cell i carries out of the domain in dt (s): its
+ * concentration times what flows through its faces with ghosts. Only cells beside a ghost
+ * have one (the OpenCL backend sums it over a list of them, kernels/opencl/edges.cl). */
+ERODEM_FN real transport_boundary_out_cell(int i, int W, GLOBAL const erodem_kind_t* kind,
+                                           GLOBAL const real* sediment,
+                                           GLOBAL const real* depth_flow, GLOBAL const real* f_left,
+                                           GLOBAL const real* f_right, GLOBAL const real* f_top,
+                                           GLOBAL const real* f_bottom, real dt) {
+  const real c = sediment_concentration(sediment[i], depth_flow[i]);
+  /* faces with active neighbours add +0 (branch-free, the same sum as skipping them) */
+  const real to_ghosts = (real)0 + (kind[i - 1] != ERODEM_CELL_ACTIVE ? f_left[i] : (real)0) +
+                         (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] : (real)0) +
+                         (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] : (real)0) +
+                         (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] : (real)0);
+  return dt * c * to_ghosts;
+}
+
 /* Conservative (flux-form upwind) transport for active padded cell (x, y): sediment leaves
  * with the water that leaves, using the same pipe fluxes as the water update. `depth_flow`
  * is the depth the flow step limited its outflows by (before the water update), so a cell
@@ -35,12 +52,8 @@ ERODEM_FN real transport_conservative_cell(int x, int y, int W, GLOBAL const ero
                       sediment_concentration(sediment[i + W], depth_flow[i + W]) * f_top[i + W];
   const real given = c * (f_left[i] + f_right[i] + f_top[i] + f_bottom[i]);
   const real s_new = sediment[i] + dt * (gained - given) / area[y];
-  /* faces with active neighbours add +0 (branch-free, the same sum as skipping them) */
-  const real to_ghosts = (real)0 + (kind[i - 1] != ERODEM_CELL_ACTIVE ? f_left[i] : (real)0) +
-                         (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] : (real)0) +
-                         (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] : (real)0) +
-                         (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] : (real)0);
-  *boundary_out = dt * c * to_ghosts;
+  *boundary_out = transport_boundary_out_cell(i, W, kind, sediment, depth_flow, f_left, f_right,
+                                              f_top, f_bottom, dt);
   return s_new;
 }
 

@@ -18,6 +18,18 @@ ERODEM_FN real face_velocity(real through_a, real through_b, real width, real me
   return flowing ? v : (real)0;
 }
 
+/* Net discharge (m^3/s) out of the domain through the faces that padded cell i shares with
+ * ghosts (walls carry nothing): what flows out minus what flows in. Only cells beside a ghost
+ * have one (the OpenCL backend sums it over a list of them, kernels/opencl/edges.cl). */
+ERODEM_FN real water_exchange_cell(int i, int W, GLOBAL const erodem_kind_t* kind,
+                                   GLOBAL const real* f_left, GLOBAL const real* f_right,
+                                   GLOBAL const real* f_top, GLOBAL const real* f_bottom) {
+  return (kind[i - 1] != ERODEM_CELL_ACTIVE ? f_left[i] - f_right[i - 1] : (real)0) +
+         (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] - f_left[i + 1] : (real)0) +
+         (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] - f_bottom[i - W] : (real)0) +
+         (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] - f_top[i + W] : (real)0);
+}
+
 /* Water update of padded cell (x, y) (active cells change; others keep their depth):
  *   d <- d + dt (sum inflow - sum outflow) / area,
  * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the mean of the
@@ -52,12 +64,8 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   *clipped = clip;
   depth_out[i] = active ? d_new : d_old;
 
-  /* net outflow through faces shared with ghosts (walls carry nothing) */
-  const real ex = (kind[i - 1] != ERODEM_CELL_ACTIVE ? f_left[i] - in_left : (real)0) +
-                  (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] - in_right : (real)0) +
-                  (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] - in_top : (real)0) +
-                  (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] - in_bottom : (real)0);
-  *exchange = active ? ex : (real)0;
+  /* net outflow through faces shared with ghosts */
+  *exchange = active ? water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom) : (real)0;
 
   const real d_mean = (real)0.5 * (d_old + d_new);
   const real u =

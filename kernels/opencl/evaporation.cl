@@ -9,7 +9,7 @@
  * `evaporate` is 0 when the rate is 0 (then only the wetness runs, as on the CPU). */
 __kernel void evaporation(int W, int H, __global const uchar* kind, __global real* depth,
                           __global real* wetness, __global const real* area, real dt, real rate,
-                          real tau, int evaporate, __global acc_t* partials, int groups) {
+                          real tau, int evaporate, __global acc_t* partials, int stride) {
   __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   const int i = x + y * W;
@@ -24,5 +24,5 @@ __kernel void evaporation(int W, int H, __global const uchar* kind, __global rea
     wetness[i] = active ? wetness_cell(w, d_new, dt, tau) : w;
     lost = active & (evaporate != 0) ? taken : (real)0;
   }
-  cell_group_sum(s, lost, partials + ERODEM_TALLY_EVAPORATED * groups + cell_group_index());
+  cell_group_sum(s, lost, partials + ERODEM_TALLY_EVAPORATED * stride + cell_group_index());
 }

@@ -153,6 +153,9 @@ class OpenClBackend final : public Backend {
   /// Runs a cell kernel over the padded rows [y0, y1) only (global offset y0; work-groups of
   /// (local_x_, 1)); nothing when the range is empty.
   void launch_rows(cl_kernel k, int y0, int y1);
+  /// Sums the water exchange (slot ERODEM_TALLY_EXCHANGE) or the sediment carried out
+  /// (ERODEM_TALLY_SEDIMENT) over the cells beside ghosts into the tally partials.
+  void launch_edge_tallies(int slot, Real dt);
   /// Runs a reduction kernel with `groups` groups of reduce_local_ work-items.
   void launch_reduction(cl_kernel k, std::size_t groups);
   /// Enqueues a read of `bytes` of `b` into `dst`; blocking or not.
@@ -186,6 +189,10 @@ class OpenClBackend final : public Backend {
   // tally kernels: one partial per group).
   std::size_t local_x_ = 1, local_y_ = 1, groups_x_ = 1, groups_y_ = 1, cell_groups_ = 1,
               interior_groups_ = 1;
+  // The active cells beside a ghost (edge_tallies): padded indices, in groups of edge_local_.
+  Buffer edge_cells_;
+  std::size_t edge_count_ = 0, edge_local_ = 1, edge_groups_ = 1;
+  std::size_t tally_stride_ = 1;   // partials per tally slot: >= every tally kernel's groups
   std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
   Buffer kind_, dx_, dy_, area_;
   Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;

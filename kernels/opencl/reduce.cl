@@ -2,10 +2,12 @@
  * has cl_khr_fp64: the host defines ERODEM_HAVE_FP64 then) and the work-group sum the cell
  * kernels use for the ledger's tallies. The host assembles this file first.
  *
- * The cell kernels run in work-groups of (Lx, Ly) work-items over a global size of
- * (Lx * groups_x, Ly * groups_y): each group sums its work-items' tallies in local-id order and
- * writes one partial per group to partials[slot * groups + group]; reduce_tallies (stats.cl) sums
- * the partials of each slot in a fixed order once per step, so no result depends on timing. */
+ * The tally kernels (water, evaporation: rows 1 .. H - 2 of the raster; edge_tallies: a list
+ * of cells) run in work-groups; each group sums its work-items' tallies in a fixed order and
+ * writes one partial per group to partials[slot * stride + group], where stride is at least
+ * every kernel's group count and the partials no kernel writes stay 0; reduce_tallies
+ * (stats.cl) sums the partials of each slot in a fixed order once per step, so no result
+ * depends on timing. */
 #pragma OPENCL FP_CONTRACT OFF
 #ifdef ERODEM_HAVE_FP64
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
@@ -76,19 +78,4 @@ static inline void cell_group_sum(__local real* s, real v, __global acc_t* out) 
   s[l] = v;
   barrier(CLK_LOCAL_MEM_FENCE);
   if (l == 0) *out = cell_tallies_sum(s, (int)(get_local_size(0) * get_local_size(1)));
-}
-
-/* cell_group_sum of two tallies behind one barrier (a second barrier costs PoCL a second
- * work-item loop): v0 into *out0, v1 into *out1; `s` holds twice the local size. */
-static inline void cell_group_sum2(__local real* s, real v0, real v1, __global acc_t* out0,
-                                   __global acc_t* out1) {
-  const int l = (int)get_local_id(0) + (int)get_local_id(1) * (int)get_local_size(0);
-  const int n = (int)(get_local_size(0) * get_local_size(1));
-  s[l] = v0;
-  s[n + l] = v1;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (l == 0) {
-    *out0 = cell_tallies_sum(s, n);
-    *out1 = cell_tallies_sum(s + n, n);
-  }
 }

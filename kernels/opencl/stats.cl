@@ -30,7 +30,8 @@ static inline int beats(acc_t v, long c, acc_t best, long best_c) {
 }
 
 /* The ledger's tallies of one step: group t sums slot t of the cell kernels' partials
- * (partials[t * groups + g], g < groups; see reduce.cl) into sums[t]. One group per slot. */
+ * (partials[t * groups + g], g < groups: the stride of the slots; see reduce.cl) into sums[t].
+ * One group per slot. */
 __kernel void reduce_tallies(int groups, __global const acc_t* partials, __global acc_t* sums) {
   __local acc_t s[ERODEM_REDUCE_MAX];
   const int l = (int)get_local_id(0), t = (int)get_group_id(0);

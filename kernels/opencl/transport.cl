@@ -3,28 +3,22 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "transport.h"
 
-/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
- * is rounded up, every work-item still reaches the group sums); ghosts keep their sediment.
- * The sediment carried out of the domain is summed per work-group into the tally partials. */
+/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep their
+ * sediment. The sediment carried out of the domain is summed over the cells beside ghosts
+ * only (edges.cl). */
 __kernel void transport_conservative(int W, int H, __global const uchar* kind,
                                      __global const real* sediment, __global real* sediment_out,
                                      __global const real* depth_flow, __global const real* f_left,
                                      __global const real* f_right, __global const real* f_top,
                                      __global const real* f_bottom, __global const real* area,
-                                     real dt, __global acc_t* partials, int groups) {
-  __local real s[ERODEM_CELL_GROUP_MAX];
+                                     real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  real out = 0;
-  if (!ERODEM_PAST_ROW(x, W)) {
-    const int i = x + y * W;
-    const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-    real carried;
-    const real s_new = transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left,
-                                                   f_right, f_top, f_bottom, area, dt, &carried);
-    sediment_out[i] = active ? s_new : sediment[i];
-    out = active ? carried : (real)0;
-  }
-  cell_group_sum(s, out, partials + ERODEM_TALLY_SEDIMENT * groups + cell_group_index());
+  if (ERODEM_PAST_ROW(x, W)) return;
+  const int i = x + y * W;
+  real carried; /* edge_tallies (unused here, so not computed) */
+  const real s_new = transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left,
+                                                 f_right, f_top, f_bottom, area, dt, &carried);
+  sediment_out[i] = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s_new : sediment[i];
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */

@@ -1,6 +1,7 @@
 /* erodem OpenCL — water process: kernels/common/water.h over the active cells (the CPU loop of
- * kernels/cpu/water.cpp). The per-cell tallies are summed per work-group into the tally
- * partials (reduce.cl); the host swaps the depth buffers. */
+ * kernels/cpu/water.cpp). The volume lifted from rounding-level negatives is summed per
+ * work-group into the tally partials (reduce.cl); the exchange through faces with ghosts is
+ * summed over the cells beside ghosts only (edges.cl). The host swaps the depth buffers. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "water.h"
 
@@ -13,14 +14,12 @@ __kernel void water_update(int W, int H, __global const uchar* kind, __global co
                            __global const real* f_bottom, __global const real* dx,
                            __global const real* dy, __global const real* area,
                            __global real* velocity_x, __global real* velocity_y, real dt,
-                           real velocity_min_depth, __global acc_t* partials, int groups) {
-  __local real s[2 * ERODEM_CELL_GROUP_MAX];
+                           real velocity_min_depth, __global acc_t* partials, int stride) {
+  __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  real exchange = 0, clipped = 0;
+  real exchange, clipped = 0; /* exchange: edge_tallies (unused here, so not computed) */
   if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, depth, depth_out, f_left, f_right, f_top, f_bottom, dx, dy,
                       area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped);
-  const int g = cell_group_index();
-  cell_group_sum2(s, exchange, clipped, partials + ERODEM_TALLY_EXCHANGE * groups + g,
-                  partials + ERODEM_TALLY_CLIPPED * groups + g);
+  cell_group_sum(s, clipped, partials + ERODEM_TALLY_CLIPPED * stride + cell_group_index());
 }
