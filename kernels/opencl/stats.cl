@@ -21,14 +21,6 @@ static inline void reduce_local_sum(__local acc_t* s) {
   barrier(CLK_LOCAL_MEM_FENCE);
 }
 
-/* Whether candidate (v, c) beats the best so far (best, best_c): larger, or as large and
- * earlier (the first cell of the maximum, as the CPU's row-order scan finds it). */
-static inline int beats(acc_t v, long c, acc_t best, long best_c) {
-  if (c < 0) return 0;
-  if (best_c < 0) return 1;
-  return v > best || (v == best && c < best_c);
-}
-
 /* The ledger's tallies of one step: group t sums slot t of the cell kernels' partials
  * (partials[t * groups + g], g < groups: the stride of the slots; see reduce.cl) into sums[t].
  * One group per slot. */
