@@ -440,9 +440,11 @@ constexpr int kTallySediment = 2;       // ERODEM_TALLY_SEDIMENT of reduce.cl
 constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
                    kEvaporatedBit = 1u << 3, kTallyBits = 0xfu, kChangeBit = 1u << 4;
 
-/// The cell kernels' work-group shape (powers of two): ERODEM_OPENCL_WG / ERODEM_OPENCL_WG_Y
-/// if set (tuning), else (64, 1) on CPU devices (PoCL vectorises across the work-items of a
-/// row; (64, 4), (256, 4), (64, 16) measured no better at 1024^2) and (128, 1) on others.
+/// A size from the environment (the tuning variables ERODEM_OPENCL_WG, ERODEM_OPENCL_WG_Y), else
+/// `fallback`. Where the kernels are built for rounded launches, the cell kernels' work-group
+/// is (ERODEM_OPENCL_WG, ERODEM_OPENCL_WG_Y) rounded down to powers of two, by default (64, 1)
+/// on CPU devices and (128, 1) on others; CPU devices launch whole rows (a divisor of the row,
+/// one row high) unless ERODEM_OPENCL_WG is set, and ignore ERODEM_OPENCL_WG_Y then.
 std::size_t env_size(const char* name, std::size_t fallback) {
   if (const char* env = std::getenv(name); env && *env) {
     const long v = std::strtol(env, nullptr, 10);
@@ -517,7 +519,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
   // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
   std::size_t limit = std::min(kReduceMax, rt_->max_work_group);
-  for (const char* name : {"reduce_tallies", "reduce_change"}) {
+  for (const char* name : {"reduce_tallies", "reduce_change", "stats_rows"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -530,16 +532,17 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
       std::clamp<std::size_t>((n_ + reduce_local_ - 1) / reduce_local_, 1, kReduceGroupsMax);
   partial_b_ = make_buffer(reduce_groups_ * acc_size_);
 
-  // Cell kernels: work-groups of (local_x_, local_y_), powers of two every cell kernel
-  // accepts; a fixed number of groups for this grid (the tallies' partials, summed in a
-  // fixed order).
+  // Cell kernels: work-groups of (local_x_, local_y_) that every cell kernel accepts: a divisor
+  // of the row by one row (whole rows), else powers of two; a fixed number of groups for this
+  // grid (the tallies' partials, summed in a fixed order). Where a kernel accepts less than the
+  // device's maximum, the whole-row divisor may be small: still correct, slower.
   const bool cpu = rt_->info.type == "CPU";
   std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
   for (const char* name : {"sources_rain", "flow_pipes", "flow_local_inertial_faces",
                            "flow_local_inertial_faces_interior", "flow_local_inertial_split",
                            "flow_local_inertial_split_interior", "water_update", "erosion",
                            "transport_conservative", "transport_semi_lagrangian", "thermal_share",
-                           "thermal_apply", "evaporation", "field_stats"}) {
+                           "thermal_apply", "evaporation", "field_stats", "edge_tallies"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -566,6 +569,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
   partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
   partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
+  row_sums_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 6 * acc_size_);  // stats_rows
+  row_cells_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 3 * sizeof(cl_long));
   // The active cells beside a ghost, row-major: the only ones with a water exchange or a
   // sediment outflow through the domain's faces (edges.cl). The kinds never change.
   std::vector<cl_int> edges;
@@ -919,40 +924,47 @@ FieldStats OpenClBackend::stats() {
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, velocity_x_, velocity_y_,
            area_, partial_a_, partial_cells_);
   launch_interior(k);
+  const int rows = H_ - 2;
+  cl_kernel r = kernel("stats_rows");
+  set_args(r, cl_int{W_}, cl_int{rows}, static_cast<cl_int>(groups_x_), partial_a_, partial_cells_,
+           velocity_x_, velocity_y_, row_sums_, row_cells_);
+  launch_reduction(r, (static_cast<std::size_t>(rows) + reduce_local_ - 1) / reduce_local_);
   // The step's tallies with the statistics: one wait per step (the queue is in order).
   enqueue_tally_reduction();
   tally_raw_.resize(kTallySlots * acc_size_);
   change_raw_.resize(reduce_groups_ * acc_size_);
   if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
   if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
-  std::vector<cl_long> cells(interior_groups_ * 3);
-  read(partial_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
-  stats_sums_raw_.resize(interior_groups_ * 5 * acc_size_);
-  read(partial_a_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
+  std::vector<cl_long> cells(static_cast<std::size_t>(rows) * 3);
+  read(row_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
+  stats_sums_raw_.resize(static_cast<std::size_t>(rows) * 6 * acc_size_);
+  read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
   deliver_tallies();
-  const auto sums = acc_values(stats_sums_raw_, interior_groups_ * 5);
-  // Groups in order; the maxima keep the first cell of the largest value (as the CPU's
-  // row-order scan does), whatever group holds it.
+  const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * 6);
+  // Rows in order, with the rules of CpuBackend::stats: the max depth starts at 0 and a
+  // later row takes it when larger (or when none has been taken); the max speed ranks the
+  // rows by the squared speed; the first bad cell.
   FieldStats st;
-  double max_d = -1, max_v = -1;
-  for (std::size_t g = 0; g < interior_groups_; ++g) {
-    st.water_volume += sums[5 * g + 0];
-    st.material_volume += sums[5 * g + 1];
-    st.sediment_volume += sums[5 * g + 2];
-    auto take = [](double v, std::int64_t c, double& best, std::int64_t& best_c) {
-      if (c < 0) return;
-      if (best_c < 0 || v > best || (v == best && c < best_c)) {
-        best = v;
-        best_c = c;
-      }
-    };
-    take(sums[5 * g + 3], cells[3 * g + 0], max_d, st.max_depth_cell);
-    take(sums[5 * g + 4], cells[3 * g + 1], max_v, st.max_speed_cell);
-    const std::int64_t bad = cells[3 * g + 2];
-    if (bad >= 0 && (st.bad_cell < 0 || bad < st.bad_cell)) st.bad_cell = bad;
+  st.max_depth = 0.0;
+  st.max_speed = 0.0;
+  double best_v2 = -1;
+  for (std::size_t y = 0; y < static_cast<std::size_t>(rows); ++y) {
+    st.water_volume += sums[6 * y + 0];
+    st.material_volume += sums[6 * y + 1];
+    st.sediment_volume += sums[6 * y + 2];
+    const double max_d = sums[6 * y + 3], max_v2 = sums[6 * y + 4];
+    const std::int64_t arg_d = cells[3 * y + 0], arg_v = cells[3 * y + 1], bad = cells[3 * y + 2];
+    if (max_d > st.max_depth || (st.max_depth_cell < 0 && arg_d >= 0)) {
+      st.max_depth = std::max(0.0, max_d);
+      st.max_depth_cell = arg_d;
+    }
+    if (arg_v >= 0 && (st.max_speed_cell < 0 || max_v2 > best_v2)) {
+      best_v2 = max_v2;
+      st.max_speed_cell = arg_v;
+      st.max_speed = std::max(0.0, sums[6 * y + 5]);
+    }
+    if (st.bad_cell < 0 && bad >= 0) st.bad_cell = bad;
   }
-  st.max_depth = std::max(0.0, max_d);
-  st.max_speed = std::max(0.0, max_v);
   return st;
 }
 

@@ -122,6 +122,47 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
   }
 }
 
+// The statistics' maxima and first bad cell follow the CPU reference's rules also on states
+// that are not physical (negative depths), on grids one to three cells wide, where a row has
+// one work-group or several.
+TEST(AgreementStats, MaximaAndBadCellOnStatesThatAreNotPhysical) {
+  if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  struct Case {
+    int nx, ny;
+    std::vector<double> depth, velocity_x;
+  };
+  const std::vector<Case> cases = {
+      {1, 2, {-0.5, 0.0}, {0.0, 0.0}},
+      {1, 3, {-0.7, -0.3, -0.2}, {-1.0, 2.0, -2.0}},
+      {3, 1, {-0.2, -0.1, -0.3}, {0.5, -0.5, 0.25}},
+      {3, 3, {0.1, -0.2, 0.4, 0.4, -0.1, 0.2, 0.0, 0.4, -0.3}, {1, -3, 3, 2, -2, 1, 0, 3, -3}},
+  };
+  for (const Case& c : cases) {
+    const Terrain terrain = flat_terrain(c.nx, c.ny, 10.0);
+    const Params params = quiet_params(FlowScheme::local_inertial, 0.1);
+    std::vector<FieldStats> got;
+    for (const char* backend : {"cpu", "opencl"}) {
+      auto b = make_backend(backend, terrain, params);
+      b->set_field(FieldId::water_depth, c.depth);
+      b->set_field(FieldId::velocity_x, c.velocity_x);
+      got.push_back(b->stats());
+    }
+    std::printf(
+        "[agreement stats] %d x %d: max depth cell %lld / %lld (%.2f / %.2f m), max speed cell "
+        "%lld / %lld (%.2f / %.2f m/s), bad cell %lld / %lld (cpu / opencl)\n",
+        c.nx, c.ny, static_cast<long long>(got[0].max_depth_cell),
+        static_cast<long long>(got[1].max_depth_cell), got[0].max_depth, got[1].max_depth,
+        static_cast<long long>(got[0].max_speed_cell),
+        static_cast<long long>(got[1].max_speed_cell), got[0].max_speed, got[1].max_speed,
+        static_cast<long long>(got[0].bad_cell), static_cast<long long>(got[1].bad_cell));
+    EXPECT_EQ(got[1].max_depth_cell, got[0].max_depth_cell) << c.nx << " x " << c.ny;
+    EXPECT_EQ(got[1].max_speed_cell, got[0].max_speed_cell) << c.nx << " x " << c.ny;
+    EXPECT_EQ(got[1].bad_cell, got[0].bad_cell) << c.nx << " x " << c.ny;
+    EXPECT_EQ(got[1].max_depth, got[0].max_depth) << c.nx << " x " << c.ny;
+    EXPECT_EQ(got[1].max_speed, got[0].max_speed) << c.nx << " x " << c.ny;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Tujunga, Agreement,
     ::testing::Values(AgreementCase{"local_inertial_conservative", FlowScheme::local_inertial,

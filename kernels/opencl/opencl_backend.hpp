@@ -200,7 +200,8 @@ class OpenClBackend final : public Backend {
   Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   Buffer partial_a_, partial_b_, partial_cells_;
-  Buffer tally_partials_, tally_sums_;  // [slot][cell group] partials, [slot] sums
+  Buffer row_sums_, row_cells_;         // stats_rows: one result per padded row 1 .. H - 2
+  Buffer tally_partials_, tally_sums_;  // [slot][tally_stride_] partials, [slot] sums
   StepTally* pending_tally_ = nullptr;
   unsigned pending_ = 0;       // bits: 1 << tally slot; kChangeBit: the transport change
   Real pending_water_dt_ = 0;  // the exchange tally is a discharge: times the step

@@ -68,10 +68,10 @@ static inline acc_t cell_tallies_sum(__local const real* s, int n) {
   return sum;
 }
 
-/* Sums v over the work-group into *out, in local-id order (one work-item adds them: on CPU
- * devices the barrier costs more than the adds). Every work-item must call it, once per
- * kernel; `s` holds at least the local size. The per-cell tallies are stored as `real` (they
- * are real numbers; the sum widens them exactly): PoCL vectorises a kernel whose local stores
+/* Sums v over the work-group into *out in the fixed order of cell_tallies_sum (one work-item
+ * adds them: on CPU devices more barriers would cost more than the adds). Every work-item must call
+ * it, once per kernel; `s` holds at least the local size. The per-cell tallies are stored as `real`
+ * (they are real numbers; the sum widens them exactly): PoCL vectorises a kernel whose local stores
  * are float and not one whose stores are double. */
 static inline void cell_group_sum(__local real* s, real v, __global acc_t* out) {
   const int l = (int)get_local_id(0) + (int)get_local_id(1) * (int)get_local_size(0);

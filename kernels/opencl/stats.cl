@@ -56,10 +56,11 @@ __kernel void reduce_change(int W, int H, __global const uchar* kind, __global c
 
 /* The field statistics over the active cells: a cell kernel over rows 1 .. H - 2 (the host's
  * launch), one work-item per padded cell, work-groups of (L, 1) inside one row (L <=
- * ERODEM_CELL_GROUP_MAX). Per group g: sums[5 g + k] = water, material, sediment volume, max
- * depth, max speed (hypot, as on the CPU; -1 where the group has no active cell); cells[3 g +
- * k] = the DEM cell (row * nx + col) of the max depth, of the max speed, and the first cell
- * whose state is not physical (-1: none). Each work-item stores its cell's values in local
+ * ERODEM_CELL_GROUP_MAX), g = group x + (y - 1) * groups per row. Per group: sums[5 g + k] =
+ * water, material, sediment volume, max depth, max squared speed (-1 where the group has no
+ * candidate); cells[3 g + k] = the DEM cell (row * nx + col) of the max depth, of the max
+ * speed, and the first cell whose state is not physical (-1: none). stats_rows combines them
+ * per row. Each work-item stores its cell's values in local
  * memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
  * cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row. */
 __kernel void field_stats(int W, int H, __global const uchar* kind, __global const real* bed,
@@ -161,13 +162,54 @@ __kernel void field_stats(int W, int H, __global const uchar* kind, __global con
   sums[5 * g + 1] = (bed_sum + sed) * a;
   sums[5 * g + 2] = sed * a;
   sums[5 * g + 3] = max_d;
-  acc_t speed = -1;
-  if (arg_v >= 0) {
-    const int c = (int)(arg_v - row_cell) + x0 + y * W;
-    speed = hypot((acc_t)velocity_x[c], (acc_t)velocity_y[c]);
-  }
-  sums[5 * g + 4] = speed;
+  sums[5 * g + 4] = max_v;
   cells[3 * g + 0] = arg_d;
   cells[3 * g + 1] = arg_v;
   cells[3 * g + 2] = bad;
+}
+
+/* The statistics of each padded row 1 .. H - 2 (r = y - 1 < rows) from the groups_x partials
+ * of field_stats in that row, in column order, as the CPU reference's row scan gives them:
+ * sums added; a maximum replaced only by a strictly larger one (a later group holds later
+ * cells); the first bad cell. Per row: row_sums[6 r + k] = water, material, sediment volume,
+ * max depth, max squared speed (-1: no candidate), the speed (m/s, hypot as on the CPU) of the
+ * cell of the max squared speed; row_cells[3 r + k] as cells. One work-item per row, so the
+ * host reads one result per row, not per group. */
+__kernel void stats_rows(int W, int rows, int groups_x, __global const acc_t* sums,
+                         __global const long* cells, __global const real* velocity_x,
+                         __global const real* velocity_y, __global acc_t* row_sums,
+                         __global long* row_cells) {
+  const int r = (int)get_global_id(0);
+  if (r >= rows) return;
+  acc_t water = 0, material = 0, sed = 0, max_d = -1, max_v = -1;
+  long arg_d = -1, arg_v = -1, bad = -1;
+  for (int gx = 0; gx < groups_x; ++gx) {
+    const int g = gx + r * groups_x;
+    water += sums[5 * g + 0];
+    material += sums[5 * g + 1];
+    sed += sums[5 * g + 2];
+    if (cells[3 * g + 0] >= 0 && sums[5 * g + 3] > max_d) {
+      max_d = sums[5 * g + 3];
+      arg_d = cells[3 * g + 0];
+    }
+    if (cells[3 * g + 1] >= 0 && sums[5 * g + 4] > max_v) {
+      max_v = sums[5 * g + 4];
+      arg_v = cells[3 * g + 1];
+    }
+    if (bad < 0) bad = cells[3 * g + 2];
+  }
+  acc_t speed = -1;
+  if (arg_v >= 0) {
+    const int c = (int)(arg_v % (long)(W - 2)) + 1 + (r + 1) * W;
+    speed = hypot((acc_t)velocity_x[c], (acc_t)velocity_y[c]);
+  }
+  row_sums[6 * r + 0] = water;
+  row_sums[6 * r + 1] = material;
+  row_sums[6 * r + 2] = sed;
+  row_sums[6 * r + 3] = max_d;
+  row_sums[6 * r + 4] = max_v;
+  row_sums[6 * r + 5] = speed;
+  row_cells[3 * r + 0] = arg_d;
+  row_cells[3 * r + 1] = arg_v;
+  row_cells[3 * r + 2] = bad;
 }

@@ -7,7 +7,8 @@
 
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
  * is rounded up, every work-item still reaches the group sums). water_update_cell is
- * branch-free and leaves ghosts as they are (the first and last column are ghosts). */
+ * branch-free and keeps the ghosts' depth (the first and last column are ghosts; their
+ * velocity is 0). */
 __kernel void water_update(int W, int H, __global const uchar* kind, __global const real* depth,
                            __global real* depth_out, __global const real* f_left,
                            __global const real* f_right, __global const real* f_top,
