@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "bandwidth.hpp"
 #include "commands.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
+#include "erodem/schema.hpp"
 #include "erodem/simulation.hpp"
 #include "erodem/terrain_synth.hpp"
 #include "json.hpp"
@@ -29,6 +32,7 @@ struct BenchOptions {
   long steps = 20;
   std::string backends = "cpu";
   std::string threads = "0";
+  std::vector<std::string> sets;   ///< --set key=value on the bench scenario
   long stream_floats = 64L << 20;  ///< elements per array of the bandwidth probe
   bool json = false;
 };
@@ -41,8 +45,9 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-/// The benchmark run: every process on, water everywhere, rain falling.
-Params bench_params() {
+/// The benchmark run: every process on, water everywhere, rain falling; then the options'
+/// `--set key=value` (the config schema's keys and value checks: flow.scheme, ...).
+Params bench_params(const BenchOptions& o) {
   Params p;
   p.flow.scheme = FlowScheme::local_inertial;
   p.time.adaptive = false;
@@ -52,6 +57,7 @@ Params bench_params() {
   p.erosion.enabled = true;
   p.thermal.enabled = true;
   p.evaporation.rate = 1e-7;
+  for (const auto& kv : o.sets) apply_setting(p, kv);  // each value checked as in a config
   return p;
 }
 
@@ -245,7 +251,7 @@ int bench(const BenchOptions& o) {
       runs.push_back({backend, n});
     }
   }
-  const Params params = bench_params();
+  const Params params = bench_params(o);
   std::vector<Row> rows;
   for (const auto& [backend, threads] : runs) {
     Params p = params;
@@ -261,8 +267,9 @@ int bench(const BenchOptions& o) {
   if (o.json) {
     std::printf(
         "{\"grid\": [%d, %d], \"cells\": %zu, \"steps\": %ld, \"repetitions\": %d, "
-        "\"source\": %s,\n",
-        g.nx, g.ny, g.cells(), o.steps, kRepetitions, json_string(terrain.source).c_str());
+        "\"source\": %s, \"flow_scheme\": \"%s\", \"transport_scheme\": \"%s\",\n",
+        g.nx, g.ny, g.cells(), o.steps, kRepetitions, json_string(terrain.source).c_str(),
+        scheme_name(params.flow.scheme), scheme_name(params.transport.scheme));
     std::printf(
         " \"bandwidth\": {\"floats_per_array\": %ld, \"bytes_per_array\": %zu, "
         "\"last_level_cache_bytes\": %zu, \"below_4x_llc\": %s, \"repetitions\": %d, "
@@ -290,8 +297,11 @@ int bench(const BenchOptions& o) {
     std::printf(" ]}\n");
     return 0;
   }
-  std::printf("%s: %d x %d cells, %ld timed steps, median of %d repetitions\n",
-              terrain.source.c_str(), g.nx, g.ny, o.steps, kRepetitions);
+  std::printf(
+      "%s: %d x %d cells, %s flow, %s transport, %ld timed steps, median of %d "
+      "repetitions\n",
+      terrain.source.c_str(), g.nx, g.ny, scheme_name(params.flow.scheme),
+      scheme_name(params.transport.scheme), o.steps, kRepetitions);
   std::printf(
       "memory bandwidth (median of %d, %.0f MiB per array%s): copy %.2f GB/s, triad %.2f GB/s "
       "with %d thread%s; copy %.2f GB/s, triad %.2f GB/s with 1 thread\n",
@@ -342,6 +352,9 @@ Action add_bench(CLI::App& app) {
                   "Comma-separated CPU thread counts to measure (0 = all cores)");
   sub->add_option("--stream-floats", o->stream_floats,
                   "Floats per array of the memory-bandwidth probe (3 arrays; default 64Mi)");
+  sub->add_option("--set", o->sets,
+                  "Override a key of the bench scenario: key=value (repeatable), e.g. "
+                  "flow.scheme=pipes");
   sub->add_flag("--json", o->json, "Machine-readable output");
   return [o] { return bench(*o); };
 }

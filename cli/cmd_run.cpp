@@ -220,14 +220,11 @@ int run(const RunOptions& o) {
   spdlog::info("erodem {}: {} ({} x {} cells, dx {:.4g} m), backend {} [{}]", ERODEM_VERSION,
                sim.terrain().source, g.nx, g.ny, g.dx_min(), sim.backend().name(),
                sim.backend().device());
-  spdlog::info(
-      "flow {}, erosion {}, transport {}, thermal {}, {}",
-      p.flow.scheme == FlowScheme::pipes ? "pipes" : "local_inertial",
-      p.erosion.enabled ? "on" : "off",
-      p.transport.scheme == TransportScheme::conservative ? "conservative" : "semi_lagrangian",
-      p.thermal.enabled ? "on" : "off",
-      p.time.duration > 0 ? fmt::format("{:.6g} s simulated", p.time.duration)
-                          : fmt::format("{} steps", p.time.steps));
+  spdlog::info("flow {}, erosion {}, transport {}, thermal {}, {}", scheme_name(p.flow.scheme),
+               p.erosion.enabled ? "on" : "off", scheme_name(p.transport.scheme),
+               p.thermal.enabled ? "on" : "off",
+               p.time.duration > 0 ? fmt::format("{:.6g} s simulated", p.time.duration)
+                                   : fmt::format("{} steps", p.time.steps));
 
   // Results go to a temporary file beside the output (flushed at every snapshot) that is
   // renamed into place when the run completes.

@@ -61,10 +61,6 @@ std::vector<double> middle_row(const Simulation& sim, FieldId id) {
   return std::vector<double>(f.begin() + nx, f.begin() + 2 * nx);
 }
 
-const char* scheme_name(FlowScheme s) {
-  return s == FlowScheme::pipes ? "pipes" : "local_inertial";
-}
-
 class Analytical : public ::testing::TestWithParam<Target> {
  protected:
   const Target& target() const { return GetParam(); }

@@ -40,7 +40,7 @@ double max_speed(const Simulation& sim) {
 
 TEST_P(Physics, LakeAtRestStaysAtRest) {
   for (FlowScheme scheme : {FlowScheme::pipes, FlowScheme::local_inertial}) {
-    SCOPED_TRACE(scheme == FlowScheme::pipes ? "pipes" : "local_inertial");
+    SCOPED_TRACE(scheme_name(scheme));
     Params p = quiet_params(scheme, 0.5);
     p.initial.water_level = 10.0;
     auto sim = make_simulation(bumpy_terrain(48, 10.0), p, target());
@@ -48,8 +48,7 @@ TEST_P(Physics, LakeAtRestStaysAtRest) {
     const double speed = max_speed(sim);
     const double limit = bound(1e-9, 1e-4);
     std::printf("[lake at rest] %s %s: max speed after 10000 steps %.3e m/s (bound %.0e)\n",
-                target().label().c_str(), scheme == FlowScheme::pipes ? "pipes" : "local_inertial",
-                speed, limit);
+                target().label().c_str(), scheme_name(scheme), speed, limit);
     EXPECT_LT(speed, limit);
   }
 }
@@ -77,7 +76,7 @@ Terrain sloshing_terrain() {
 
 TEST_P(Physics, ClosedBoxConservesWaterAndMaterial) {
   for (FlowScheme scheme : {FlowScheme::pipes, FlowScheme::local_inertial}) {
-    const char* name = scheme == FlowScheme::pipes ? "pipes" : "local_inertial";
+    const char* name = scheme_name(scheme);
     SCOPED_TRACE(name);
     Params p = sloshing_params(scheme);
     p.erosion.enabled = true;
@@ -125,7 +124,7 @@ TEST_P(Physics, SemiLagrangianLossIsMeasured) {
 
 TEST_P(Physics, DepthNeverNegativeWhileDraining) {
   for (FlowScheme scheme : {FlowScheme::pipes, FlowScheme::local_inertial}) {
-    SCOPED_TRACE(scheme == FlowScheme::pipes ? "pipes" : "local_inertial");
+    SCOPED_TRACE(scheme_name(scheme));
     // Thin water on a steep slope drains through an open edge: cells dry out every step.
     Terrain t = flat_terrain(30, 30, 5.0);
     for (int r = 0; r < 30; ++r)
@@ -145,8 +144,8 @@ TEST_P(Physics, DepthNeverNegativeWhileDraining) {
     std::printf(
         "[no negative depth] %s %s: min depth %.3e m, clipped %.3e m^3 of %.3e m^3, "
         "drained %.3e m^3, closure %.3e\n",
-        target().label().c_str(), scheme == FlowScheme::pipes ? "pipes" : "local_inertial",
-        min_depth, L.clipped, L.water_initial, L.boundary_out, L.relative_closure_error());
+        target().label().c_str(), scheme_name(scheme), min_depth, L.clipped, L.water_initial,
+        L.boundary_out, L.relative_closure_error());
     EXPECT_GE(min_depth, 0.0);
     EXPECT_GT(L.boundary_out, 0.1 * L.water_initial) << "the slope must drain";
     EXPECT_LT(L.clipped, bound(1e-12, 1e-5) * L.water_initial);

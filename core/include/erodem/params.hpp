@@ -13,6 +13,14 @@ namespace erodem {
 
 enum class FlowScheme { pipes, local_inertial };
 enum class TransportScheme { conservative, semi_lagrangian };
+
+/// The schemes' names as configs, HDF5 attributes and logs spell them.
+inline const char* scheme_name(FlowScheme s) {
+  return s == FlowScheme::pipes ? "pipes" : "local_inertial";
+}
+inline const char* scheme_name(TransportScheme s) {
+  return s == TransportScheme::conservative ? "conservative" : "semi_lagrangian";
+}
 enum class BoundaryKind { closed, open, fixed_level };
 enum class NodataKind { wall, sea };
 enum class Precision { float32, float64 };
