@@ -538,11 +538,12 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // device's maximum, the whole-row divisor may be small: still correct, slower.
   const bool cpu = rt_->info.type == "CPU";
   std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
-  for (const char* name : {"sources_rain", "flow_pipes", "flow_local_inertial_faces",
-                           "flow_local_inertial_faces_interior", "flow_local_inertial_split",
-                           "flow_local_inertial_split_interior", "water_update", "erosion",
-                           "transport_conservative", "transport_semi_lagrangian", "thermal_share",
-                           "thermal_apply", "evaporation", "field_stats", "edge_tallies"}) {
+  for (const char* name :
+       {"sources_rain", "flow_pipes", "flow_pipes_interior", "flow_local_inertial_faces",
+        "flow_local_inertial_faces_interior", "flow_local_inertial_split",
+        "flow_local_inertial_split_interior", "water_update", "erosion", "transport_conservative",
+        "transport_semi_lagrangian", "thermal_share", "thermal_apply", "evaporation", "field_stats",
+        "edge_tallies"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -814,11 +815,15 @@ void OpenClBackend::run_flow(Real dt) {
   const auto& f = params_.flow;
   const Real g = static_cast<Real>(f.gravity);
   if (f.scheme == FlowScheme::pipes) {
-    cl_kernel k = kernel("flow_pipes");
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, dx_, dy_, area_, flux_[0], flux_[1],
-             flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], dt, g,
-             static_cast<Real>(f.pipe_area), static_cast<Real>(f.pipe_length));
-    launch_cells(k);
+    // The interior rows by a kernel without clamping, the first and last row by the general one.
+    for (const char* name : {"flow_pipes_interior", "flow_pipes"})
+      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, dx_, dy_, area_, flux_[0],
+               flux_[1], flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2],
+               flux_next_[3], dt, g, static_cast<Real>(f.pipe_area),
+               static_cast<Real>(f.pipe_length));
+    launch_interior(kernel("flow_pipes_interior"));
+    launch_rows(kernel("flow_pipes"), 0, 1);
+    launch_rows(kernel("flow_pipes"), H_ - 1, H_);
   } else {
     // Each face once (face pass), then split into the cells' outflows (cell pass); the
     // interior rows by kernels that need no clamping (they vectorise on CPU devices), the

@@ -45,15 +45,83 @@ ERODEM_FN real outflow_limit(real depth, real cell_area, real total_out, real dt
 
 /* ---- pipes (Mei, Decaudin & Hu 2007) ------------------------------------------------ */
 
-/* One pipe's outflow after a step: f <- max(0, f + dt * A * g * dh / l).
- * f (m^3/s), dt (s), pipe_area A (m^2), gravity g (m/s^2), dh surface drop towards the
- * neighbour (m), length l (m). */
-ERODEM_FN real pipe_flux_update(real f, real dt, real pipe_area, real gravity, real dh,
-                                real length) {
-  return fmax((real)0, f + dt * pipe_area * gravity * dh / length);
+/* The pipes scheme (Mei, Decaudin & Hu 2007) for a cell of kind k with neighbours of kinds
+ * k_left .. k_bottom: surface eta = bed + depth of the cell and eta_* of the neighbours (m),
+ * its previous outflows f_* (m^3/s), pipe lengths across x and towards the cells north and
+ * south (m), its depth (m) and area (m^2); dt (s), gravity g (m/s^2), pipe_area A (m^2). Active and
+ * fixed-level cells give water to neighbours that take it (gives_water); an active cell's outflows
+ * are then limited to what it holds. Branch-free: every pipe is computed and the ones that carry
+ * nothing are replaced by 0. */
+ERODEM_FN void flow_pipes_outflows(int k, int k_left, int k_right, int k_top, int k_bottom,
+                                   real eta, real eta_left, real eta_right, real eta_top,
+                                   real eta_bottom, real f_left, real f_right, real f_top,
+                                   real f_bottom, real length_x, real length_top,
+                                   real length_bottom, real depth, real cell_area, real dt,
+                                   real gravity, real pipe_area, real* out_left, real* out_right,
+                                   real* out_top, real* out_bottom) {
+  /* Each pipe: f <- max(0, f + dt A g dh / l), dh the surface drop towards the neighbour.
+   * The four are written in four forms that give the same numbers (c dh = dh c, and
+   * f + c (a - b) / l = f - c (b - a) / l exactly; a zero's sign aside, which the max
+   * removes): written alike, PoCL's SLP vectoriser packs them into a 4-vector and then does
+   * not vectorise the kernel across work-items (8 times slower). The max as a comparison
+   * (NaN gives 0, as fmax does), which GCC vectorises. */
+  const real c = dt * pipe_area * gravity;
+  const real fl = f_left + c * (eta - eta_left) / length_x;
+  const real fr = f_right - c * (eta_right - eta) / length_x;
+  const real ft = f_top + (eta - eta_top) * c / length_top;
+  const real fb = f_bottom - (eta_bottom - eta) * c / length_bottom;
+  const real gl = gives_water(k, k_left) & (fl > 0) ? fl : (real)0;
+  const real gr = gives_water(k, k_right) & (fr > 0) ? fr : (real)0;
+  const real gt = gives_water(k, k_top) & (ft > 0) ? ft : (real)0;
+  const real gb = gives_water(k, k_bottom) & (fb > 0) ? fb : (real)0;
+  const real K =
+      k == ERODEM_CELL_ACTIVE ? outflow_limit(depth, cell_area, gl + gr + gt + gb, dt) : (real)1;
+  *out_left = gl * K;
+  *out_right = gr * K;
+  *out_top = gt * K;
+  *out_bottom = gb * K;
 }
 
-/* Pipes scheme for padded cell (x, y): reads the previous fluxes f_*, writes out_*. */
+/* The pipe lengths (m) of padded row y, whose neighbour rows are y_top and y_bottom:
+ * pipe_length (m) where it is > 0, else the distances between cell centres, across x and to
+ * the cells north and south. */
+ERODEM_FN void pipe_lengths(int y, int y_top, int y_bottom, GLOBAL const real* dx,
+                            GLOBAL const real* dy, real pipe_length, real* length_x,
+                            real* length_top, real* length_bottom) {
+  const int given = pipe_length > 0;
+  *length_x = given ? pipe_length : dx[y];
+  *length_top = given ? pipe_length : (real)0.5 * (dy[y] + dy[y_top]);
+  *length_bottom = given ? pipe_length : (real)0.5 * (dy[y] + dy[y_bottom]);
+}
+
+/* Pipes scheme for padded cell (x, y) in a row 1 <= y <= H - 2, any 0 <= x <= W - 1, with the
+ * row's pipe lengths (pipe_lengths) and cell area (m^2): reads the previous fluxes f_*,
+ * writes out_*. Every index it reads lies inside the raster in these rows (x - 1 and x + 1
+ * across the row ends in the first and last column, masked there), so it reads without
+ * clamping, and the per-row values come in as numbers: loops over x vectorise. */
+ERODEM_FN void flow_pipes_cell_interior(
+    int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
+    GLOBAL const real* depth, real length_x, real length_top, real length_bottom, real cell_area,
+    GLOBAL const real* f_left, GLOBAL const real* f_right, GLOBAL const real* f_top,
+    GLOBAL const real* f_bottom, GLOBAL real* out_left, GLOBAL real* out_right,
+    GLOBAL real* out_top, GLOBAL real* out_bottom, real dt, real gravity, real pipe_area) {
+  const int i = x + y * W;
+  const int k_left = kind[i - 1], k_right = kind[i + 1]; /* loaded, then masked by x */
+  real fl, fr, ft, fb;
+  flow_pipes_outflows(kind[i], x >= 1 ? k_left : ERODEM_CELL_WALL,
+                      x <= W - 2 ? k_right : ERODEM_CELL_WALL, kind[i - W], kind[i + W],
+                      bed[i] + depth[i], bed[i - 1] + depth[i - 1], bed[i + 1] + depth[i + 1],
+                      bed[i - W] + depth[i - W], bed[i + W] + depth[i + W], f_left[i], f_right[i],
+                      f_top[i], f_bottom[i], length_x, length_top, length_bottom, depth[i],
+                      cell_area, dt, gravity, pipe_area, &fl, &fr, &ft, &fb);
+  out_left[i] = fl;
+  out_right[i] = fr;
+  out_top[i] = ft;
+  out_bottom[i] = fb;
+}
+
+/* Pipes scheme for any padded cell (rows 0 and H - 1 clamp their indices; beyond the raster
+ * are walls); pipe_length (m) as for pipe_lengths. */
 ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
                                GLOBAL const real* bed, GLOBAL const real* depth,
                                GLOBAL const real* dx, GLOBAL const real* dy,
@@ -63,36 +131,25 @@ ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_k
                                GLOBAL real* out_right, GLOBAL real* out_top,
                                GLOBAL real* out_bottom, real dt, real gravity, real pipe_area,
                                real pipe_length) {
-  const int i = x + y * W;
-  const int k = kind[i];
-  real fl = 0, fr = 0, ft = 0, fb = 0;
-  if (k == ERODEM_CELL_ACTIVE || k == ERODEM_CELL_FIXED) {
-    const real eta = bed[i] + depth[i];
-    /* pipe lengths: the distance between cell centres unless a length is given */
-    const real lx = pipe_length > 0 ? pipe_length : dx[y];
-    if (gives_water(k, kind_at(kind, x - 1, y, W, H)))
-      fl = pipe_flux_update(f_left[i], dt, pipe_area, gravity, eta - (bed[i - 1] + depth[i - 1]),
-                            lx);
-    if (gives_water(k, kind_at(kind, x + 1, y, W, H)))
-      fr = pipe_flux_update(f_right[i], dt, pipe_area, gravity, eta - (bed[i + 1] + depth[i + 1]),
-                            lx);
-    if (gives_water(k, kind_at(kind, x, y - 1, W, H))) {
-      const real l = pipe_length > 0 ? pipe_length : (real)0.5 * (dy[y] + dy[y - 1]);
-      ft = pipe_flux_update(f_top[i], dt, pipe_area, gravity, eta - (bed[i - W] + depth[i - W]), l);
-    }
-    if (gives_water(k, kind_at(kind, x, y + 1, W, H))) {
-      const real l = pipe_length > 0 ? pipe_length : (real)0.5 * (dy[y] + dy[y + 1]);
-      fb = pipe_flux_update(f_bottom[i], dt, pipe_area, gravity, eta - (bed[i + W] + depth[i + W]),
-                            l);
-    }
-    if (k == ERODEM_CELL_ACTIVE) {
-      const real K = outflow_limit(depth[i], area[y], fl + fr + ft + fb, dt);
-      fl *= K;
-      fr *= K;
-      ft *= K;
-      fb *= K;
-    }
+  const int yt = y >= 1 ? y - 1 : y, yb = y <= H - 2 ? y + 1 : y; /* clamped: masked */
+  real lx, lt, lb;
+  pipe_lengths(y, yt, yb, dx, dy, pipe_length, &lx, &lt, &lb);
+  if (y >= 1 && y <= H - 2) {
+    flow_pipes_cell_interior(x, y, W, kind, bed, depth, lx, lt, lb, area[y], f_left, f_right, f_top,
+                             f_bottom, out_left, out_right, out_top, out_bottom, dt, gravity,
+                             pipe_area);
+    return;
   }
+  const int i = x + y * W;
+  const int xl = x >= 1 ? x - 1 : x, xr = x <= W - 2 ? x + 1 : x;
+  const int il = xl + y * W, ir = xr + y * W, it = x + yt * W, ib = x + yb * W;
+  real fl, fr, ft, fb;
+  flow_pipes_outflows(kind[i], kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
+                      kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H),
+                      bed[i] + depth[i], bed[il] + depth[il], bed[ir] + depth[ir],
+                      bed[it] + depth[it], bed[ib] + depth[ib], f_left[i], f_right[i], f_top[i],
+                      f_bottom[i], lx, lt, lb, depth[i], area[y], dt, gravity, pipe_area, &fl, &fr,
+                      &ft, &fb);
   out_left[i] = fl;
   out_right[i] = fr;
   out_top[i] = ft;

@@ -151,10 +151,23 @@ void CpuBackend<Real>::run_flow(Real dt) {
   if (f.scheme == FlowScheme::pipes) {
     const Real area_pipe = static_cast<Real>(f.pipe_area);
     const Real length = static_cast<Real>(f.pipe_length);
+    // Rows 1 .. H - 2 without clamping (the loop vectorises), the first and last row clamped.
     for_rows(0, H, [=](int y) {
-      for (int x = 0; x < W; ++x)
-        cell::flow_pipes_cell(x, y, W, H, kind, b, d, dx, dy, area, fl, fr, ft, fb, ol, orr, ot, ob,
-                              dt, g, area_pipe, length);
+      // Locals, not closure members: stores to Real arrays could alias those.
+      const Real step = dt, gravity = g, a_pipe = area_pipe, l_pipe = length;
+      if (y >= 1 && y <= H - 2) {
+        Real lx, lt, lb;
+        cell::pipe_lengths(y, y - 1, y + 1, dx, dy, l_pipe, &lx, &lt, &lb);
+        const Real cell_area = area[y];
+        ERODEM_IVDEP
+        for (int x = 0; x < W; ++x)
+          cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft, fb,
+                                         ol, orr, ot, ob, step, gravity, a_pipe);
+      } else {
+        for (int x = 0; x < W; ++x)
+          cell::flow_pipes_cell(x, y, W, H, kind, b, d, dx, dy, area, fl, fr, ft, fb, ol, orr, ot,
+                                ob, step, gravity, a_pipe, l_pipe);
+      }
     });
     std::swap(flux_, flux_next_);
     return;

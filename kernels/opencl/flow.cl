@@ -4,7 +4,8 @@
 #include "flow.h"
 
 /* One work-item per padded cell (where the global size is rounded up, the work-items past
- * the raster stop). */
+ * the raster stop); the host runs flow_pipes_interior on rows 1 .. H - 2 and this one on rows
+ * 0 and H - 1. */
 __kernel void flow_pipes(int W, int H, __global const uchar* kind, __global const real* bed,
                          __global const real* depth, __global const real* dx,
                          __global const real* dy, __global const real* area,
@@ -17,6 +18,25 @@ __kernel void flow_pipes(int W, int H, __global const uchar* kind, __global cons
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   flow_pipes_cell(x, y, W, H, kind, bed, depth, dx, dy, area, f_left, f_right, f_top, f_bottom,
                   out_left, out_right, out_top, out_bottom, dt, gravity, pipe_area, pipe_length);
+}
+
+/* The pipes scheme on rows 1 .. H - 2 (global offset 1): no clamping, no branches. */
+__kernel void flow_pipes_interior(int W, int H, __global const uchar* kind,
+                                  __global const real* bed, __global const real* depth,
+                                  __global const real* dx, __global const real* dy,
+                                  __global const real* area, __global const real* f_left,
+                                  __global const real* f_right, __global const real* f_top,
+                                  __global const real* f_bottom, __global real* out_left,
+                                  __global real* out_right, __global real* out_top,
+                                  __global real* out_bottom, real dt, real gravity, real pipe_area,
+                                  real pipe_length) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W)) return;
+  real lx, lt, lb;
+  pipe_lengths(y, y - 1, y + 1, dx, dy, pipe_length, &lx, &lt, &lb);
+  flow_pipes_cell_interior(x, y, W, kind, bed, depth, lx, lt, lb, area[y], f_left, f_right, f_top,
+                           f_bottom, out_left, out_right, out_top, out_bottom, dt, gravity,
+                           pipe_area);
 }
 
 /* Local inertial, face pass: one work-item per padded cell computes the face east of it
