@@ -70,10 +70,12 @@ ERODEM_FN void flow_pipes_outflows(int k, int k_left, int k_right, int k_top, in
   const real fr = f_right - c * (eta_right - eta) / length_x;
   const real ft = f_top + (eta - eta_top) * c / length_top;
   const real fb = f_bottom - (eta_bottom - eta) * c / length_bottom;
-  const real gl = gives_water(k, k_left) & (fl > 0) ? fl : (real)0;
-  const real gr = gives_water(k, k_right) & (fr > 0) ? fr : (real)0;
-  const real gt = gives_water(k, k_top) & (ft > 0) ? ft : (real)0;
-  const real gb = gives_water(k, k_bottom) & (fb > 0) ? fb : (real)0;
+  const real pl = fl > 0 ? fl : (real)0, pr = fr > 0 ? fr : (real)0;
+  const real pt = ft > 0 ? ft : (real)0, pb = fb > 0 ? fb : (real)0;
+  const real gl = gives_water(k, k_left) ? pl : (real)0;
+  const real gr = gives_water(k, k_right) ? pr : (real)0;
+  const real gt = gives_water(k, k_top) ? pt : (real)0;
+  const real gb = gives_water(k, k_bottom) ? pb : (real)0;
   const real K =
       k == ERODEM_CELL_ACTIVE ? outflow_limit(depth, cell_area, gl + gr + gt + gb, dt) : (real)1;
   *out_left = gl * K;
@@ -96,9 +98,11 @@ ERODEM_FN void pipe_lengths(int y, int y_top, int y_bottom, GLOBAL const real* d
 
 /* Pipes scheme for padded cell (x, y) in a row 1 <= y <= H - 2, any 0 <= x <= W - 1, with the
  * row's pipe lengths (pipe_lengths) and cell area (m^2): reads the previous fluxes f_*,
- * writes out_*. Every index it reads lies inside the raster in these rows (x - 1 and x + 1
- * across the row ends in the first and last column, masked there), so it reads without
- * clamping, and the per-row values come in as numbers: loops over x vectorise. */
+ * writes out_*. Every index it reads lies inside the raster in these rows, so it reads
+ * without clamping, and the per-row values come in as numbers: loops over x vectorise. In the
+ * first and last column x - 1 and x + 1 reach across the row ends to halo cells of the rows
+ * above and below; the halo is never active, so no pipe between two halo cells carries water
+ * (gives_water) and those reads need no mask (a mask on x kept GCC from vectorising). */
 ERODEM_FN void flow_pipes_cell_interior(
     int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
     GLOBAL const real* depth, real length_x, real length_top, real length_bottom, real cell_area,
@@ -106,10 +110,8 @@ ERODEM_FN void flow_pipes_cell_interior(
     GLOBAL const real* f_bottom, GLOBAL real* out_left, GLOBAL real* out_right,
     GLOBAL real* out_top, GLOBAL real* out_bottom, real dt, real gravity, real pipe_area) {
   const int i = x + y * W;
-  const int k_left = kind[i - 1], k_right = kind[i + 1]; /* loaded, then masked by x */
   real fl, fr, ft, fb;
-  flow_pipes_outflows(kind[i], x >= 1 ? k_left : ERODEM_CELL_WALL,
-                      x <= W - 2 ? k_right : ERODEM_CELL_WALL, kind[i - W], kind[i + W],
+  flow_pipes_outflows(kind[i], kind[i - 1], kind[i + 1], kind[i - W], kind[i + W],
                       bed[i] + depth[i], bed[i - 1] + depth[i - 1], bed[i + 1] + depth[i + 1],
                       bed[i - W] + depth[i - W], bed[i + W] + depth[i + W], f_left[i], f_right[i],
                       f_top[i], f_bottom[i], length_x, length_top, length_bottom, depth[i],
