@@ -7,6 +7,23 @@
 
 namespace erodem {
 
+const std::array<LedgerEntry, 11>& ledger_entries() {
+  static const std::array<LedgerEntry, 11> table{{
+      {"water_initial", &Ledger::water_initial},
+      {"water", &Ledger::water},
+      {"rain", &Ledger::rain},
+      {"inflow", &Ledger::inflow},
+      {"boundary_out", &Ledger::boundary_out},
+      {"evaporated", &Ledger::evaporated},
+      {"clipped", &Ledger::clipped},
+      {"material_initial", &Ledger::material_initial},
+      {"material", &Ledger::material},
+      {"sediment_out", &Ledger::sediment_out},
+      {"transport_change", &Ledger::transport_change},
+  }};
+  return table;
+}
+
 double Ledger::relative_closure_error() const {
   const double scale = std::max({std::abs(water_initial), std::abs(water), rain + inflow,
                                  std::abs(boundary_out) + evaporated});

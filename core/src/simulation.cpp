@@ -11,6 +11,25 @@
 
 namespace erodem {
 
+const std::array<DiagnosticsSeries, 11>& diagnostics_series() {
+  static const std::array<DiagnosticsSeries, 11> table{{
+      {"time", &Diagnostics::time, "s", "time since the start of the run, at the end of the step"},
+      {"dt", &Diagnostics::dt, "s", "time step"},
+      {"water_volume", &Diagnostics::water_volume, "m3", "water volume on the grid"},
+      {"material_volume", &Diagnostics::material_volume, "m3",
+       "bed plus suspended sediment volume"},
+      {"rain_volume", &Diagnostics::rain_volume, "m3", "cumulative rain volume"},
+      {"inflow_volume", &Diagnostics::inflow_volume, "m3", "cumulative inflow volume"},
+      {"boundary_outflow_volume", &Diagnostics::boundary_outflow_volume, "m3",
+       "cumulative net outflow through the boundary"},
+      {"evaporated_volume", &Diagnostics::evaporated_volume, "m3", "cumulative evaporated volume"},
+      {"closure_error", &Diagnostics::closure_error, "m3", "water ledger closure error"},
+      {"max_depth", &Diagnostics::max_depth, "m", "largest water depth"},
+      {"max_speed", &Diagnostics::max_speed, "m s-1", "largest flow speed"},
+  }};
+  return table;
+}
+
 const char* process_name(Process p) {
   switch (p) {
     case Process::boundary:

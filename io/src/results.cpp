@@ -265,57 +265,7 @@ bool exists(hid_t loc, const std::string& path) {
 
 // ---- the layout -----------------------------------------------------------------------------
 
-/// One per-step series of `diagnostics/`.
-struct DiagSeries {
-  const char* name;
-  double Diagnostics::*member;
-  const char* units;
-  const char* long_name;
-};
-
-const std::array<DiagSeries, 11>& diag_series() {
-  static const std::array<DiagSeries, 11> table{{
-      {"time", &Diagnostics::time, "s", "time since the start of the run, at the end of the step"},
-      {"dt", &Diagnostics::dt, "s", "time step"},
-      {"water_volume", &Diagnostics::water_volume, "m3", "water volume on the grid"},
-      {"material_volume", &Diagnostics::material_volume, "m3",
-       "bed plus suspended sediment volume"},
-      {"rain_volume", &Diagnostics::rain_volume, "m3", "cumulative rain volume"},
-      {"inflow_volume", &Diagnostics::inflow_volume, "m3", "cumulative inflow volume"},
-      {"boundary_outflow_volume", &Diagnostics::boundary_outflow_volume, "m3",
-       "cumulative net outflow through the boundary"},
-      {"evaporated_volume", &Diagnostics::evaporated_volume, "m3", "cumulative evaporated volume"},
-      {"closure_error", &Diagnostics::closure_error, "m3", "water ledger closure error"},
-      {"max_depth", &Diagnostics::max_depth, "m", "largest water depth"},
-      {"max_speed", &Diagnostics::max_speed, "m s-1", "largest flow speed"},
-  }};
-  return table;
-}
-
 constexpr const char* kGaugeSeries[] = {"water_depth", "water_level", "speed"};
-
-/// One ledger entry of `restart/`, one value per snapshot.
-struct LedgerEntry {
-  const char* name;
-  double Ledger::*member;
-};
-
-const std::array<LedgerEntry, 11>& ledger_entries() {
-  static const std::array<LedgerEntry, 11> table{{
-      {"ledger_water_initial", &Ledger::water_initial},
-      {"ledger_water", &Ledger::water},
-      {"ledger_rain", &Ledger::rain},
-      {"ledger_inflow", &Ledger::inflow},
-      {"ledger_boundary_out", &Ledger::boundary_out},
-      {"ledger_evaporated", &Ledger::evaporated},
-      {"ledger_clipped", &Ledger::clipped},
-      {"ledger_material_initial", &Ledger::material_initial},
-      {"ledger_material", &Ledger::material},
-      {"ledger_sediment_out", &Ledger::sediment_out},
-      {"ledger_transport_change", &Ledger::transport_change},
-  }};
-  return table;
-}
 
 std::string iso_utc_now() {
   const std::time_t now = std::time(nullptr);
@@ -491,7 +441,7 @@ struct ResultWriter::Impl {
                   "diagnostics/step");
       std::vector<double> column(rows);
       for (std::size_t k = 0; k < diag.size(); ++k) {
-        const auto& s = diag_series()[k];
+        const auto& s = diagnostics_series()[k];
         for (std::size_t r = 0; r < rows; ++r) column[r] = pending[r].*s.member;
         append_rows(diag[k], H5T_NATIVE_DOUBLE, rows, column.data(), partial,
                     std::string("diagnostics/") + s.name);
@@ -684,7 +634,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     put_text(group, "comment", "one row per simulation step, at the end of the step", partial_);
     m.diag_step = m.coordinate(group, "step", H5T_STD_I64LE, nullptr, 0, true);
     put_text(m.diag_step, "long_name", "number of steps done", partial_);
-    for (const auto& s : diag_series())
+    for (const auto& s : diagnostics_series())
       m.diag.push_back(m.series(group, s.name, m.diag_step, -1, 0, s.units, s.long_name));
   }
 
@@ -720,8 +670,9 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     };
     m.restart_steps = per_snapshot("steps", H5T_STD_I64LE, "1", "steps done");
     for (const auto& e : ledger_entries())
-      m.restart_ledger.push_back(
-          per_snapshot(e.name, H5T_IEEE_F64LE, "m3", std::string("ledger entry ") + (e.name + 7)));
+      m.restart_ledger.push_back(per_snapshot((std::string("ledger_") + e.name).c_str(),
+                                              H5T_IEEE_F64LE, "m3",
+                                              std::string("ledger entry ") + e.name));
   }
 
   // gauges/: one row per step, one column per gauge.
@@ -807,7 +758,7 @@ void ResultWriter::snapshot(const Simulation& sim) {
     for (std::size_t k = 0; k < ledger_entries().size(); ++k) {
       const double v = point.ledger.*ledger_entries()[k].member;
       append_rows(m.restart_ledger[k], H5T_NATIVE_DOUBLE, 1, &v, partial_,
-                  std::string("restart/") + ledger_entries()[k].name);
+                  std::string("restart/ledger_") + ledger_entries()[k].name);
     }
   }
   // The time last: a file cut short mid-snapshot lists only the complete snapshots.
@@ -1107,7 +1058,8 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
   p.time = times_[index];
   p.steps = static_cast<long>(steps[index]);
   for (const auto& e : ledger_entries())
-    p.ledger.*e.member = read_doubles(file_, std::string("restart/") + e.name, path_).at(index);
+    p.ledger.*e.member =
+        read_doubles(file_, std::string("restart/ledger_") + e.name, path_).at(index);
   for (FieldId id : state_fields()) {
     const std::string name = std::string("restart/") + field_info(id).name;
     H5Id ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
@@ -1134,7 +1086,7 @@ std::vector<Diagnostics> ResultReader::diagnostics() const {
   QuietH5 quiet;
   if (!exists(file_, "diagnostics")) return {};
   std::vector<Diagnostics> rows;
-  for (const auto& s : diag_series()) {
+  for (const auto& s : diagnostics_series()) {
     const auto v = read_doubles(file_, std::string("diagnostics/") + s.name, path_);
     if (rows.empty()) rows.resize(v.size());
     if (v.size() != rows.size())

@@ -250,19 +250,9 @@ long PySimulation::advance(long max_steps, bool to_end, double until_time, PyWri
 
 py::dict ledger_dict(const Ledger& l) {
   py::dict d;
-  d["water_initial"] = l.water_initial;
-  d["water"] = l.water;
-  d["rain"] = l.rain;
-  d["inflow"] = l.inflow;
-  d["boundary_out"] = l.boundary_out;
-  d["evaporated"] = l.evaporated;
-  d["clipped"] = l.clipped;
+  for (const auto& e : ledger_entries()) d[e.name] = l.*e.member;
   d["closure_error"] = l.closure_error();
   d["relative_closure_error"] = l.relative_closure_error();
-  d["material_initial"] = l.material_initial;
-  d["material"] = l.material;
-  d["sediment_out"] = l.sediment_out;
-  d["transport_change"] = l.transport_change;
   d["material_closure_error"] = l.material_closure_error();
   d["relative_material_closure_error"] = l.relative_material_closure_error();
   return d;
@@ -270,17 +260,7 @@ py::dict ledger_dict(const Ledger& l) {
 
 py::dict diagnostics_dict(const Diagnostics& g) {
   py::dict d;
-  d["time"] = g.time;
-  d["dt"] = g.dt;
-  d["water_volume"] = g.water_volume;
-  d["material_volume"] = g.material_volume;
-  d["rain_volume"] = g.rain_volume;
-  d["inflow_volume"] = g.inflow_volume;
-  d["boundary_outflow_volume"] = g.boundary_outflow_volume;
-  d["evaporated_volume"] = g.evaporated_volume;
-  d["closure_error"] = g.closure_error;
-  d["max_depth"] = g.max_depth;
-  d["max_speed"] = g.max_speed;
+  for (const auto& s : diagnostics_series()) d[s.name] = g.*s.member;
   return d;
 }
 

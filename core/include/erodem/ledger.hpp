@@ -2,6 +2,7 @@
 // double precision whatever the precision of the fields.
 #pragma once
 
+#include <array>
 #include <string>
 
 namespace erodem {
@@ -37,5 +38,16 @@ struct Ledger {
   /// A human-readable table.
   std::string format() const;
 };
+
+/// One kept entry of the ledger (m^3): its name (a key of the Python ledger dict,
+/// `ledger_<name>` in an HDF5 file's restart/) and its member.
+struct LedgerEntry {
+  const char* name;
+  double Ledger::*member;
+};
+
+/// Every kept entry of the ledger, in the order of the structure (the derived closure errors
+/// are not kept).
+const std::array<LedgerEntry, 11>& ledger_entries();
 
 }  // namespace erodem

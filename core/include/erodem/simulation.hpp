@@ -2,6 +2,7 @@
 // time step, keeps the ledger and stops an unstable run with the step and the cell.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -27,6 +28,18 @@ struct Diagnostics {
   double evaporated_volume = 0.0, closure_error = 0.0;
   double max_depth = 0.0, max_speed = 0.0;
 };
+
+/// One series of the per-step diagnostics: its name (HDF5 `diagnostics/<name>`, a Python
+/// diagnostics key), member, units (UDUNITS) and long name.
+struct DiagnosticsSeries {
+  const char* name;
+  double Diagnostics::*member;
+  const char* units;
+  const char* long_name;
+};
+
+/// Every series of the diagnostics, in file order.
+const std::array<DiagnosticsSeries, 11>& diagnostics_series();
 
 /// The state of a run between two steps: with the same terrain and parameters, a run
 /// restored from it continues exactly as the uninterrupted run would (same backend and
