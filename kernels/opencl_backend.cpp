@@ -440,11 +440,10 @@ constexpr int kTallySediment = 2;       // ERODEM_TALLY_SEDIMENT of reduce.cl
 constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
                    kEvaporatedBit = 1u << 3, kTallyBits = 0xfu, kChangeBit = 1u << 4;
 
-/// A size from the environment (the tuning variables ERODEM_OPENCL_WG, ERODEM_OPENCL_WG_Y), else
-/// `fallback`. Where the kernels are built for rounded launches, the cell kernels' work-group
-/// is (ERODEM_OPENCL_WG, ERODEM_OPENCL_WG_Y) rounded down to powers of two, by default (64, 1)
-/// on CPU devices and (128, 1) on others; CPU devices launch whole rows (a divisor of the row,
-/// one row high) unless ERODEM_OPENCL_WG is set, and ignore ERODEM_OPENCL_WG_Y then.
+/// A size from the environment (the tuning variable ERODEM_OPENCL_WG), else `fallback`. Where
+/// the kernels are built for rounded launches, the cell kernels' work-group is ERODEM_OPENCL_WG
+/// rounded down to a power of two, by default 64 on CPU devices and 128 on others, one row high;
+/// CPU devices launch whole rows (a divisor of the row) unless ERODEM_OPENCL_WG is set.
 std::size_t env_size(const char* name, std::size_t fallback) {
   if (const char* env = std::getenv(name); env && *env) {
     const long v = std::strtol(env, nullptr, 10);
@@ -532,7 +531,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
       std::clamp<std::size_t>((n_ + reduce_local_ - 1) / reduce_local_, 1, kReduceGroupsMax);
   partial_b_ = make_buffer(reduce_groups_ * acc_size_);
 
-  // Cell kernels: work-groups of (local_x_, local_y_) that every cell kernel accepts: a divisor
+  // Cell kernels: work-groups of (local_x_, 1) that every cell kernel accepts: a divisor
   // of the row by one row (whole rows), else powers of two; a fixed number of groups for this
   // grid (the tallies' partials, summed in a fixed order). Where a kernel accepts less than the
   // device's maximum, the whole-row divisor may be small: still correct, slower.
@@ -559,14 +558,10 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     // the program was built for it: a local size that divides the row (any divisor keeps
     // the kernels correct; the largest is the fastest)
     local_x_ = whole_row_group(static_cast<std::size_t>(W_), cell_limit);
-    local_y_ = 1;
   } else {
     local_x_ = pow2_at_most(std::min(cell_limit, env_size("ERODEM_OPENCL_WG", cpu ? 64 : 128)));
-    local_y_ = pow2_at_most(std::min(cell_limit / local_x_, env_size("ERODEM_OPENCL_WG_Y", 1)));
   }
   groups_x_ = (static_cast<std::size_t>(W_) + local_x_ - 1) / local_x_;
-  groups_y_ = (static_cast<std::size_t>(H_) + local_y_ - 1) / local_y_;
-  cell_groups_ = groups_x_ * groups_y_;
   interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
   partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
   partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
@@ -616,13 +611,6 @@ cl_kernel OpenClBackend::kernel(const char* name) {
   check(err, fmt::format("clCreateKernel({})", name).c_str());
   kernels_.emplace_back(name, std::move(k));
   return kernels_.back().second.get();
-}
-
-void OpenClBackend::launch_cells(cl_kernel k) {
-  const std::size_t global[2] = {groups_x_ * local_x_, groups_y_ * local_y_};
-  const std::size_t local[2] = {local_x_, local_y_};
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, nullptr, global, local, 0, nullptr, nullptr),
-        "clEnqueueNDRangeKernel");
 }
 
 void OpenClBackend::launch_interior(cl_kernel k) {

@@ -144,9 +144,6 @@ class OpenClBackend final : public Backend {
     return make_buffer(v.size() * sizeof(T), v.data());
   }
   cl_kernel kernel(const char* name);
-  /// Runs a cell kernel over the padded raster: work-groups of (local_x_, local_y_), the global
-  /// size rounded up to whole groups (the kernels bound-check).
-  void launch_cells(cl_kernel k);
   /// Runs a cell kernel over the padded rows 1 .. H - 2, the rows with DEM cells (what the
   /// processes but flow touch), in interior_groups_ work-groups of (local_x_, 1).
   void launch_interior(cl_kernel k);
@@ -184,11 +181,10 @@ class OpenClBackend final : public Backend {
   int nx_, ny_, W_, H_;
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
-  // The cell kernels' groups: (local_x_, local_y_) work-items, groups_x_ * groups_y_ of them
-  // over the padded raster, interior_groups_ over its rows 1 .. H - 2 (launch_interior; the
-  // tally kernels: one partial per group).
-  std::size_t local_x_ = 1, local_y_ = 1, groups_x_ = 1, groups_y_ = 1, cell_groups_ = 1,
-              interior_groups_ = 1;
+  // The cell kernels' groups: (local_x_, 1) work-items, groups_x_ per padded row (the global
+  // size rounded up to whole groups where local_x_ does not divide the row), interior_groups_
+  // over rows 1 .. H - 2 (launch_interior; the tally kernels: one partial per group).
+  std::size_t local_x_ = 1, groups_x_ = 1, interior_groups_ = 1;
   // The active cells beside a ghost (edge_tallies): padded indices, in groups of edge_local_.
   Buffer edge_cells_;
   std::size_t edge_count_ = 0, edge_local_ = 1, edge_groups_ = 1;
