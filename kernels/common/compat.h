@@ -58,8 +58,8 @@ typedef std::uint8_t erodem_kind_t;
  * cbrtf and OpenCL's cbrt may differ by an ulp, and the thresholds of the flow schemes (dry
  * faces, clipping) turn one ulp into visible differences after many steps. This one uses
  * only correctly rounded +, -, *, / (FP_CONTRACT off in the kernels): a bit-level first
- * guess and three Halley steps, about 1 ulp from the exact root. erodem_cbrt(x) is this
- * function for float and the C library's cbrt for double (the CPU float64 reference). */
+ * guess and two Halley steps, within 1 ulp of the exact root (tests/test_cbrt.cpp). erodem_cbrt(x)
+ * is this function for float and the C library's cbrt for double (the CPU float64 reference). */
 #ifdef __OPENCL_C_VERSION__
 ERODEM_INLINE unsigned int erodem_float_bits(float x) {
   return as_uint(x);
@@ -86,14 +86,15 @@ inline float erodem_bits_float(unsigned int b) {
 #endif
 
 ERODEM_BEGIN_NAMESPACE
-/* u / 3 rounded down, exactly, for every 32-bit u, with shifts, adds and 32-bit multiplies
- * only (GCC does not vectorise the integer division on x86-64): 2^16 = 3 * 21845 + 1 and
- * 2^8 = 3 * 85 + 1 fold u into n < 768 with u = 3 (21845 h + 85 m_h) + n, and
- * n / 3 = (683 n) >> 11 for n < 2048. */
-ERODEM_INLINE unsigned int erodem_div3(unsigned int u) {
-  const unsigned int h = u >> 16, m = h + (u & 0xffffu);
-  const unsigned int m_h = m >> 8, n = m_h + (m & 0xffu);
-  return h * 21845u + m_h * 85u + ((n * 683u) >> 11);
+/* First guess of the cube root of a positive normal float x, within 3.3 % (Kahan's bit
+ * trick): the bits of x over 3 plus the bias of the exponent times 2/3. The division by 3
+ * is done in float, (float)bits * (1/3) truncated (exact enough for a guess), since neither
+ * GCC nor PoCL vectorise a 32-bit integer division well; every step of it is exactly
+ * defined (int -> float rounds to nearest, float -> int truncates), so every device gives
+ * the same bits. */
+ERODEM_INLINE float cbrt_f32_guess(float x) {
+  const int bits = (int)erodem_float_bits(x); /* < 2^31 for x >= 0 */
+  return erodem_bits_float((unsigned int)((int)((float)bits * 0.333333343f) + 709958130));
 }
 
 /* Cube root of a positive, finite x (NaN gives NaN): the body of cbrt_f32 without its
@@ -104,12 +105,11 @@ ERODEM_INLINE float cbrt_f32_positive(float x) {
   const int tiny = x<1.0e-30f, huge = x> 1.0e30f;
   const float xs = x * (tiny ? 4722366482869645213696.0f : huge ? 2.1175823681357508e-22f : 1.0f);
   const float scale = tiny ? 5.9604644775390625e-08f : huge ? 16777216.0f : 1.0f;
-  float y = erodem_bits_float(erodem_div3(erodem_float_bits(xs)) + 709958130u); /* ~3 % */
-  /* three Halley steps, written out: PoCL does not vectorise a work-item loop that holds
-   * an inner loop */
+  float y = cbrt_f32_guess(xs);
+  /* two Halley steps (cubic convergence: 3.3 % -> 2e-5 -> below float rounding; a third
+   * step changes no result by more than rounding), written out: PoCL does not vectorise a
+   * work-item loop that holds an inner loop */
   float y3 = y * y * y;
-  y = y - y * ((y3 - xs) / (y3 + y3 + xs));
-  y3 = y * y * y;
   y = y - y * ((y3 - xs) / (y3 + y3 + xs));
   y3 = y * y * y;
   y = y - y * ((y3 - xs) / (y3 + y3 + xs));
