@@ -5,8 +5,10 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "erodem/backends.hpp"
@@ -161,6 +163,89 @@ TEST(AgreementStats, MaximaAndBadCellOnStatesThatAreNotPhysical) {
     EXPECT_EQ(got[1].max_depth, got[0].max_depth) << c.nx << " x " << c.ny;
     EXPECT_EQ(got[1].max_speed, got[0].max_speed) << c.nx << " x " << c.ny;
   }
+}
+
+// The same on rows long enough for the OpenCL kernel's 8-cell blocks and several work-groups
+// per row, filled from small sets of values so that rows hold ties: equal depths (and -0
+// beside +0), negative and NaN depths, squared speeds equal in float but not in double
+// (1 + 2^-23 against 1 and 2^-12), planted pairs that float squares would rank the wrong way
+// round (normal and subnormal), speeds whose float square underflows or overflows. 20 states
+// on each of three grid shapes. (A kernel that ranked by float squares, or took the last of
+// equal maxima, fails most of them.)
+TEST(AgreementStats, MaximaOnLongRowsWithTiesAndNearTies) {
+  if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  const double eps = std::ldexp(1.0, -23), nan = std::nan("");
+  const std::vector<double> depths = {-2.0, -1.0, -0.5, -0.0, 0.0, 0.4, 0.4, 1.5, 1.5, nan};
+  // Velocity components by regime: near ties, squares that underflow in float, squares that
+  // overflow in float, all of them.
+  const std::vector<std::vector<double>> speeds = {
+      {0.0, 1.0, 1.0 + eps, 1.0 - eps / 2, -1.0 - eps, std::ldexp(1.0, -12), 0.5},
+      {0.0, 1e-20, -1e-20, 1e-25, 3e-25},
+      {3.0, 1e19, 2e19, -2e19, 1.9e19},
+      {0.0, 1.0, 1.0 + eps, std::ldexp(1.0, -12), -3.0, 1e-20, 1e-25, 2e19, 0.5}};
+  std::uint32_t seed = 12345;
+  // A value of `set` (a linear congruential generator: the same states everywhere); the
+  // last one only `with_last`.
+  auto pick = [&seed](const std::vector<double>& set, bool with_last) {
+    seed = seed * 1664525u + 1013904223u;
+    return set[(seed >> 8) % (with_last ? set.size() : set.size() - 1)];
+  };
+  int states = 0, agreed = 0;
+  for (const auto& [nx, ny] : std::vector<std::pair<int, int>>{{45, 4}, {130, 3}, {700, 2}}) {
+    const Terrain terrain = flat_terrain(nx, ny, 10.0);
+    const Params params = quiet_params(FlowScheme::local_inertial, 0.1);
+    auto cpu = make_backend("cpu", terrain, params);
+    auto ocl = make_backend("opencl", terrain, params);
+    const std::size_t n = static_cast<std::size_t>(nx) * ny;
+    for (int s = 0; s < 20; ++s) {
+      // Half of the states without NaN depths (a NaN makes that cell the first bad one, and
+      // the other half checks the first bad cell).
+      std::vector<double> d(n), u(n), v(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        d[i] = pick(depths, s % 2 == 1);
+        const auto& regime = speeds[static_cast<std::size_t>(s / 2) % speeds.size()];
+        u[i] = pick(regime, true);
+        v[i] = s % 3 == 2 ? 0.0 : pick(regime, true);
+      }
+      if (s % 4 == 1 || s % 4 == 3) {
+        // Two planted cells whose float squared speeds rank them the other way round from
+        // the exact ones: A = (ua, va) is faster, B = (ub, vb) has the larger float u u + v v
+        // (near 1.125; and in the subnormal range, where float rounds to 2^-149: 5 against
+        // 6 of them, exactly 5.73 against 5.58). Everything else slower.
+        const bool tiny = s % 4 == 3;
+        const double ua = tiny ? 7.855647288146363e-23 : 0.7500035762786865;
+        const double va = tiny ? 4.314757393729191e-23 : 0.7500025033950806;
+        const double ub = tiny ? 8.841709535720696e-23 : 0.7500033974647522;
+        const double vb = tiny ? 0.0 : 0.7500026822090149;
+        for (std::size_t i = 0; i < n; ++i) u[i] = v[i] = tiny ? 0.0 : 0.5;
+        seed = seed * 1664525u + 1013904223u;
+        const std::size_t a = (seed >> 8) % n, b = (a + 1 + (seed >> 20) % (n - 1)) % n;
+        u[a] = ua, v[a] = va, u[b] = ub, v[b] = vb;
+      }
+      std::vector<FieldStats> got;
+      for (auto* b : {cpu.get(), ocl.get()}) {
+        b->set_field(FieldId::water_depth, d);
+        b->set_field(FieldId::velocity_x, u);
+        b->set_field(FieldId::velocity_y, v);
+        got.push_back(b->stats());
+      }
+      ++states;
+      const bool same =
+          got[1].max_depth_cell == got[0].max_depth_cell &&
+          got[1].max_speed_cell == got[0].max_speed_cell && got[1].bad_cell == got[0].bad_cell &&
+          got[1].max_depth == got[0].max_depth && got[1].max_speed == got[0].max_speed;
+      agreed += same;
+      EXPECT_TRUE(same) << nx << " x " << ny << " state " << s << ": max depth cell "
+                        << got[0].max_depth_cell << " / " << got[1].max_depth_cell
+                        << ", max speed cell " << got[0].max_speed_cell << " / "
+                        << got[1].max_speed_cell << ", bad cell " << got[0].bad_cell << " / "
+                        << got[1].bad_cell << " (cpu / opencl)";
+    }
+  }
+  std::printf(
+      "[agreement stats] long rows: %d of %d states with the same maxima, their cells "
+      "and the first bad cell (bound: all)\n",
+      agreed, states);
 }
 
 INSTANTIATE_TEST_SUITE_P(
