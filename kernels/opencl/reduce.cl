@@ -77,5 +77,8 @@ static inline void cell_group_sum(__local real* s, real v, __global acc_t* out) 
   const int l = (int)get_local_id(0) + (int)get_local_id(1) * (int)get_local_size(0);
   s[l] = v;
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (l == 0) *out = cell_tallies_sum(s, (int)(get_local_size(0) * get_local_size(1)));
+  /* the ids again, not l: on PoCL a value computed before a barrier and used after it is
+   * kept per work-item (see field_stats in stats.cl) */
+  if (get_local_id(0) == 0 && get_local_id(1) == 0)
+    *out = cell_tallies_sum(s, (int)(get_local_size(0) * get_local_size(1)));
 }

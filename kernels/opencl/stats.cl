@@ -85,7 +85,7 @@ __kernel void field_stats(int W, int H, __global const uchar* kind, __global con
   s_v[l] = active ? velocity_y[i] : (real)0;
   s_state[l] = active ? (cell_state_ok(b, d, sd) ? 1 : 2) : 0; /* 0 ghost, 1 ok, 2 not physical */
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (l != 0) return;
+  if (get_local_id(0) != 0) return;
   /* The group's row and first column from the group's ids, not from x and y: PoCL keeps every
    * work-item's values that are used after a barrier in per-work-item storage, and a 64-bit
    * one (a global id) halves the vector width of the whole kernel (8 -> 4 lanes on AVX2/512:
