@@ -90,10 +90,13 @@ ERODEM_FN void flow_pipes_outflows(int k, int k_left, int k_right, int k_top, in
 ERODEM_FN void pipe_lengths(int y, int y_top, int y_bottom, GLOBAL const real* dx,
                             GLOBAL const real* dy, real pipe_length, real* length_x,
                             real* length_top, real* length_bottom) {
+  /* loaded unconditionally: a load under the condition becomes a masked gather in every
+   * iteration of PoCL's vectorised work-item loop */
+  const real dx_y = dx[y], dy_y = dy[y], dy_top = dy[y_top], dy_bottom = dy[y_bottom];
   const int given = pipe_length > 0;
-  *length_x = given ? pipe_length : dx[y];
-  *length_top = given ? pipe_length : (real)0.5 * (dy[y] + dy[y_top]);
-  *length_bottom = given ? pipe_length : (real)0.5 * (dy[y] + dy[y_bottom]);
+  *length_x = given ? pipe_length : dx_y;
+  *length_top = given ? pipe_length : (real)0.5 * (dy_y + dy_top);
+  *length_bottom = given ? pipe_length : (real)0.5 * (dy_y + dy_bottom);
 }
 
 /* Pipes scheme for padded cell (x, y) in a row 1 <= y <= H - 2, any 0 <= x <= W - 1, with the
