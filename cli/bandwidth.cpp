@@ -17,15 +17,15 @@
 
 namespace erodem::cli {
 
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
 
 // The kernels, each in a multi-threaded (static schedule: each thread touches the part it
 // initialised) and a single-threaded version. Signed loop index for OpenMP.
@@ -93,34 +93,67 @@ std::size_t last_level_cache_bytes() {
   return conf > 0 ? static_cast<std::size_t>(conf) : 0;
 }
 
-Bandwidth measure_bandwidth(std::size_t floats, int repetitions) {
-  Bandwidth bw;
-  bw.floats = floats;
-  bw.llc_bytes = last_level_cache_bytes();
-  bw.repetitions = repetitions;
-#ifdef _OPENMP
-  bw.threads = omp_get_max_threads();
-#endif
+BandwidthProbe::BandwidthProbe(std::size_t floats, int repetitions)
+    : floats_(floats),
+      repetitions_(repetitions),
+      a_(new float[floats]),
+      b_(new float[floats]),
+      c_(new float[floats]) {
   const long n = static_cast<long>(floats);
+  float *pa = a_, *pb = b_, *pc = c_;
   // Uninitialised storage, first touched by the threads that use it in the parallel runs.
-  std::unique_ptr<float[]> a(new float[floats]), b(new float[floats]), c(new float[floats]);
-  float *pa = a.get(), *pb = b.get(), *pc = c.get();
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
     pa[i] = 1.0f;
     pb[i] = 2.0f;
     pc[i] = 0.0f;
   }
+}
+
+BandwidthProbe::~BandwidthProbe() {
+  delete[] a_;
+  delete[] b_;
+  delete[] c_;
+}
+
+void BandwidthProbe::round() {
+  Bandwidth bw;
+  const long n = static_cast<long>(floats_);
+  float *pa = a_, *pb = b_, *pc = c_;
   const float s = 3.0f;
   const double copy_bytes = 2.0 * sizeof(float) * static_cast<double>(n);
   const double triad_bytes = 3.0 * sizeof(float) * static_cast<double>(n);
-  bw.copy_all = rate([&] { copy_all(pc, pa, n); }, copy_bytes, repetitions);
-  bw.triad_all = rate([&] { triad_all(pa, pb, pc, s, n); }, triad_bytes, repetitions);
-  bw.copy_one = rate([&] { copy_one(pc, pa, n); }, copy_bytes, repetitions);
-  bw.triad_one = rate([&] { triad_one(pa, pb, pc, s, n); }, triad_bytes, repetitions);
+  bw.copy_all = rate([&] { copy_all(pc, pa, n); }, copy_bytes, repetitions_);
+  bw.triad_all = rate([&] { triad_all(pa, pb, pc, s, n); }, triad_bytes, repetitions_);
+  bw.copy_one = rate([&] { copy_one(pc, pa, n); }, copy_bytes, repetitions_);
+  bw.triad_one = rate([&] { triad_one(pa, pb, pc, s, n); }, triad_bytes, repetitions_);
   // Use the results, so no compiler can drop the stores.
   volatile float sink = pa[n / 2] + pc[n - 1];
   (void)sink;
+  rounds_.push_back(bw);
+}
+
+Bandwidth BandwidthProbe::result() const {
+  Bandwidth bw;
+  bw.floats = floats_;
+  bw.llc_bytes = last_level_cache_bytes();
+  bw.repetitions = repetitions_;
+  bw.rounds = static_cast<int>(rounds_.size());
+#ifdef _OPENMP
+  bw.threads = omp_get_max_threads();
+#endif
+  auto over_rounds = [this](double Bandwidth::*value) {
+    std::vector<double> v;
+    for (const auto& r : rounds_) v.push_back(r.*value);
+    return v;
+  };
+  const std::vector<double> copies = over_rounds(&Bandwidth::copy_all);
+  bw.copy_all = median(copies);
+  bw.copy_all_low = copies.empty() ? 0.0 : *std::min_element(copies.begin(), copies.end());
+  bw.copy_all_high = copies.empty() ? 0.0 : *std::max_element(copies.begin(), copies.end());
+  bw.triad_all = median(over_rounds(&Bandwidth::triad_all));
+  bw.copy_one = median(over_rounds(&Bandwidth::copy_one));
+  bw.triad_one = median(over_rounds(&Bandwidth::triad_one));
   return bw;
 }
 

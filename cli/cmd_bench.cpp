@@ -139,16 +139,11 @@ struct Row {
   double gbs() const { return bytes * cell_steps_per_second / 1e9; }
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 constexpr int kRepetitions = 3;
 
+/// Times `backend` on `terrain`; a round of `probe` runs before each timed repetition.
 std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::string& backend,
-                           int threads, long steps) {
+                           int threads, long steps, BandwidthProbe& probe) {
   auto be = make_backend(backend, terrain, p);
   Simulation sim(terrain, p, std::move(be));
   const auto seq = sim.sequence();
@@ -165,6 +160,7 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
   std::vector<std::vector<double>> per_step(seq.size() + 2);
   const double dt = sim.next_dt();
   for (int rep = 0; rep < kRepetitions; ++rep) {
+    probe.round();
     // Each process alone, waited for; then the reduction the driver runs after each step.
     std::vector<double> total(seq.size() + 1, 0.0);
     for (long s = 0; s < steps; ++s) {
@@ -253,14 +249,17 @@ int bench(const BenchOptions& o) {
   }
   const Params params = bench_params(o);
   std::vector<Row> rows;
+  // Rounds of the bandwidth probe interleaved with the timed repetitions, and one at the end:
+  // the kernels and the probe see the same machine.
+  BandwidthProbe probe(static_cast<std::size_t>(o.stream_floats));
   for (const auto& [backend, threads] : runs) {
     Params p = params;
     p.numerics.threads = threads;
-    auto r = bench_one(terrain, p, backend, threads, o.steps);
+    auto r = bench_one(terrain, p, backend, threads, o.steps, probe);
     rows.insert(rows.end(), r.begin(), r.end());
   }
-  // The probe after the kernels, so its 3 arrays do not sit in memory during the runs.
-  const Bandwidth bw = measure_bandwidth(static_cast<std::size_t>(o.stream_floats));
+  probe.round();
+  const Bandwidth bw = probe.result();
   const bool small = bw.llc_bytes > 0 && o.stream_floats * sizeof(float) < 4 * bw.llc_bytes;
 
   const auto& g = terrain.grid;
@@ -273,12 +272,14 @@ int bench(const BenchOptions& o) {
     std::printf(
         " \"bandwidth\": {\"floats_per_array\": %ld, \"bytes_per_array\": %zu, "
         "\"last_level_cache_bytes\": %zu, \"below_4x_llc\": %s, \"repetitions\": %d, "
-        "\"threads\": %d, \"copy_gbs\": %s, \"triad_gbs\": %s, \"copy_gbs_1_thread\": %s, "
+        "\"rounds\": %d, \"threads\": %d, \"copy_gbs\": %s, \"copy_gbs_lowest_round\": %s, "
+        "\"copy_gbs_highest_round\": %s, \"triad_gbs\": %s, \"copy_gbs_1_thread\": %s, "
         "\"triad_gbs_1_thread\": %s},\n",
         o.stream_floats, static_cast<std::size_t>(o.stream_floats) * sizeof(float), bw.llc_bytes,
-        small ? "true" : "false", bw.repetitions, bw.threads, json_number(bw.copy_all).c_str(),
-        json_number(bw.triad_all).c_str(), json_number(bw.copy_one).c_str(),
-        json_number(bw.triad_one).c_str());
+        small ? "true" : "false", bw.repetitions, bw.rounds, bw.threads,
+        json_number(bw.copy_all).c_str(), json_number(bw.copy_all_low).c_str(),
+        json_number(bw.copy_all_high).c_str(), json_number(bw.triad_all).c_str(),
+        json_number(bw.copy_one).c_str(), json_number(bw.triad_one).c_str());
     std::printf(" \"results\": [\n");
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const auto& r = rows[k];
@@ -303,11 +304,13 @@ int bench(const BenchOptions& o) {
       terrain.source.c_str(), g.nx, g.ny, scheme_name(params.flow.scheme),
       scheme_name(params.transport.scheme), o.steps, kRepetitions);
   std::printf(
-      "memory bandwidth (median of %d, %.0f MiB per array%s): copy %.2f GB/s, triad %.2f GB/s "
-      "with %d thread%s; copy %.2f GB/s, triad %.2f GB/s with 1 thread\n",
-      bw.repetitions, o.stream_floats * 4.0 / (1024.0 * 1024.0),
-      small ? ", below 4x the last-level cache: cache-resident" : "", bw.copy_all, bw.triad_all,
-      bw.threads, bw.threads == 1 ? "" : "s", bw.copy_one, bw.triad_one);
+      "memory bandwidth (median of %d rounds of %d beside the runs, %.0f MiB per array%s): copy "
+      "%.2f GB/s (rounds %.1f to %.1f), triad %.2f GB/s with %d thread%s; copy %.2f GB/s, "
+      "triad %.2f GB/s with 1 thread\n",
+      bw.rounds, bw.repetitions, o.stream_floats * 4.0 / (1024.0 * 1024.0),
+      small ? ", below 4x the last-level cache: cache-resident" : "", bw.copy_all, bw.copy_all_low,
+      bw.copy_all_high, bw.triad_all, bw.threads, bw.threads == 1 ? "" : "s", bw.copy_one,
+      bw.triad_one);
   // Runs by a short label; their devices listed first.
   auto label = [](const Row& r) {
     return r.backend == "cpu" ? fmt::format("cpu/{}", r.threads ? std::to_string(r.threads) : "all")

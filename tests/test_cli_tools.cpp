@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -166,6 +167,17 @@ TEST_F(CliTools, BenchReportsRatesAndBandwidth) {
                           "\"fraction_of_copy\"", "\"fraction_of_triad\"", "\"process\": \"flow\"",
                           "\"process\": \"stats\"", "\"process\": \"full_step\""})
     EXPECT_TRUE(contains(r.output, key)) << key << "\n" << r.output;
+  // One probe round before each of the 3 repetitions of the one run, and one at the end; the
+  // median copy bandwidth lies between the lowest and the highest round.
+  EXPECT_TRUE(contains(r.output, "\"rounds\": 4,")) << r.output;
+  const auto number_after = [&r](const std::string& key) {
+    const auto at = r.output.find("\"" + key + "\": ");
+    return at == std::string::npos ? std::nan("") : std::stod(r.output.substr(at + key.size() + 4));
+  };
+  const double low = number_after("copy_gbs_lowest_round"), copy = number_after("copy_gbs"),
+               high = number_after("copy_gbs_highest_round");
+  std::printf("bench probe: copy %.1f GB/s, rounds %.1f to %.1f\n", copy, low, high);
+  EXPECT_TRUE(low > 0 && low <= copy && copy <= high) << low << " " << copy << " " << high;
   // The byte model of the benchmark scenario (local inertial, conservative transport).
   EXPECT_TRUE(contains(r.output, "\"process\": \"flow\", \"seconds_per_step\"")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 45,")) << r.output;
