@@ -16,6 +16,7 @@
 #include "erodem/io/results.hpp"
 #include "erodem/schema.hpp"
 #include "scenarios.hpp"
+#include "temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using erodem::ExitCode;
@@ -36,23 +37,6 @@ const char* kUtm33 =
 constexpr int kNx = 24, kNy = 20;
 constexpr double kCell = 10.0, kX0 = 500000.0, kY0 = 5200000.0;
 constexpr std::size_t kNodata = 3 * kNx + 5;  // an inactive cell
-
-/// A fresh temporary directory, removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() /
-           (std::string("erodem_results_") + info->test_suite_name() + "_" + info->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
 
 /// A small rainy run on a georeferenced (UTM 33N) bumpy grid with one nodata cell.
 erodem::Simulation small_run(long steps, long every) {
@@ -146,7 +130,7 @@ std::vector<std::vector<float>> write_run(const std::string& path, long steps, l
 }
 
 TEST(Results, WriteAndReadBack) {
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   const std::string path = dir.file("run.h5");
   auto sim = small_run(23, 5);
   ResultWriter w(path, sim, "erodem run test.toml", false);
@@ -241,7 +225,7 @@ TEST(Results, WriteAndReadBack) {
 
 TEST(Results, GeographicGridsUseLatLon) {
   using namespace erodem;
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   Terrain t = test::flat_terrain(8, 6, 100.0);
   t.grid.georef.transform = {10.0, 0.001, 0.0, 47.0, 0.0, -0.001};
   t.grid.georef.crs_wkt =
@@ -278,7 +262,7 @@ TEST(Results, GeographicGridsUseLatLon) {
 }
 
 TEST(Results, SnapshotsByInterval) {
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   auto sim = small_run(12, 100);
   auto p = sim.params();
   p.output.interval = 2.0;  // every 4 steps of 0.5 s
@@ -295,7 +279,7 @@ TEST(Results, SnapshotsByInterval) {
 }
 
 TEST(Results, PartialFileSurvivesWithoutFinish) {
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   const std::string path = dir.file("crash.h5");
   {
     auto sim = small_run(10, 3);
@@ -319,7 +303,7 @@ TEST(Results, PartialFileSurvivesWithoutFinish) {
 }
 
 TEST(Results, RefusesToOverwriteAndChecksTheFolder) {
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   const std::string path = dir.file("run.h5");
   std::ofstream(path) << "old";
   auto sim = small_run(2, 1);
@@ -346,7 +330,7 @@ TEST(Results, RefusesToOverwriteAndChecksTheFolder) {
 }
 
 TEST(Results, GaugeOutsideTheGridIsAConfigError) {
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   auto sim = small_run(2, 1);
   auto p = sim.params();
   p.output.gauges.push_back({kX0 - 5.0, kY0 - 5.0});
@@ -363,7 +347,7 @@ TEST(Results, GaugeOutsideTheGridIsAConfigError) {
 }
 
 TEST(Results, ReaderRejectsMissingAndForeignFiles) {
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   EXPECT_EQ(code_of([&] { ResultReader r(dir.file("none.h5")); }), ExitCode::no_input);
   std::ofstream(dir.file("text.h5")) << "not hdf5";
   EXPECT_EQ(code_of([&] { ResultReader r(dir.file("text.h5")); }), ExitCode::data);
@@ -376,7 +360,7 @@ TEST(Results, PythonAndGdalReadTheFile) {
     GTEST_SKIP() << "python3 cannot import h5py, xarray, h5netcdf and numpy (run "
                     "scripts/setup.sh): "
                  << probe.output;
-  TempDir dir;
+  erodem::test::TempDir dir("erodem_results_");
   const std::string path = dir.file("run.h5");
   const auto depths = write_run(path, 12, 4);  // snapshots at steps 0, 4, 8, 12
   ASSERT_EQ(depths.size(), 4u);

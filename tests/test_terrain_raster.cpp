@@ -17,6 +17,7 @@
 #include "erodem/io/raster.hpp"
 #include "erodem/params.hpp"
 #include "erodem/terrain_synth.hpp"
+#include "temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using erodem::ExitCode;
@@ -28,23 +29,6 @@ const std::string kShared = ERODEM_SHARED_DIR;
 const std::string kVolcano = kShared + "/data/dem/volcano/volcano_northup_10m.tif";
 const std::string kTujunga = kShared + "/data/dem/big_tujunga/srtm_bigtujunga30m_utm11.tif";
 const std::string kPuget = kShared + "/data/dem/puget_sound/ps_height_1k.png";
-
-/// A fresh temporary directory, removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() /
-           (std::string("erodem_test_") + info->test_suite_name() + "_" + info->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
 
 /// Runs `f` and returns the exit code of the erodem::Error it throws (fails if none).
 template <class F>
@@ -296,7 +280,7 @@ TEST(Raster, Sha256KnownVectors) {
 }
 
 TEST(Raster, GeoTiffRoundTrip) {
-  TempDir dir;
+  erodem::test::TempDir dir;
   // A projected grid with a real CRS and an odd origin.
   erodem::Grid g = erodem::Grid::uniform(37, 23, 30.0);
   g.georef.transform = {376313.655454263, 30.0, 0.0, 3807917.82762838, 0.0, -30.0};
@@ -381,7 +365,7 @@ TEST(Raster, GeoTiffRoundTrip) {
 }
 
 TEST(Raster, SyntheticTerrainRoundTripWithoutCrs) {
-  TempDir dir;
+  erodem::test::TempDir dir;
   erodem::Params::Dem sdem;
   sdem.synthetic = "lake";
   sdem.size = 33;
@@ -400,7 +384,7 @@ TEST(Raster, SyntheticTerrainRoundTripWithoutCrs) {
 }
 
 TEST(Raster, WriteFailures) {
-  TempDir dir;
+  erodem::test::TempDir dir;
   const erodem::Grid g = erodem::Grid::uniform(4, 3, 1.0);
   std::vector<float> v(12, 1.0f);
   EXPECT_EQ(code_of([&] { erodem::io::write_geotiff(dir.file("no/such/dir/x.tif"), g, v, "x"); }),
@@ -518,7 +502,7 @@ TEST(Raster, BigTujungaProjectedWithWindow) {
 TEST(Raster, NodataIsMasked) {
   // Big Tujunga declares nodata 32767 but has no such cell; write a copy of a window with
   // some nodata cells to check the masking path, with the same nodata value.
-  TempDir dir;
+  erodem::test::TempDir dir;
   erodem::Params::Dem dem;
   dem.path = kTujunga;
   dem.window = std::array<int, 4>{0, 0, 50, 40};
@@ -549,7 +533,7 @@ TEST(Raster, NodataIsMasked) {
 }
 
 TEST(Raster, MissingAndBadFiles) {
-  TempDir dir;
+  erodem::test::TempDir dir;
   erodem::Params::Dem dem;
   dem.path = dir.file("does_not_exist.tif");
   std::string msg;

@@ -14,6 +14,39 @@
 #include <utility>
 
 namespace erodem {
+
+std::string quoted_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -84,10 +117,8 @@ struct Where {
 };
 
 /// The value of a node as TOML text, for "got ..." in error messages.
-std::string quote(const std::string& s);
-
 std::string node_text(const toml::node& n) {
-  if (const auto str = n.value_exact<std::string>()) return quote(*str);
+  if (const auto str = n.value_exact<std::string>()) return quoted_string(*str);
   std::ostringstream os;
   n.visit([&os](auto&& v) { os << v; });
   return os.str();
@@ -227,38 +258,6 @@ void check_points(const std::vector<std::array<double, 2>>& pts, const Where& w)
 
 // ---- formatting for dump_toml -----------------------------------------------------------
 
-std::string quote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
 std::string format_pair(double a, double b) {
   return "[" + format_number(a) + ", " + format_number(b) + "]";
 }
@@ -354,7 +353,7 @@ Descriptor text(const char* key, Access access, const char* doc) {
   Descriptor d = base(key, access, "string", Dimension::dimensionless, "any string", doc);
   d.assign = [=](Params& p, const toml::node& n, const Where& w) { access(p) = read_string(n, w); };
   d.check = [](const Params&, const Where&) {};
-  d.format = [=](const Params& p) { return quote(access(p)); };
+  d.format = [=](const Params& p) { return quoted_string(access(p)); };
   return d;
 }
 
@@ -401,7 +400,7 @@ Descriptor choice(const char* key, Access access, Choices<T> choices, const char
     }
     throw w.fail("expected one of " + accepted);
   };
-  d.format = [=](const Params& p) { return quote(choice_name(choices, access(p))); };
+  d.format = [=](const Params& p) { return quoted_string(choice_name(choices, access(p))); };
   return d;
 }
 
@@ -448,7 +447,7 @@ Descriptor scalar_or_raster(const char* key, Access access, Dimension dim, Range
     if (!access(p).is_raster()) check_double(access(p).value, dim, range, w);
   };
   d.format = [=](const Params& p) {
-    return access(p).is_raster() ? quote(access(p).path) : format_number(access(p).value);
+    return access(p).is_raster() ? quoted_string(access(p).path) : format_number(access(p).value);
   };
   return d;
 }
@@ -509,7 +508,8 @@ Descriptor name_list(const char* key, Access access, std::vector<std::string> al
   d.check = [=](const Params& p, const Where& w) { check_names(access(p), w); };
   d.format = [=](const Params& p) {
     std::string out = "[";
-    for (size_t i = 0; i < access(p).size(); ++i) out += (i ? ", " : "") + quote(access(p)[i]);
+    for (size_t i = 0; i < access(p).size(); ++i)
+      out += (i ? ", " : "") + quoted_string(access(p)[i]);
     return out + "]";
   };
   return d;
@@ -613,7 +613,7 @@ Descriptor pipe_length_descriptor(const char* key, const char* doc) {
     check_double(p.flow.pipe_length, Dimension::length, at_least(0), w);
   };
   d.format = [](const Params& p) {
-    return p.flow.pipe_length == 0.0 ? quote("cell") : format_number(p.flow.pipe_length);
+    return p.flow.pipe_length == 0.0 ? quoted_string("cell") : format_number(p.flow.pipe_length);
   };
   return d;
 }

@@ -66,4 +66,8 @@ std::string closest_parameter_key(const std::string& key);
 /// True when the two parameter sets hold identical values (every schema key).
 bool params_equal(const Params& a, const Params& b);
 
+/// `s` in double quotes, with `"`, `\` and control characters escaped (\n, \t, \r, \uXXXX):
+/// a TOML basic string and a JSON string alike.
+std::string quoted_string(const std::string& s);
+
 }  // namespace erodem
