@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# erodem — regression guard for the OpenCL kernels on PoCL (ctest PoclVectorisation).
+#
+# PoCL runs a work-group as a loop over its work-items and vectorises that loop; a kernel it
+# does not vectorise runs several times slower, and small edits have done that: LLVM's SLP
+# pass packing a cell's four pipes into a vector first, a value kept across a barrier in
+# 64-bit (8 lanes -> 4), a load under a condition (a gather per iteration). Nothing but the
+# speed shows it, so this guard compiles the kernels of a small benchmark afresh with PoCL's
+# vectoriser remarks on, for both flow and both transport schemes, and counts the work-item
+# loops vectorised 8 wide (AVX2/AVX-512 devices; 16 lanes are not PoCL's choice there) and
+# 4 wide. Bounds: today's counts, where every cell kernel of a step is 8 wide and only the
+# double-precision reductions are 4 wide. A new kernel raises the first count; a kernel that
+# falls back lowers it. Exit 77 (skipped) without a PoCL CPU device or without remarks.
+# Usage: pocl_vectorisation.sh path/to/erodem
+set -euo pipefail
+erodem=$1
+if ! "$erodem" devices 2>/dev/null | grep -q "Portable Computing Language"; then
+  echo "no PoCL device: skipped"
+  exit 77
+fi
+cache=$(mktemp -d)
+trap 'rm -rf "$cache"' EXIT
+status=0
+# flow scheme, transport scheme, least loops 8 wide, most loops 4 wide
+while read -r flow transport least8 most4; do
+  remarks=$(POCL_CACHE_DIR="$cache/$flow-$transport" POCL_VECTORIZER_REMARKS=1 \
+    "$erodem" bench --size 64 --steps 1 --backends opencl --stream-floats 65536 \
+    --set flow.scheme="$flow" --set transport.scheme="$transport" 2>&1 | tr '<' '\n')
+  w8=$(grep -c "vectorization width: 8," <<<"$remarks" || true)
+  w4=$(grep -c "vectorization width: 4," <<<"$remarks" || true)
+  if ((w8 + w4 == 0)); then
+    echo "PoCL printed no vectoriser remarks (not an AVX2/AVX-512 device?): skipped"
+    exit 77
+  fi
+  verdict=ok
+  if ((w8 < least8 || w4 > most4)); then
+    verdict=FAILED
+    status=1
+  fi
+  printf '%-15s %-16s work-item loops 8 wide: %2d (bound >= %d), 4 wide: %d (bound <= %d): %s\n' \
+    "$flow" "$transport" "$w8" "$least8" "$w4" "$most4" "$verdict"
+done <<'TABLE'
+local_inertial conservative 36 6
+local_inertial semi_lagrangian 42 9
+pipes conservative 33 6
+pipes semi_lagrangian 39 9
+TABLE
+exit $status
