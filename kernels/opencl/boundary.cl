@@ -5,8 +5,9 @@
 
 /* One work-item per halo cell, corners excluded: ids [0, W-2) the north row, then the south
  * row, the west column and the east column (the cells the CPU loops visit). */
-__kernel void boundary_fill(int W, int H, __global const uchar* kind, __global real* bed,
-                            __global real* depth, real sea_level) {
+__kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
+                            __global real* restrict bed, __global real* restrict depth,
+                            real sea_level) {
   const int id = (int)get_global_id(0);
   const int nxi = W - 2, nyi = H - 2;
   int x, y;

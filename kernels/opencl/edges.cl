@@ -14,11 +14,12 @@
  * (m^3/s), ERODEM_TALLY_SEDIMENT the sediment carried out in dt (m^3; sediment and
  * depth_flow as the conservative transport reads them). Group g's sum goes to
  * partials[slot * stride + g]. */
-__kernel void edge_tallies(int W, __global const uchar* kind, __global const int* cells, int count,
-                           __global const real* f_left, __global const real* f_right,
-                           __global const real* f_top, __global const real* f_bottom,
-                           __global const real* sediment, __global const real* depth_flow, real dt,
-                           int slot, __global acc_t* partials, int stride) {
+__kernel void edge_tallies(
+    int W, __global const uchar* restrict kind, __global const int* restrict cells, int count,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global const real* restrict f_top, __global const real* restrict f_bottom,
+    __global const real* restrict sediment, __global const real* restrict depth_flow, real dt,
+    int slot, __global acc_t* restrict partials, int stride) {
   __local real s[ERODEM_CELL_GROUP_MAX];
   const int e = (int)get_global_id(0);
   real v = 0;

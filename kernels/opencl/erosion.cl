@@ -6,12 +6,15 @@
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch). Every work-item
  * computes (in the first and last column on neighbours across the row ends, inside the
  * buffer) and active cells keep the result: no per-work-item branch, so PoCL vectorises it. */
-__kernel void erosion(int W, int H, __global const uchar* kind, __global const real* bed,
-                      __global real* bed_out, __global real* sediment, __global const real* depth,
-                      __global const real* velocity_x, __global const real* velocity_y,
-                      __global const real* hardness, __global const real* dx,
-                      __global const real* dy, real dt, real capacity_k, real dissolving_rate,
-                      real deposition_rate, real min_tilt, real min_depth, real bedrock) {
+__kernel void erosion(int W, int H, __global const uchar* restrict kind,
+                      __global const real* restrict bed, __global real* restrict bed_out,
+                      __global real* restrict sediment, __global const real* restrict depth,
+                      __global const real* restrict velocity_x,
+                      __global const real* restrict velocity_y,
+                      __global const real* restrict hardness, __global const real* restrict dx,
+                      __global const real* restrict dy, real dt, real capacity_k,
+                      real dissolving_rate, real deposition_rate, real min_tilt, real min_depth,
+                      real bedrock) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;

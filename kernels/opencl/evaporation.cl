@@ -6,7 +6,8 @@
 
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
  * is rounded up, every work-item still reaches the group sum); ghosts keep their values.
- * `evaporate` is 0 when the rate is 0 (then only the wetness runs, as on the CPU). */
+ * `evaporate` is 0 when the rate is 0 (then only the wetness runs, as on the CPU). No
+ * `restrict` here, unlike the other kernels: PoCL ran this one slower with it (reduce.cl). */
 __kernel void evaporation(int W, int H, __global const uchar* kind, __global real* depth,
                           __global real* wetness, __global const real* area, real dt, real rate,
                           real tau, int evaporate, __global acc_t* partials, int stride) {

@@ -6,13 +6,14 @@
 /* One work-item per padded cell (where the global size is rounded up, the work-items past
  * the raster stop); the host runs flow_pipes_interior on rows 1 .. H - 2 and this one on rows
  * 0 and H - 1. */
-__kernel void flow_pipes(int W, int H, __global const uchar* kind, __global const real* bed,
-                         __global const real* depth, __global const real* dx,
-                         __global const real* dy, __global const real* area,
-                         __global const real* f_left, __global const real* f_right,
-                         __global const real* f_top, __global const real* f_bottom,
-                         __global real* out_left, __global real* out_right, __global real* out_top,
-                         __global real* out_bottom, real dt, real gravity, real pipe_area,
+__kernel void flow_pipes(int W, int H, __global const uchar* restrict kind,
+                         __global const real* restrict bed, __global const real* restrict depth,
+                         __global const real* restrict dx, __global const real* restrict dy,
+                         __global const real* restrict area, __global const real* restrict f_left,
+                         __global const real* restrict f_right, __global const real* restrict f_top,
+                         __global const real* restrict f_bottom, __global real* restrict out_left,
+                         __global real* restrict out_right, __global real* restrict out_top,
+                         __global real* restrict out_bottom, real dt, real gravity, real pipe_area,
                          real pipe_length) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
@@ -21,15 +22,15 @@ __kernel void flow_pipes(int W, int H, __global const uchar* kind, __global cons
 }
 
 /* The pipes scheme on rows 1 .. H - 2 (global offset 1): no clamping, no branches. */
-__kernel void flow_pipes_interior(int W, int H, __global const uchar* kind,
-                                  __global const real* bed, __global const real* depth,
-                                  __global const real* dx, __global const real* dy,
-                                  __global const real* area, __global const real* f_left,
-                                  __global const real* f_right, __global const real* f_top,
-                                  __global const real* f_bottom, __global real* out_left,
-                                  __global real* out_right, __global real* out_top,
-                                  __global real* out_bottom, real dt, real gravity, real pipe_area,
-                                  real pipe_length) {
+__kernel void flow_pipes_interior(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict dx,
+    __global const real* restrict dy, __global const real* restrict area,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global const real* restrict f_top, __global const real* restrict f_bottom,
+    __global real* restrict out_left, __global real* restrict out_right,
+    __global real* restrict out_top, __global real* restrict out_bottom, real dt, real gravity,
+    real pipe_area, real pipe_length) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   real lx, lt, lb;
@@ -44,14 +45,14 @@ __kernel void flow_pipes_interior(int W, int H, __global const uchar* kind,
  * last column and row have no face east / south: computed on what is there, stored as 0.
  * The host runs flow_local_inertial_faces_interior on rows 1 .. H - 3 (global offset 1) and
  * this one on the other rows. */
-__kernel void flow_local_inertial_faces(int W, int H, __global const uchar* kind,
-                                        __global const real* bed, __global const real* depth,
-                                        __global const real* manning, __global const real* dx,
-                                        __global const real* dy, __global const real* f_left,
-                                        __global const real* f_right, __global const real* f_top,
-                                        __global const real* f_bottom, __global real* face_x,
-                                        __global real* face_y, real dt, real gravity, real theta,
-                                        real dry_depth) {
+__kernel void flow_local_inertial_faces(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global const real* restrict f_top, __global const real* restrict f_bottom,
+    __global real* restrict face_x, __global real* restrict face_y, real dt, real gravity,
+    real theta, real dry_depth) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   const int i = x + y * W;
@@ -65,11 +66,13 @@ __kernel void flow_local_inertial_faces(int W, int H, __global const uchar* kind
 
 /* The face pass on rows 1 .. H - 3: no clamping, no branches but the column mask. */
 __kernel void flow_local_inertial_faces_interior(
-    int W, int H, __global const uchar* kind, __global const real* bed, __global const real* depth,
-    __global const real* manning, __global const real* dx, __global const real* dy,
-    __global const real* f_left, __global const real* f_right, __global const real* f_top,
-    __global const real* f_bottom, __global real* face_x, __global real* face_y, real dt,
-    real gravity, real theta, real dry_depth) {
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global const real* restrict f_top, __global const real* restrict f_bottom,
+    __global real* restrict face_x, __global real* restrict face_y, real dt, real gravity,
+    real theta, real dry_depth) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
@@ -83,12 +86,12 @@ __kernel void flow_local_inertial_faces_interior(
 /* Local inertial, cell pass: the four faces around each padded cell split into its
  * outflows (flow_local_inertial_cell); the host runs flow_local_inertial_split_interior on
  * rows 1 .. H - 2 and this one on rows 0 and H - 1. */
-__kernel void flow_local_inertial_split(int W, int H, __global const uchar* kind,
-                                        __global const real* depth, __global const real* area,
-                                        __global const real* face_x, __global const real* face_y,
-                                        __global real* out_left, __global real* out_right,
-                                        __global real* out_top, __global real* out_bottom,
-                                        real dt) {
+__kernel void flow_local_inertial_split(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict depth,
+    __global const real* restrict area, __global const real* restrict face_x,
+    __global const real* restrict face_y, __global real* restrict out_left,
+    __global real* restrict out_right, __global real* restrict out_top,
+    __global real* restrict out_bottom, real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   flow_local_inertial_cell(x, y, W, H, kind, depth, area, face_x, face_y, out_left, out_right,
@@ -97,9 +100,11 @@ __kernel void flow_local_inertial_split(int W, int H, __global const uchar* kind
 
 /* The cell pass on rows 1 .. H - 2. */
 __kernel void flow_local_inertial_split_interior(
-    int W, int H, __global const uchar* kind, __global const real* depth, __global const real* area,
-    __global const real* face_x, __global const real* face_y, __global real* out_left,
-    __global real* out_right, __global real* out_top, __global real* out_bottom, real dt) {
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict depth,
+    __global const real* restrict area, __global const real* restrict face_x,
+    __global const real* restrict face_y, __global real* restrict out_left,
+    __global real* restrict out_right, __global real* restrict out_top,
+    __global real* restrict out_bottom, real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   flow_local_inertial_cell_interior(x, y, W, kind, depth, area, face_x, face_y, out_left, out_right,

@@ -5,8 +5,9 @@
 
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep their
  * depth. */
-__kernel void sources_rain(int W, int H, __global const uchar* kind, __global real* depth,
-                           __global const real* rain_factor, real dt, real rate) {
+__kernel void sources_rain(int W, int H, __global const uchar* restrict kind,
+                           __global real* restrict depth, __global const real* restrict rain_factor,
+                           real dt, real rate) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
@@ -17,8 +18,8 @@ __kernel void sources_rain(int W, int H, __global const uchar* kind, __global re
 /* Point and line inflows, one work-item adding them in order (a cell may appear twice):
  * cells are padded indices, amounts the depth each adds (volume / area, rounded on the host
  * as the CPU reference rounds it). */
-__kernel void sources_points(__global real* depth, __global const int* cells,
-                             __global const real* amounts, int count) {
+__kernel void sources_points(__global real* restrict depth, __global const int* restrict cells,
+                             __global const real* restrict amounts, int count) {
   if (get_global_id(0) != 0) return;
   for (int k = 0; k < count; ++k) depth[cells[k]] += amounts[k];
 }

@@ -24,7 +24,8 @@ static inline void reduce_local_sum(__local acc_t* s) {
 /* The ledger's tallies of one step: group t sums slot t of the cell kernels' partials
  * (partials[t * groups + g], g < groups: the stride of the slots; see reduce.cl) into sums[t].
  * One group per slot. */
-__kernel void reduce_tallies(int groups, __global const acc_t* partials, __global acc_t* sums) {
+__kernel void reduce_tallies(int groups, __global const acc_t* restrict partials,
+                             __global acc_t* restrict sums) {
   __local acc_t s[ERODEM_REDUCE_MAX];
   const int l = (int)get_local_id(0), t = (int)get_group_id(0);
   __global const acc_t* p = partials + (long)t * groups;
@@ -37,9 +38,10 @@ __kernel void reduce_tallies(int groups, __global const acc_t* partials, __globa
 
 /* Sum over the active cells of (after - before) * area (the change of sum(s * area) by the
  * semi-Lagrangian transport). partials[group]. */
-__kernel void reduce_change(int W, int H, __global const uchar* kind, __global const real* after,
-                            __global const real* before, __global const real* area,
-                            __global acc_t* partials) {
+__kernel void reduce_change(int W, int H, __global const uchar* restrict kind,
+                            __global const real* restrict after,
+                            __global const real* restrict before,
+                            __global const real* restrict area, __global acc_t* restrict partials) {
   __local acc_t s[ERODEM_REDUCE_MAX];
   const int l = (int)get_local_id(0);
   const int n = W * H;
@@ -63,10 +65,13 @@ __kernel void reduce_change(int W, int H, __global const uchar* kind, __global c
  * per row. Each work-item stores its cell's values in local
  * memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
  * cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row. */
-__kernel void field_stats(int W, int H, __global const uchar* kind, __global const real* bed,
-                          __global const real* depth, __global const real* sediment,
-                          __global const real* velocity_x, __global const real* velocity_y,
-                          __global const real* area, __global acc_t* sums, __global long* cells) {
+__kernel void field_stats(int W, int H, __global const uchar* restrict kind,
+                          __global const real* restrict bed, __global const real* restrict depth,
+                          __global const real* restrict sediment,
+                          __global const real* restrict velocity_x,
+                          __global const real* restrict velocity_y,
+                          __global const real* restrict area, __global acc_t* restrict sums,
+                          __global long* restrict cells) {
   __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_s[ERODEM_CELL_GROUP_MAX],
       s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
   __local int s_state[ERODEM_CELL_GROUP_MAX];
@@ -180,10 +185,11 @@ __kernel void field_stats(int W, int H, __global const uchar* kind, __global con
  * max depth, max squared speed (-1: no candidate), the speed (m/s, hypot as on the CPU) of the
  * cell of the max squared speed; row_cells[3 r + k] as cells. One work-item per row, so the
  * host reads one result per row, not per group. */
-__kernel void stats_rows(int W, int rows, int groups_x, __global const acc_t* sums,
-                         __global const long* cells, __global const real* velocity_x,
-                         __global const real* velocity_y, __global acc_t* row_sums,
-                         __global long* row_cells) {
+__kernel void stats_rows(int W, int rows, int groups_x, __global const acc_t* restrict sums,
+                         __global const long* restrict cells,
+                         __global const real* restrict velocity_x,
+                         __global const real* restrict velocity_y,
+                         __global acc_t* restrict row_sums, __global long* restrict row_cells) {
   const int r = (int)get_global_id(0);
   if (r >= rows) return;
   acc_t water = 0, material = 0, sed = 0, max_d = -1, max_v = -1;

@@ -5,10 +5,10 @@
 
 /* Pass 1, one work-item per padded cell of rows 1 .. H - 2 (the host's launch); 0 for
  * ghosts. Branch-free over the row (see erosion.cl). */
-__kernel void thermal_share(int W, int H, __global const uchar* kind, __global const real* bed,
-                            __global const real* dx, __global const real* dy,
-                            __global const real* area, __global real* share, real dt, real rate,
-                            real tan_talus) {
+__kernel void thermal_share(int W, int H, __global const uchar* restrict kind,
+                            __global const real* restrict bed, __global const real* restrict dx,
+                            __global const real* restrict dy, __global const real* restrict area,
+                            __global real* restrict share, real dt, real rate, real tan_talus) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
@@ -18,10 +18,11 @@ __kernel void thermal_share(int W, int H, __global const uchar* kind, __global c
 
 /* Pass 2, one work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep
  * their bed. */
-__kernel void thermal_apply(int W, int H, __global const uchar* kind, __global const real* bed,
-                            __global const real* share, __global const real* dx,
-                            __global const real* dy, __global const real* area,
-                            __global real* bed_out, real tan_talus) {
+__kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
+                            __global const real* restrict bed, __global const real* restrict share,
+                            __global const real* restrict dx, __global const real* restrict dy,
+                            __global const real* restrict area, __global real* restrict bed_out,
+                            real tan_talus) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;

@@ -6,12 +6,12 @@
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep their
  * sediment. The sediment carried out of the domain is summed over the cells beside ghosts
  * only (edges.cl). */
-__kernel void transport_conservative(int W, int H, __global const uchar* kind,
-                                     __global const real* sediment, __global real* sediment_out,
-                                     __global const real* depth_flow, __global const real* f_left,
-                                     __global const real* f_right, __global const real* f_top,
-                                     __global const real* f_bottom, __global const real* area,
-                                     real dt) {
+__kernel void transport_conservative(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict sediment,
+    __global real* restrict sediment_out, __global const real* restrict depth_flow,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global const real* restrict f_top, __global const real* restrict f_bottom,
+    __global const real* restrict area, real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
@@ -22,11 +22,13 @@ __kernel void transport_conservative(int W, int H, __global const uchar* kind,
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */
-__kernel void transport_semi_lagrangian(int W, int H, __global const uchar* kind,
-                                        __global const real* sediment, __global real* sediment_out,
-                                        __global const real* velocity_x,
-                                        __global const real* velocity_y, __global const real* dx,
-                                        __global const real* dy, real dt) {
+__kernel void transport_semi_lagrangian(int W, int H, __global const uchar* restrict kind,
+                                        __global const real* restrict sediment,
+                                        __global real* restrict sediment_out,
+                                        __global const real* restrict velocity_x,
+                                        __global const real* restrict velocity_y,
+                                        __global const real* restrict dx,
+                                        __global const real* restrict dy, real dt) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;

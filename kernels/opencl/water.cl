@@ -9,13 +9,16 @@
  * is rounded up, every work-item still reaches the group sums). water_update_cell is
  * branch-free and keeps the ghosts' depth (the first and last column are ghosts; their
  * velocity is 0). */
-__kernel void water_update(int W, int H, __global const uchar* kind, __global const real* depth,
-                           __global real* depth_out, __global const real* f_left,
-                           __global const real* f_right, __global const real* f_top,
-                           __global const real* f_bottom, __global const real* dx,
-                           __global const real* dy, __global const real* area,
-                           __global real* velocity_x, __global real* velocity_y, real dt,
-                           real velocity_min_depth, __global acc_t* partials, int stride) {
+__kernel void water_update(int W, int H, __global const uchar* restrict kind,
+                           __global const real* restrict depth, __global real* restrict depth_out,
+                           __global const real* restrict f_left,
+                           __global const real* restrict f_right,
+                           __global const real* restrict f_top,
+                           __global const real* restrict f_bottom, __global const real* restrict dx,
+                           __global const real* restrict dy, __global const real* restrict area,
+                           __global real* restrict velocity_x, __global real* restrict velocity_y,
+                           real dt, real velocity_min_depth, __global acc_t* restrict partials,
+                           int stride) {
   __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real exchange, clipped = 0; /* exchange: edge_tallies (unused here, so not computed) */
