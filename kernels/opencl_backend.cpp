@@ -539,10 +539,10 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
   for (const char* name :
        {"sources_rain", "flow_pipes", "flow_pipes_interior", "flow_local_inertial_faces",
-        "flow_local_inertial_faces_interior", "flow_local_inertial_split",
-        "flow_local_inertial_split_interior", "water_update", "erosion", "transport_conservative",
-        "transport_semi_lagrangian", "thermal_share", "thermal_apply", "evaporation", "field_stats",
-        "edge_tallies"}) {
+        "flow_local_inertial_faces_x_interior", "flow_local_inertial_faces_y_interior",
+        "flow_local_inertial_split", "flow_local_inertial_split_interior", "water_update",
+        "erosion", "transport_conservative", "transport_semi_lagrangian", "thermal_share",
+        "thermal_apply", "evaporation", "field_stats", "edge_tallies"}) {
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
                                    &wg, nullptr),
@@ -818,10 +818,12 @@ void OpenClBackend::run_flow(Real dt) {
     // edge rows by the general ones. H >= 3.
     const Real theta = static_cast<Real>(f.theta),
                dry = static_cast<Real>(params_.numerics.dry_depth);
-    for (const char* name : {"flow_local_inertial_faces_interior", "flow_local_inertial_faces"})
+    for (const char* name : {"flow_local_inertial_faces_x_interior",
+                             "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
                flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, g, theta, dry);
-    launch_rows(kernel("flow_local_inertial_faces_interior"), 1, H_ - 2);
+    launch_rows(kernel("flow_local_inertial_faces_x_interior"), 1, H_ - 2);
+    launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
     launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
     launch_rows(kernel("flow_local_inertial_faces"), H_ - 2, H_);
     for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
