@@ -100,7 +100,7 @@ BandwidthProbe::BandwidthProbe(std::size_t floats, int repetitions)
       b_(new float[floats]),
       c_(new float[floats]) {
   const long n = static_cast<long>(floats);
-  float *pa = a_, *pb = b_, *pc = c_;
+  float *pa = a_.get(), *pb = b_.get(), *pc = c_.get();
   // Uninitialised storage, first touched by the threads that use it in the parallel runs.
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
@@ -110,16 +110,10 @@ BandwidthProbe::BandwidthProbe(std::size_t floats, int repetitions)
   }
 }
 
-BandwidthProbe::~BandwidthProbe() {
-  delete[] a_;
-  delete[] b_;
-  delete[] c_;
-}
-
 void BandwidthProbe::round() {
   Bandwidth bw;
   const long n = static_cast<long>(floats_);
-  float *pa = a_, *pb = b_, *pc = c_;
+  float *pa = a_.get(), *pb = b_.get(), *pc = c_.get();
   const float s = 3.0f;
   const double copy_bytes = 2.0 * sizeof(float) * static_cast<double>(n);
   const double triad_bytes = 3.0 * sizeof(float) * static_cast<double>(n);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace erodem::cli {
@@ -33,14 +34,13 @@ class BandwidthProbe {
   explicit BandwidthProbe(std::size_t floats, int repetitions = 5);
   BandwidthProbe(const BandwidthProbe&) = delete;
   BandwidthProbe& operator=(const BandwidthProbe&) = delete;
-  ~BandwidthProbe();
   void round();              ///< runs one round
   Bandwidth result() const;  ///< the medians over the rounds so far (at least one)
 
  private:
   std::size_t floats_;
   int repetitions_;
-  float *a_, *b_, *c_;
+  std::unique_ptr<float[]> a_, b_, c_;
   std::vector<Bandwidth> rounds_;
 };
 

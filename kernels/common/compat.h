@@ -93,7 +93,7 @@ ERODEM_BEGIN_NAMESPACE
  * defined (int -> float rounds to nearest, float -> int truncates), so every device gives
  * the same bits. */
 ERODEM_INLINE float cbrt_f32_guess(float x) {
-  const int bits = (int)erodem_float_bits(x); /* < 2^31 for x >= 0 */
+  const int bits = (int)erodem_float_bits(x); /* < 2^31 for x > 0 (not for -0: 0x80000000) */
   return erodem_bits_float((unsigned int)((int)((float)bits * 0.333333343f) + 709958130));
 }
 
