@@ -1,6 +1,7 @@
 // erodem — the float32 cube root shared by the CPU reference and the OpenCL kernels
-// (kernels/common/compat.h): its error against the exact root, over a sample of every
-// binade of positive floats, subnormals included (bound: 1 ulp), and its special cases.
+// (kernels/common/compat.h): its error against the exact root over a sample of every binade
+// of its range [1e-30, 1e38] (bound: 1 ulp), and the local-inertial face's floor that keeps
+// the root in that range and the friction term finite (kernels/common/flow.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,10 +10,16 @@
 #include <cstring>
 #include <limits>
 
-#include "common/compat.h"
+#include "common/flow.h"
 
 namespace erodem::test {
 namespace {
+
+std::uint32_t float_bits(float x) {
+  std::uint32_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+}
 
 float float_from_bits(std::uint32_t b) {
   float x;
@@ -28,21 +35,30 @@ double ulp_error(float x, float y) {
   return std::fabs(static_cast<double>(y) - exact) / ulp;
 }
 
-TEST(Cbrt, WithinOneUlpOverEveryBinade) {
-  // Every 61st bit pattern from the smallest subnormal to the largest float: 35 million
-  // values, all exponents, mantissas spread over each binade.
+TEST(Cbrt, WithinOneUlpOverEveryBinadeOfItsRange) {
+  // Every 61st bit pattern from 1e-30 to 1e38: 25 million values, mantissas spread over
+  // each binade, both ends included.
+  const auto lo = float_bits(ERODEM_CBRT_MIN), hi = float_bits(ERODEM_CBRT_MAX);
   double worst = 0;
   float worst_x = 0;
   std::uint64_t count = 0;
-  for (std::uint64_t b = 1; b <= 0x7f7fffffu; b += 61) {
-    const float x = float_from_bits(static_cast<std::uint32_t>(b));
+  auto check = [&](std::uint32_t b) {
+    const float x = float_from_bits(b);
     const double e = ulp_error(x, cell::cbrt_f32_positive(x));
     if (e > worst) worst = e, worst_x = x;
     ++count;
-  }
-  std::printf("cbrt_f32_positive: %llu values, max error %.3f ulp at x = %.9g (bound 1 ulp)\n",
-              static_cast<unsigned long long>(count), worst, static_cast<double>(worst_x));
+  };
+  for (std::uint32_t b = lo; b < hi; b += 61) check(b);
+  check(hi);
+  std::printf(
+      "cbrt_f32_positive: %llu values in [%g, %g], max error %.3f ulp at x = %.9g "
+      "(bound 1 ulp)\n",
+      static_cast<unsigned long long>(count), static_cast<double>(ERODEM_CBRT_MIN),
+      static_cast<double>(ERODEM_CBRT_MAX), worst, static_cast<double>(worst_x));
   EXPECT_LE(worst, 1.0);
+  EXPECT_TRUE(std::isnan(cell::cbrt_f32_positive(std::nanf(""))));
+  EXPECT_EQ(cell::cbrt_f32_positive(27.0f), 3.0f);
+  EXPECT_EQ(cell::cbrt_f32_positive(0.125f), 0.5f);
 }
 
 TEST(Cbrt, FirstGuessWithinItsBound) {
@@ -57,20 +73,33 @@ TEST(Cbrt, FirstGuessWithinItsBound) {
   EXPECT_LE(worst, 0.033);
 }
 
-TEST(Cbrt, SpecialValuesAndSign) {
-  const float inf = std::numeric_limits<float>::infinity();
-  EXPECT_EQ(cell::cbrt_f32(0.0f), 0.0f);
-  EXPECT_TRUE(std::signbit(cell::cbrt_f32(-0.0f)));
-  EXPECT_EQ(cell::cbrt_f32(inf), inf);
-  EXPECT_EQ(cell::cbrt_f32(-inf), -inf);
-  EXPECT_TRUE(std::isnan(cell::cbrt_f32(std::nanf(""))));
-  EXPECT_TRUE(std::isnan(cell::cbrt_f32_positive(std::nanf(""))));
-  EXPECT_EQ(cell::cbrt_f32(27.0f), 3.0f);
-  EXPECT_EQ(cell::cbrt_f32(-8.0f), -2.0f);
-  EXPECT_EQ(cell::cbrt_f32(-5.0f), -cell::cbrt_f32(5.0f));
-  std::printf("cbrt_f32(27) = %.9g, cbrt_f32(-8) = %.9g\n",
-              static_cast<double>(cell::cbrt_f32(27.0f)),
-              static_cast<double>(cell::cbrt_f32(-8.0f)));
+// A face whose flow depth h_f is at or below ERODEM_FACE_DEPTH_MIN is dry even with
+// dry_depth = 0; just above it, the friction term stays finite with q = 0 (before the floor,
+// h_f = 1e-20 m gave h_f^(7/3) = 0 in float and q_new = NaN from 0 / 0).
+TEST(Cbrt, FaceDepthFloorKeepsTheFrictionTermFinite) {
+  const float g = 9.81f, dt = 1.0f, n = 0.03f, dist = 10.0f, theta = 0.7f, dry_depth = 0.0f;
+  auto q_new = [&](float h, float q) {  // a face over a flat bed at 0 with a surface drop
+    return cell::local_inertial_q(q, q, q, h, 0.5f * h, 0.0f, 0.0f, n, dist, dt, g, theta,
+                                  dry_depth);
+  };
+  int checked = 0;
+  for (float h : {1e-30f, 1e-20f, 1e-17f, ERODEM_FACE_DEPTH_MIN}) {
+    EXPECT_EQ(q_new(h, 0.0f), 0.0f) << "h_f = " << h;
+    EXPECT_EQ(q_new(h, 1e-3f), 0.0f) << "h_f = " << h;
+    ++checked;
+  }
+  float largest = 0;
+  for (float h = std::nextafter(ERODEM_FACE_DEPTH_MIN, 1.0f); h < 1e3f; h *= 3.7f)
+    for (float q : {0.0f, 1e-30f, 1e-3f, 1.0f, -5.0f}) {
+      const float r = q_new(h, q);
+      EXPECT_TRUE(std::isfinite(r)) << "h_f = " << h << ", q = " << q;
+      largest = std::fmax(largest, std::fabs(r));
+      ++checked;
+    }
+  std::printf(
+      "local_inertial_q with dry_depth = 0: %d faces, dry at or below %g m, finite "
+      "above (largest |q_new| %.4g m^2/s)\n",
+      checked, static_cast<double>(ERODEM_FACE_DEPTH_MIN), static_cast<double>(largest));
 }
 
 }  // namespace

@@ -168,6 +168,13 @@ ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_k
  * faces at a time; the OpenCL kernels (kernels/opencl/flow.cl) a face pass and a cell pass.
  * Both evaluate the same expressions on the same numbers, so they agree bit for bit. */
 
+/* Flow depth (m) at or below which a face is dry whatever numerics.dry_depth says: from
+ * here up h_f^(7/3) is a normal float (1e-16^(7/3) = 4.6e-38), so the friction term
+ * |q| / h_f^(7/3) is never 0 / 0, and h_f lies in the range of erodem_cbrt_positive. A
+ * film this thin (a millionth of an atom) carries nothing that a float can tell apart
+ * from 0. */
+#define ERODEM_FACE_DEPTH_MIN 1.0e-16f
+
 /* Discharge per unit width (m^2/s) across a face at the old time, from the outflow of the
  * cell before it towards the cell after it, out_ab, the outflow back, out_ba (m^3/s), and
  * the face width (m). */
@@ -181,17 +188,21 @@ ERODEM_FN real face_unit_discharge(real out_ab, real out_ba, real width) {
  * q, q_up, q_down: this face and its two neighbours in the same direction at the old time
  * (m^2/s); eta, b: water surface and bed of both cells (m); n: Manning n of the face
  * (s m^-1/3); dist between cell centres (m); dt (s); gravity (m/s^2); theta in [0, 1];
- * faces with h_f <= dry_depth (m) carry nothing. Branch-free: a dry face is evaluated on
- * h_f = 1 and its result replaced by 0. */
+ * faces with h_f <= dry_depth (m), or h_f <= ERODEM_FACE_DEPTH_MIN whatever dry_depth is,
+ * carry nothing. Branch-free: a dry face is evaluated on h_f = 1 and its result replaced
+ * by 0. */
 ERODEM_FN real local_inertial_q(real q, real q_up, real q_down, real eta_a, real eta_b, real b_a,
                                 real b_b, real n, real dist, real dt, real gravity, real theta,
                                 real dry_depth) {
   const real h_raw = (eta_a > eta_b ? eta_a : eta_b) - (b_a > b_b ? b_a : b_b);
-  const int wet = h_raw > dry_depth;
+  /* one threshold, the same for every face (hoisted out of the cell loops) */
+  const real wet_above =
+      dry_depth > (real)ERODEM_FACE_DEPTH_MIN ? dry_depth : (real)ERODEM_FACE_DEPTH_MIN;
+  const int wet = h_raw > wet_above;
   const real h_f = wet ? h_raw : (real)1;
   const real numerator = theta * q + ((real)1 - theta) * (real)0.5 * (q_up + q_down) -
                          gravity * h_f * dt * (eta_b - eta_a) / dist;
-  const real h_f_7_3 = h_f * h_f * erodem_cbrt_positive(h_f); /* h_f > 0 */
+  const real h_f_7_3 = h_f * h_f * erodem_cbrt_positive(h_f); /* normal, > 0 */
   const real denominator = (real)1 + gravity * dt * n * n * fabs(q) / h_f_7_3;
   const real q_new = numerator / denominator;
   return wet ? q_new : (real)0;
