@@ -56,47 +56,15 @@ __kernel void reduce_change(int W, int H, __global const uchar* restrict kind,
   if (l == 0) partials[get_group_id(0)] = s[0];
 }
 
-/* The field statistics over the active cells: a cell kernel over rows 1 .. H - 2 (the host's
- * launch), one work-item per padded cell, work-groups of (L, 1) inside one row (L <=
- * ERODEM_CELL_GROUP_MAX), g = group x + (y - 1) * groups per row. Per group: sums[5 g + k] =
- * water, material, sediment volume, max depth, max squared speed (-1 where the group has no
- * candidate); cells[3 g + k] = the DEM cell (row * nx + col) of the max depth, of the max
- * speed, and the first cell whose state is not physical (-1: none). stats_rows combines them
- * per row. Each work-item stores its cell's values in local
- * memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
- * cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row. */
-__kernel void field_stats(int W, int H, __global const uchar* restrict kind,
-                          __global const real* restrict bed, __global const real* restrict depth,
-                          __global const real* restrict sediment,
-                          __global const real* restrict velocity_x,
-                          __global const real* restrict velocity_y,
-                          __global const real* restrict area, __global acc_t* restrict sums,
-                          __global long* restrict cells) {
-  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_s[ERODEM_CELL_GROUP_MAX],
-      s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
-  __local int s_state[ERODEM_CELL_GROUP_MAX];
-  const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
-  const int n = (int)get_local_size(0);
-  /* work-items past the row (rounded global sizes only) read the row's first cell */
-  const int i = ERODEM_PAST_ROW(x, W) ? y * W : x + y * W;
-  const int active =
-      !ERODEM_PAST_ROW(x, W) & (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-  const real d = depth[i], b = bed[i], sd = sediment[i];
-  /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
-  s_d[l] = active ? d : (real)0;
-  s_b[l] = active ? b : (real)0;
-  s_s[l] = active ? sd : (real)0;
-  s_u[l] = active ? velocity_x[i] : (real)0;
-  s_v[l] = active ? velocity_y[i] : (real)0;
-  s_state[l] = active ? (cell_state_ok(b, d, sd) ? 1 : 2) : 0; /* 0 ghost, 1 ok, 2 not physical */
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (get_local_id(0) != 0) return;
-  /* The group's row and first column from the group's ids, not from x and y: PoCL keeps every
-   * work-item's values that are used after a barrier in per-work-item storage, and a 64-bit
-   * one (a global id) halves the vector width of the whole kernel (8 -> 4 lanes on AVX2/512:
-   * 25 ms -> 21 ms at 4096^2). */
-  const int row = (int)(get_group_id(1) + get_global_offset(1));
-  const int x0 = (int)(get_group_id(0) * get_local_size(0) + get_global_offset(0));
+/* The part of field_stats that one work-item does for its group, once the cells' values are
+ * in local memory: the group of n work-items starts at column x0 of padded row `row` and
+ * writes partial g (see field_stats). ERODEM_GROUP_ONCE: see reduce.cl. */
+ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
+                                         __local const real* s_d, __local const real* s_b,
+                                         __local const real* s_s, __local const real* s_u,
+                                         __local const real* s_v, __local const int* s_state,
+                                         __global const real* area, __global acc_t* sums,
+                                         __global long* cells) {
   const int last = min(n, W - x0); /* work-items inside the row */
   const acc_t a = (acc_t)area[row];
   const long row_cell = (long)(row - 1) * (long)(W - 2) - 1 + (long)x0; /* cell of local id 0 */
@@ -167,7 +135,6 @@ __kernel void field_stats(int W, int H, __global const uchar* restrict kind,
       arg_v = row_cell + k;
     }
   }
-  const int g = (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
   sums[5 * g + 0] = water * a;
   sums[5 * g + 1] = (bed_sum + sed) * a;
   sums[5 * g + 2] = sed * a;
@@ -176,6 +143,52 @@ __kernel void field_stats(int W, int H, __global const uchar* restrict kind,
   cells[3 * g + 0] = arg_d;
   cells[3 * g + 1] = arg_v;
   cells[3 * g + 2] = bad;
+}
+
+/* The field statistics over the active cells: a cell kernel over rows 1 .. H - 2 (the host's
+ * launch), one work-item per padded cell, work-groups of (L, 1) inside one row (L <=
+ * ERODEM_CELL_GROUP_MAX), g = group x + (y - 1) * groups per row. Per group: sums[5 g + k] =
+ * water, material, sediment volume, max depth, max squared speed (-1 where the group has no
+ * candidate); cells[3 g + k] = the DEM cell (row * nx + col) of the max depth, of the max
+ * speed, and the first cell whose state is not physical (-1: none). stats_rows combines them
+ * per row. Each work-item stores its cell's values in local
+ * memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
+ * cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row
+ * (field_stats_group). */
+__kernel void field_stats(int W, int H, __global const uchar* restrict kind,
+                          __global const real* restrict bed, __global const real* restrict depth,
+                          __global const real* restrict sediment,
+                          __global const real* restrict velocity_x,
+                          __global const real* restrict velocity_y,
+                          __global const real* restrict area, __global acc_t* restrict sums,
+                          __global long* restrict cells) {
+  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_s[ERODEM_CELL_GROUP_MAX],
+      s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
+  __local int s_state[ERODEM_CELL_GROUP_MAX];
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
+  /* work-items past the row (rounded global sizes only) read the row's first cell */
+  const int i = ERODEM_PAST_ROW(x, W) ? y * W : x + y * W;
+  const int active =
+      !ERODEM_PAST_ROW(x, W) & (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  const real d = depth[i], b = bed[i], sd = sediment[i];
+  /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
+  s_d[l] = active ? d : (real)0;
+  s_b[l] = active ? b : (real)0;
+  s_s[l] = active ? sd : (real)0;
+  s_u[l] = active ? velocity_x[i] : (real)0;
+  s_v[l] = active ? velocity_y[i] : (real)0;
+  s_state[l] = active ? (cell_state_ok(b, d, sd) ? 1 : 2) : 0; /* 0 ghost, 1 ok, 2 not physical */
+  barrier(CLK_LOCAL_MEM_FENCE);
+  /* The group's row and first column from the group's ids, not from x and y: PoCL keeps every
+   * work-item's values that are used after a barrier in per-work-item storage, and a 64-bit
+   * one (a global id) halves the vector width of the whole kernel (8 -> 4 lanes on AVX2/512:
+   * 25 ms -> 21 ms at 4096^2). */
+  if (get_local_id(0) == 0)
+    field_stats_group(W, (int)(get_group_id(1) + get_global_offset(1)),
+                      (int)(get_group_id(0) * get_local_size(0) + get_global_offset(0)),
+                      (int)get_local_size(0),
+                      (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0), s_d,
+                      s_b, s_s, s_u, s_v, s_state, area, sums, cells);
 }
 
 /* The statistics of each padded row 1 .. H - 2 (r = y - 1 < rows) from the groups_x partials
