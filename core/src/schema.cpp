@@ -840,8 +840,9 @@ const std::vector<Descriptor>& descriptor_table() {
       choice(ERODEM_FIELD(numerics.precision),
              Choices<Precision>{{"float32", Precision::float32}, {"float64", Precision::float64}},
              "floating-point precision of the CPU reference: float32 or float64"),
-      number(ERODEM_FIELD(numerics.dry_depth), D::length, at_least(0),
-             "local_inertial: faces shallower than this carry no flow (m)"),
+      number(
+          ERODEM_FIELD(numerics.dry_depth), D::length, at_least(0),
+          "local_inertial: faces shallower than this carry no flow (m); below 1e-16 m none does"),
       number(ERODEM_FIELD(numerics.velocity_min_depth), D::length, at_least(0),
              "velocity is 0 below this mean depth d_min (m)"),
       number(ERODEM_FIELD(numerics.wetness_time), D::time, above(0),
