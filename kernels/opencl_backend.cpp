@@ -392,6 +392,8 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
   rt->fp64 = chosen->info.fp64;
   rt->whole_rows = whole_rows;
   rt->max_work_group = device_value<std::size_t>(rt->device, CL_DEVICE_MAX_WORK_GROUP_SIZE);
+  rt->base_align = std::max<std::size_t>(
+      1, device_value<cl_uint>(rt->device, CL_DEVICE_MEM_BASE_ADDR_ALIGN) / 8);
   const cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
                                          reinterpret_cast<cl_context_properties>(rt->platform), 0};
   cl_int err = CL_SUCCESS;
@@ -594,12 +596,40 @@ std::string OpenClBackend::device() const {
   return rt_->info.platform + " / " + rt_->info.device;
 }
 
+// Field buffers start at different offsets modulo 4 KiB. A device allocates its buffers at the
+// same offset modulo the page (PoCL: all of them), so cell i of every field falls into the
+// same set of a CPU's L1 cache (4 KiB per way) and the same L2 sets; a cell kernel that reads
+// eight fields at rows y - 1 .. y + 2 then asks one set for more lines than it has ways. Each
+// field buffer is therefore a sub-buffer whose origin is slot k * kStaggerStep modulo 4 KiB
+// (rounded to the device's base alignment) of a parent 4 KiB longer. PoCL at 4096^2, the
+// kernels alone, medians of 12 runs alternating: local-inertial south faces 26.5 -> 21.1 ms,
+// conservative transport 23.6 -> 19.3 ms, the others 0 to 2 ms faster.
+constexpr std::size_t kStaggerMin = 64 * 1024, kStaggerPeriod = 4096, kStaggerStep = 1152;
+
 Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
   cl_int err = CL_SUCCESS;
-  const cl_mem_flags flags = CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0);
-  Buffer b(clCreateBuffer(rt_->context.get(), flags, std::max<std::size_t>(bytes, 1),
-                          const_cast<void*>(data), &err));
+  bytes = std::max<std::size_t>(bytes, 1);
+  const std::size_t align = rt_->base_align;
+  if (bytes < kStaggerMin || align >= kStaggerPeriod) {
+    const cl_mem_flags flags = CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0);
+    Buffer b(clCreateBuffer(rt_->context.get(), flags, bytes, const_cast<void*>(data), &err));
+    check(err, "clCreateBuffer");
+    return b;
+  }
+  // Slots k * 1152 modulo 4096 in units of the alignment: 9 k modulo 32 with PoCL's 128
+  // bytes, all 32 slots distinct before one repeats.
+  const std::size_t offset = (stagger_next_++ * kStaggerStep) % kStaggerPeriod / align * align;
+  Buffer parent(
+      clCreateBuffer(rt_->context.get(), CL_MEM_READ_WRITE, bytes + kStaggerPeriod, nullptr, &err));
   check(err, "clCreateBuffer");
+  const cl_buffer_region region{offset, bytes};
+  // The sub-buffer keeps its parent alive (OpenCL 1.2, clReleaseMemObject).
+  Buffer b(clCreateSubBuffer(parent.get(), CL_MEM_READ_WRITE, CL_BUFFER_CREATE_TYPE_REGION, &region,
+                             &err));
+  check(err, "clCreateSubBuffer");
+  if (data)
+    check(clEnqueueWriteBuffer(queue_.get(), b.get(), CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+          "clEnqueueWriteBuffer");
   return b;
 }
 

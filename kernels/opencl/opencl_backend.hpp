@@ -94,6 +94,8 @@ struct Runtime {
   Program program;
   bool fp64 = false;
   std::size_t max_work_group = 1;
+  /// CL_DEVICE_MEM_BASE_ADDR_ALIGN in bytes: the alignment of a sub-buffer's origin.
+  std::size_t base_align = 4096;
   /// Built for launches of whole rows (ERODEM_WHOLE_ROWS: every cell kernel's local size
   /// divides the row; the kernels then need no per-work-item bound check).
   bool whole_rows = false;
@@ -138,6 +140,9 @@ class OpenClBackend final : public Backend {
   void run_thermal(Real dt);
   void run_evaporation(Real dt, StepTally& tally);
 
+  /// A device buffer of `bytes`, filled from `data` where given. A buffer of a field (at
+  /// least kStaggerMin bytes) starts at its own offset modulo 4 KiB (stagger_next_): see
+  /// make_buffer.
   Buffer make_buffer(std::size_t bytes, const void* data = nullptr);
   template <class T>
   Buffer upload(const std::vector<T>& v) {
@@ -189,6 +194,7 @@ class OpenClBackend final : public Backend {
   Buffer edge_cells_;
   std::size_t edge_count_ = 0, edge_local_ = 1, edge_groups_ = 1;
   std::size_t tally_stride_ = 1;   // partials per tally slot: >= every tally kernel's groups
+  std::size_t stagger_next_ = 0;   // make_buffer: the next field buffer's slot
   std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
   Buffer kind_, dx_, dy_, area_;
   Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;
