@@ -33,13 +33,14 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   threads_ = 1;
 #endif
   auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
+  auto to_field = [](const std::vector<double>& v) { return Field(v.begin(), v.end()); };
   const std::size_t n = s.size();
   kind_ = s.kind;
   dx_ = to_real(s.dx);
   dy_ = to_real(s.dy);
   area_ = to_real(s.area);
-  bed_ = to_real(s.bed);
-  depth_ = to_real(s.depth);
+  bed_ = to_field(s.bed);
+  depth_ = to_field(s.depth);
   bed_next_ = bed_;
   bed0_ = bed_;
   depth_next_ = depth_;
@@ -53,9 +54,9 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   velocity_y_.assign(n, Real(0));
   thermal_share_.assign(n, Real(0));
   wetness_ = depth_;
-  manning_ = to_real(s.manning);
-  hardness_ = to_real(s.hardness);
-  rain_factor_ = to_real(s.rain_factor);
+  manning_ = to_field(s.manning);
+  hardness_ = to_field(s.hardness);
+  rain_factor_ = to_field(s.rain_factor);
   row_sums_a_.assign(H_, 0.0);
   row_sums_b_.assign(H_, 0.0);
   run_boundary();
@@ -177,7 +178,7 @@ FieldStats CpuBackend<Real>::stats() {
 }
 
 template <class Real>
-std::vector<Real>* CpuBackend<Real>::field_storage(FieldId id) {
+typename CpuBackend<Real>::Field* CpuBackend<Real>::field_storage(FieldId id) {
   switch (id) {
     case FieldId::bed:
       return &bed_;
@@ -215,7 +216,7 @@ template <class Real>
 std::vector<double> CpuBackend<Real>::field(FieldId id) const {
   std::vector<double> out(static_cast<std::size_t>(nx_) * ny_);
   auto* self = const_cast<CpuBackend*>(this);
-  const std::vector<Real>* src = self->field_storage(id);
+  const Field* src = self->field_storage(id);
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, r + 1);
@@ -231,13 +232,13 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
   if (values.size() != static_cast<std::size_t>(nx_) * ny_)
     throw Error(ExitCode::data, fmt::format("field '{}': {} values for a grid of {} x {}",
                                             field_info(id).name, values.size(), nx_, ny_));
-  std::vector<Real>* dst = field_storage(id);
+  Field* dst = field_storage(id);
   if (!dst) throw Error(ExitCode::usage, "field 'erosion' is derived and cannot be set");
   // Fields kept in two buffers get both, so the next step starts from the new values.
-  std::vector<Real>* twin = id == FieldId::bed           ? &bed_next_
-                            : id == FieldId::water_depth ? &depth_next_
-                            : id == FieldId::sediment    ? &sediment_next_
-                                                         : nullptr;
+  Field* twin = id == FieldId::bed           ? &bed_next_
+                : id == FieldId::water_depth ? &depth_next_
+                : id == FieldId::sediment    ? &sediment_next_
+                                             : nullptr;
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, r + 1);
@@ -249,7 +250,7 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
 
 template <class Real>
 HostView CpuBackend<Real>::host_view(FieldId id) {
-  std::vector<Real>* src = field_storage(id);
+  Field* src = field_storage(id);
   if (!src) return {};
   return {src->data() + at(1, 1), sizeof(Real), static_cast<std::ptrdiff_t>(W_)};
 }

@@ -16,6 +16,7 @@
 #include "erodem/backend.hpp"
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
+#include "stagger.hpp"
 
 /// Before a cell loop whose iterations write only their own cells: tells GCC that the
 /// output arrays do not overlap the inputs, so it vectorises without alias checks.
@@ -99,20 +100,22 @@ class CpuBackend final : public Backend {
   static std::unique_ptr<Real[]> row_scratch(int n) {
     return std::unique_ptr<Real[]>(new Real[static_cast<std::size_t>(n)]());
   }
-  std::vector<Real>* field_storage(FieldId id);
+  /// A per-cell field: each array at its own offset modulo 4 KiB (stagger.hpp).
+  using Field = std::vector<Real, StaggeredAllocator<Real>>;
+  Field* field_storage(FieldId id);
 
   Params params_;
   int nx_, ny_, W_, H_;
   int threads_;
   std::vector<Kind> kind_;
   std::vector<Real> dx_, dy_, area_;  // per padded row
-  std::vector<Real> bed_, bed_next_, bed0_;
-  std::vector<Real> depth_, depth_next_;  // after `water`, depth_next_ holds the depth the
-                                          // flow step saw (used by conservative transport)
-  std::vector<Real> sediment_, sediment_next_;
-  std::array<std::vector<Real>, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
-  std::vector<Real> velocity_x_, velocity_y_;
-  std::vector<Real> hardness_, manning_, wetness_, rain_factor_, thermal_share_;
+  Field bed_, bed_next_, bed0_;
+  Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the
+                              // flow step saw (used by conservative transport)
+  Field sediment_, sediment_next_;
+  std::array<Field, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
+  Field velocity_x_, velocity_y_;
+  Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   std::vector<double> row_sums_a_, row_sums_b_;  // scratch for per-row reductions
 };
 

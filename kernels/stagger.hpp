@@ -1,0 +1,74 @@
+// erodem — field arrays that start at different offsets modulo 4 KiB, for both backends.
+//
+// An allocator hands out large arrays at the same offset modulo the page (glibc's mmap'd
+// blocks, PoCL's buffers), so cell i of every field falls into the same set of a CPU's L1
+// cache (4 KiB per way) and into the same L2 sets. A cell loop that reads eight fields, some
+// of them at rows y - 1 .. y + 2, then asks one set for more lines than it has ways, and the
+// lines evict each other. Starting field k at offset k * 1152 modulo 4096 spreads them: with
+// the 128-byte steps PoCL's sub-buffers allow, 32 fields before two share an offset.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <new>
+#include <type_traits>
+
+namespace erodem {
+
+inline constexpr std::size_t kStaggerPeriod = 4096;    ///< bytes: the L1 way size
+inline constexpr std::size_t kStaggerStep = 1152;      ///< bytes: 9 x 128, odd in 128-byte units
+inline constexpr std::size_t kStaggerMin = 64 * 1024;  ///< bytes: smaller arrays stay as they are
+
+/// The offset (bytes, < kStaggerPeriod) of the array in slot `slot`, rounded down to a
+/// multiple of `align` (a power of two; 0 when align >= kStaggerPeriod).
+constexpr std::size_t stagger_offset(std::size_t slot, std::size_t align) {
+  return align >= kStaggerPeriod ? 0 : (slot * kStaggerStep) % kStaggerPeriod / align * align;
+}
+
+/// std::allocator for the CPU reference's fields: arrays of at least kStaggerMin bytes come
+/// from a 4 KiB-aligned block kStaggerPeriod bytes longer, at the next slot's offset (one
+/// process-wide counter); smaller ones from operator new. The offset is the address modulo
+/// 4 KiB, so deallocate finds the block without a header.
+template <class T>
+struct StaggeredAllocator {
+  using value_type = T;
+  using is_always_equal = std::true_type;
+  using propagate_on_container_move_assignment = std::true_type;
+
+  StaggeredAllocator() noexcept = default;
+  template <class U>
+  StaggeredAllocator(const StaggeredAllocator<U>&) noexcept {}
+
+  T* allocate(std::size_t n) {
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < kStaggerMin) return static_cast<T*>(::operator new(bytes));
+    static std::atomic<std::size_t> next{0};
+    const std::size_t offset =
+        stagger_offset(next.fetch_add(1, std::memory_order_relaxed), alignof(std::max_align_t));
+    auto* block = static_cast<unsigned char*>(
+        ::operator new (bytes + kStaggerPeriod, std::align_val_t{kStaggerPeriod}));
+    return reinterpret_cast<T*>(block + offset);
+  }
+
+  void deallocate(T* p, std::size_t n) noexcept {
+    if (n * sizeof(T) < kStaggerMin) {
+      ::operator delete(p);
+      return;
+    }
+    const auto address = reinterpret_cast<std::uintptr_t>(p);
+    ::operator delete (reinterpret_cast<void*>(address - address % kStaggerPeriod),
+                       std::align_val_t{kStaggerPeriod});
+  }
+
+  template <class U>
+  bool operator==(const StaggeredAllocator<U>&) const noexcept {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const StaggeredAllocator<U>&) const noexcept {
+    return false;
+  }
+};
+
+}  // namespace erodem
