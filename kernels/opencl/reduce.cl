@@ -19,12 +19,16 @@
 #ifdef ERODEM_HAVE_FP64
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double acc_t;
+typedef double2 acc2_t;
+typedef double4 acc4_t;
 typedef double8 acc8_t;
 typedef long8 acc8_mask_t; /* what comparing two acc8_t gives */
 #define convert_acc8 convert_double8
 #define convert_acc8_mask convert_long8
 #else
 typedef float acc_t;
+typedef float2 acc2_t;
+typedef float4 acc4_t;
 typedef float8 acc8_t;
 typedef int8 acc8_mask_t;
 #define convert_acc8 convert_float8
@@ -71,18 +75,23 @@ static inline int cell_group_index(void) {
 #define ERODEM_GROUP_ONCE
 #endif
 
+/* The eight lanes of a running sum added pairwise: ((0 + 1) + (2 + 3)) + ((4 + 5) + (6 + 7)). */
+static inline acc_t acc8_total(acc8_t a) {
+  return ((a.s0 + a.s1) + (a.s2 + a.s3)) + ((a.s4 + a.s5) + (a.s6 + a.s7));
+}
+
 /* The sum in acc_t of the n per-cell tallies s[0 .. n) (n the local size): eight running
  * sums, lane j over the indices j mod 8 below the last multiple of 8, as one 8-vector, added
- * pairwise, then the rest in order; a fixed order. (One running sum makes every add wait for
- * the one before: on CPU devices that chain, not the memory traffic, would set the speed of
- * the tally kernels.) */
+ * pairwise (acc8_total), then the rest in order; a fixed order. (One running sum makes every
+ * add wait for the one before: on CPU devices that chain, not the memory traffic, would set
+ * the speed of the tally kernels.) */
 ERODEM_GROUP_ONCE acc_t cell_tallies_sum(__local const real* s, int n) {
   const int blocks = n / 8;
   acc_t sum = 0;
   if (blocks > 0) {
     acc8_t a = convert_acc8(vload8(0, s));
     for (int k = 1; k < blocks; ++k) a += convert_acc8(vload8(k, s));
-    sum = ((a.s0 + a.s1) + (a.s2 + a.s3)) + ((a.s4 + a.s5) + (a.s6 + a.s7));
+    sum = acc8_total(a);
   }
   for (int k = 8 * blocks; k < n; ++k) sum += (acc_t)s[k];
   return sum;

@@ -68,12 +68,31 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
   const int last = min(n, W - x0); /* work-items inside the row */
   const acc_t a = (acc_t)area[row];
   const long row_cell = (long)(row - 1) * (long)(W - 2) - 1 + (long)x0; /* cell of local id 0 */
-  acc_t water = cell_tallies_sum(s_d, last), bed_sum = cell_tallies_sum(s_b, last);
-  const acc_t sed = cell_tallies_sum(s_s, last);
+  /* the three sums of cell_tallies_sum, in its order, in one loop: three chains of adds side
+   * by side run in the time of one (each waits for its previous add) */
+  acc_t water = 0, bed_sum = 0, sed = 0;
+  const int sum_blocks = last / 8;
+  if (sum_blocks > 0) {
+    acc8_t w8 = convert_acc8(vload8(0, s_d)), b8 = convert_acc8(vload8(0, s_b)),
+           s8 = convert_acc8(vload8(0, s_s));
+    for (int k = 1; k < sum_blocks; ++k) {
+      w8 += convert_acc8(vload8(k, s_d));
+      b8 += convert_acc8(vload8(k, s_b));
+      s8 += convert_acc8(vload8(k, s_s));
+    }
+    water = acc8_total(w8);
+    bed_sum = acc8_total(b8);
+    sed = acc8_total(s8);
+  }
+  for (int k = 8 * sum_blocks; k < last; ++k) {
+    water += (acc_t)s_d[k];
+    bed_sum += (acc_t)s_b[k];
+    sed += (acc_t)s_s[k];
+  }
   /* maxima: the first largest value in local-id (= row) order, active cells only; lane j of
    * the 8-vectors keeps the first largest among the local ids j mod 8 (strictly larger
-   * replaces), the lanes are then merged (as large and earlier wins), and the rest after the
-   * last multiple of 8 comes in order. The squared speed in acc_t is exact for float
+   * replaces), the lanes are then merged (the largest, the earliest of equals), and the rest after
+   * the last multiple of 8 comes in order. The squared speed in acc_t is exact for float
    * velocities, so it ranks the cells as the CPU ranks them. bad: the first state 2. */
   acc_t max_d = -1, max_v = -1;
   long arg_d = -1, arg_v = -1, bad = -1;
@@ -97,29 +116,28 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
       at_v = select(at_v, id, convert_int8(faster));
       at_bad = select(at_bad, id, (state == (int8)(2)) & (at_bad < (int8)(0)));
     }
-    const real bd[8] = {best_d.s0, best_d.s1, best_d.s2, best_d.s3,
-                        best_d.s4, best_d.s5, best_d.s6, best_d.s7};
-    const acc_t bv[8] = {best_v.s0, best_v.s1, best_v.s2, best_v.s3,
-                         best_v.s4, best_v.s5, best_v.s6, best_v.s7};
-    const int ad[8] = {at_d.s0, at_d.s1, at_d.s2, at_d.s3, at_d.s4, at_d.s5, at_d.s6, at_d.s7};
-    const int av[8] = {at_v.s0, at_v.s1, at_v.s2, at_v.s3, at_v.s4, at_v.s5, at_v.s6, at_v.s7};
-    const int ab[8] = {at_bad.s0, at_bad.s1, at_bad.s2, at_bad.s3,
-                       at_bad.s4, at_bad.s5, at_bad.s6, at_bad.s7};
-    int kd = -1, kv = -1, kb = -1;
-    for (int j = 0; j < 8; ++j) {
-      if (ad[j] >= 0 && (kd < 0 || (acc_t)bd[j] > max_d || ((acc_t)bd[j] == max_d && ad[j] < kd))) {
-        max_d = (acc_t)bd[j];
-        kd = ad[j];
-      }
-      if (av[j] >= 0 && (kv < 0 || bv[j] > max_v || (bv[j] == max_v && av[j] < kv))) {
-        max_v = bv[j];
-        kv = av[j];
-      }
-      if (ab[j] >= 0 && (kb < 0 || ab[j] < kb)) kb = ab[j];
-    }
-    arg_d = kd < 0 ? -1 : row_cell + kd;
-    arg_v = kv < 0 ? -1 : row_cell + kv;
-    bad = kb < 0 ? -1 : row_cell + kb;
+    /* the lanes merged without branches (they mispredicted): the largest value, then the
+     * smallest local id holding it. A lane that never took a cell holds -1 and id -1; one
+     * that did holds more than -1 (it took only strictly larger values), never NaN. */
+    const float4 d4 = fmax(best_d.lo, best_d.hi);
+    const float2 d_pair = fmax(d4.lo, d4.hi);
+    const float d_top = fmax(d_pair.x, d_pair.y);
+    const acc4_t v4 = fmax(best_v.lo, best_v.hi);
+    const acc2_t v_pair = fmax(v4.lo, v4.hi);
+    const acc_t v_top = fmax(v_pair.x, v_pair.y);
+    const int8 none = (int8)(INT_MAX);
+    const int8 cd = select(none, at_d, (best_d == (float8)(d_top)) & (at_d >= (int8)(0)));
+    const int8 cv =
+        select(none, at_v, convert_int8(best_v == (acc8_t)(v_top)) & (at_v >= (int8)(0)));
+    const int8 cb = select(none, at_bad, at_bad >= (int8)(0));
+    const int4 cd4 = min(cd.lo, cd.hi), cv4 = min(cv.lo, cv.hi), cb4 = min(cb.lo, cb.hi);
+    const int2 cd2 = min(cd4.lo, cd4.hi), cv2 = min(cv4.lo, cv4.hi), cb2 = min(cb4.lo, cb4.hi);
+    const int kd = min(cd2.x, cd2.y), kv = min(cv2.x, cv2.y), kb = min(cb2.x, cb2.y);
+    if (kd != INT_MAX) max_d = (acc_t)d_top;
+    if (kv != INT_MAX) max_v = v_top;
+    arg_d = kd == INT_MAX ? -1 : row_cell + kd;
+    arg_v = kv == INT_MAX ? -1 : row_cell + kv;
+    bad = kb == INT_MAX ? -1 : row_cell + kb;
   }
   for (int k = 8 * blocks; k < last; ++k) {
     if (s_state[k] == 0) continue;
