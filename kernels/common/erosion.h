@@ -22,16 +22,20 @@ ERODEM_FN real bed_tilt_sin(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   const real b_t = has_t ? b_n : b_c;
   const real b_b = has_b ? b_s : b_c;
   /* the central difference spans two cells, a one-sided one one cell, none no cell (then
-   * the gradient is 0). Written with the neighbour counts selecting the span, not as
-   * count * spacing: that form lets PoCL's SLP vectoriser pack the x and y parts into a
-   * 2-vector, and PoCL does not vectorise a kernel across work-items after that (the same
-   * numbers: 2 dx = dx + dx and 1 dx = dx exactly) */
+   * the gradient is 0): the difference times the reciprocal of the span, chosen by the
+   * neighbour counts among the row's reciprocals. Those are divisions of per-row numbers,
+   * made unconditionally, so the cell loops hoist them; a division per cell under the
+   * condition n > 0 made PoCL gather the row's spacing in every iteration (19.5 -> 16.8 ms
+   * at 4096^2), and the count * spacing form lets PoCL's SLP vectoriser pack the x and y
+   * parts into a 2-vector, after which PoCL does not vectorise across work-items. */
   const int n_x = has_l + has_r, n_y = has_t + has_b;
   const real dx_y = dx[y], dy_y = dy[y];
-  const real span_x = n_x == 2 ? dx_y + dx_y : (n_x == 1 ? dx_y : (real)1);
-  const real span_y = n_y == 2 ? dy_y + dy_y : (n_y == 1 ? dy_y : (real)1);
-  const real gx = n_x > 0 ? (b_r - b_l) / span_x : (real)0;
-  const real gy = n_y > 0 ? (b_b - b_t) / span_y : (real)0;
+  const real inv_dx = (real)1 / dx_y, inv_2dx = (real)1 / (dx_y + dx_y);
+  const real inv_dy = (real)1 / dy_y, inv_2dy = (real)1 / (dy_y + dy_y);
+  const real per_span_x = n_x == 2 ? inv_2dx : (n_x == 1 ? inv_dx : (real)0);
+  const real per_span_y = n_y == 2 ? inv_2dy : (n_y == 1 ? inv_dy : (real)0);
+  const real gx = (b_r - b_l) * per_span_x; /* n_x = 0: b_r = b_l, so +0 */
+  const real gy = (b_b - b_t) * per_span_y;
   const real tan2 = gx * gx + gy * gy;
   return sqrt(tan2 / ((real)1 + tan2));
 }
