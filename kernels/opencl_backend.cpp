@@ -395,6 +395,8 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
   rt->max_work_group = device_value<std::size_t>(rt->device, CL_DEVICE_MAX_WORK_GROUP_SIZE);
   rt->base_align = std::max<std::size_t>(
       1, device_value<cl_uint>(rt->device, CL_DEVICE_MEM_BASE_ADDR_ALIGN) / 8);
+  rt->max_alloc =
+      static_cast<std::size_t>(device_value<cl_ulong>(rt->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE));
   const cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
                                          reinterpret_cast<cl_context_properties>(rt->platform), 0};
   cl_int err = CL_SUCCESS;
@@ -606,24 +608,29 @@ Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
   cl_int err = CL_SUCCESS;
   bytes = std::max<std::size_t>(bytes, 1);
   const std::size_t align = rt_->base_align;
-  if (bytes < kStaggerMin || align >= kStaggerPeriod) {
-    const cl_mem_flags flags = CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0);
-    Buffer b(clCreateBuffer(rt_->context.get(), flags, bytes, const_cast<void*>(data), &err));
-    check(err, "clCreateBuffer");
-    return b;
+  // The staggering is only for speed: a buffer that would not fit with the extra 4 KiB, or a
+  // sub-buffer the device refuses, gets a plain buffer.
+  if (bytes >= kStaggerMin && align < kStaggerPeriod && bytes + kStaggerPeriod <= rt_->max_alloc) {
+    const std::size_t offset = stagger_offset(stagger_next_++, align);
+    Buffer parent(clCreateBuffer(rt_->context.get(), CL_MEM_READ_WRITE, bytes + kStaggerPeriod,
+                                 nullptr, &err));
+    if (err == CL_SUCCESS) {
+      const cl_buffer_region region{offset, bytes};
+      // The sub-buffer keeps its parent alive (OpenCL 1.2, clReleaseMemObject).
+      Buffer b(clCreateSubBuffer(parent.get(), CL_MEM_READ_WRITE, CL_BUFFER_CREATE_TYPE_REGION,
+                                 &region, &err));
+      if (err == CL_SUCCESS) {
+        if (data)
+          check(clEnqueueWriteBuffer(queue_.get(), b.get(), CL_TRUE, 0, bytes, data, 0, nullptr,
+                                     nullptr),
+                "clEnqueueWriteBuffer");
+        return b;
+      }
+    }
   }
-  const std::size_t offset = stagger_offset(stagger_next_++, align);
-  Buffer parent(
-      clCreateBuffer(rt_->context.get(), CL_MEM_READ_WRITE, bytes + kStaggerPeriod, nullptr, &err));
+  const cl_mem_flags flags = CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0);
+  Buffer b(clCreateBuffer(rt_->context.get(), flags, bytes, const_cast<void*>(data), &err));
   check(err, "clCreateBuffer");
-  const cl_buffer_region region{offset, bytes};
-  // The sub-buffer keeps its parent alive (OpenCL 1.2, clReleaseMemObject).
-  Buffer b(clCreateSubBuffer(parent.get(), CL_MEM_READ_WRITE, CL_BUFFER_CREATE_TYPE_REGION, &region,
-                             &err));
-  check(err, "clCreateSubBuffer");
-  if (data)
-    check(clEnqueueWriteBuffer(queue_.get(), b.get(), CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
-          "clEnqueueWriteBuffer");
   return b;
 }
 

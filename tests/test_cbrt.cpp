@@ -73,33 +73,45 @@ TEST(Cbrt, FirstGuessWithinItsBound) {
   EXPECT_LE(worst, 0.033);
 }
 
-// A face whose flow depth h_f is at or below ERODEM_FACE_DEPTH_MIN is dry even with
-// dry_depth = 0; just above it, the friction term stays finite with q = 0 (before the floor,
-// h_f = 1e-20 m gave h_f^(7/3) = 0 in float and q_new = NaN from 0 / 0).
-TEST(Cbrt, FaceDepthFloorKeepsTheFrictionTermFinite) {
-  const float g = 9.81f, dt = 1.0f, n = 0.03f, dist = 10.0f, theta = 0.7f, dry_depth = 0.0f;
-  auto q_new = [&](float h, float q) {  // a face over a flat bed at 0 with a surface drop
-    return cell::local_inertial_q(q, q, q, h, 0.5f * h, 0.0f, 0.0f, n, dist, dt, g, theta,
-                                  dry_depth);
+// A face whose flow depth h_f is at or below ERODEM_FACE_DEPTH_MIN is dry even where
+// dry_depth is smaller (0 or 1e-20 m), in float and in double (the CPU float64 reference);
+// just above it, the friction term stays finite with q = 0 (before the floor, h_f = 1e-20 m
+// gave h_f^(7/3) = 0 in float and q_new = NaN from 0 / 0).
+template <class Real>
+int check_face_depth_floor(Real dry_depth, Real* largest) {
+  const Real g = 9.81, dt = 1, n = 0.03, dist = 10, theta = 0.7;
+  auto q_new = [&](Real h, Real q) {  // a face over a flat bed at 0 with a surface drop
+    return cell::local_inertial_q<Real>(q, q, q, h, Real(0.5) * h, 0, 0, n, dist, dt, g, theta,
+                                        dry_depth);
   };
+  const Real floor = ERODEM_FACE_DEPTH_MIN;
   int checked = 0;
-  for (float h : {1e-30f, 1e-20f, 1e-17f, ERODEM_FACE_DEPTH_MIN}) {
-    EXPECT_EQ(q_new(h, 0.0f), 0.0f) << "h_f = " << h;
-    EXPECT_EQ(q_new(h, 1e-3f), 0.0f) << "h_f = " << h;
+  for (Real h : {Real(1e-30), Real(1e-20), Real(1e-17), floor}) {
+    EXPECT_EQ(q_new(h, 0), Real(0)) << "h_f = " << h << ", dry_depth = " << dry_depth;
+    EXPECT_EQ(q_new(h, Real(1e-3)), Real(0)) << "h_f = " << h << ", dry_depth = " << dry_depth;
     ++checked;
   }
-  float largest = 0;
-  for (float h = std::nextafter(ERODEM_FACE_DEPTH_MIN, 1.0f); h < 1e3f; h *= 3.7f)
-    for (float q : {0.0f, 1e-30f, 1e-3f, 1.0f, -5.0f}) {
-      const float r = q_new(h, q);
+  for (Real h = std::nextafter(floor, Real(1)); h < Real(1e3); h *= Real(3.7))
+    for (Real q : {Real(0), Real(1e-30), Real(1e-3), Real(1), Real(-5)}) {
+      const Real r = q_new(h, q);
       EXPECT_TRUE(std::isfinite(r)) << "h_f = " << h << ", q = " << q;
-      largest = std::fmax(largest, std::fabs(r));
+      *largest = std::fmax(*largest, std::fabs(r));
       ++checked;
     }
+  return checked;
+}
+
+TEST(Cbrt, FaceDepthFloorKeepsTheFrictionTermFinite) {
+  float largest_f = 0;
+  double largest_d = 0;
+  int checked = 0;
+  for (float dry : {0.0f, 1e-20f}) checked += check_face_depth_floor<float>(dry, &largest_f);
+  for (double dry : {0.0, 1e-20}) checked += check_face_depth_floor<double>(dry, &largest_d);
   std::printf(
-      "local_inertial_q with dry_depth = 0: %d faces, dry at or below %g m, finite "
-      "above (largest |q_new| %.4g m^2/s)\n",
-      checked, static_cast<double>(ERODEM_FACE_DEPTH_MIN), static_cast<double>(largest));
+      "local_inertial_q with dry_depth = 0 and 1e-20 m, float and double: %d faces, dry at or "
+      "below %g m, finite above (largest |q_new| %.4g / %.4g m^2/s)\n",
+      checked, static_cast<double>(ERODEM_FACE_DEPTH_MIN), static_cast<double>(largest_f),
+      largest_d);
 }
 
 }  // namespace

@@ -64,6 +64,21 @@ TEST(Stagger, AllocatorGivesLargeFieldsTheirOwnOffsets) {
   EXPECT_EQ(moved[100], 8.0f);
   const Field small(16, 2.0f);  // below kStaggerMin: plain operator new
   EXPECT_EQ(small[15], 2.0f);
+  // Across the threshold: one element short of kStaggerMin bytes, exactly at it, and a vector
+  // grown from below to above it (allocate and deallocate must draw the line alike; the
+  // sanitizer run checks every block is freed as it was allocated); swap; double.
+  Field below(kStaggerMin / sizeof(float) - 1, 1.0f), at(kStaggerMin / sizeof(float), 3.0f);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(at.data()) % 128, 0u);
+  for (int k = 0; k < 3; ++k) below.resize(below.size() * 2, 4.0f);
+  below.shrink_to_fit();
+  EXPECT_EQ(below[0], 1.0f);
+  EXPECT_EQ(below.back(), 4.0f);
+  std::swap(below, at);
+  EXPECT_EQ(below[0], 3.0f);
+  EXPECT_EQ(at[0], 1.0f);
+  std::vector<double, StaggeredAllocator<double>> doubles(kStaggerMin / sizeof(double), 0.5);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(doubles.data()) % 128, 0u);
+  EXPECT_EQ(doubles.back(), 0.5);
 }
 
 }  // namespace

@@ -38,6 +38,7 @@
 #include "erodem/grid.hpp"
 #include "erodem/initial_state.hpp"
 #include "erodem/params.hpp"
+#include "stagger.hpp"  // the fields' allocator: shared by the builds, so baseline code
 
 #ifndef ERODEM_CPU_ISA_LEVEL
 #error "kernels/cpu/*.cpp are built by kernels/CMakeLists.txt with ERODEM_CPU_ISA_LEVEL set"

@@ -96,6 +96,8 @@ struct Runtime {
   std::size_t max_work_group = 1;
   /// CL_DEVICE_MEM_BASE_ADDR_ALIGN in bytes: the alignment of a sub-buffer's origin.
   std::size_t base_align = 4096;
+  /// CL_DEVICE_MAX_MEM_ALLOC_SIZE in bytes: the largest buffer.
+  std::size_t max_alloc = 0;
   /// Built for launches of whole rows (ERODEM_WHOLE_ROWS: every cell kernel's local size
   /// divides the row; the kernels then need no per-work-item bound check).
   bool whole_rows = false;

@@ -133,7 +133,7 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
     const int4 cd4 = min(cd.lo, cd.hi), cv4 = min(cv.lo, cv.hi), cb4 = min(cb.lo, cb.hi);
     const int2 cd2 = min(cd4.lo, cd4.hi), cv2 = min(cv4.lo, cv4.hi), cb2 = min(cb4.lo, cb4.hi);
     const int kd = min(cd2.x, cd2.y), kv = min(cv2.x, cv2.y), kb = min(cb2.x, cb2.y);
-    if (kd != INT_MAX) max_d = (acc_t)d_top;
+    if (kd != INT_MAX) max_d = (acc_t)s_d[kd]; /* the cell's own value: -0 stays -0 */
     if (kv != INT_MAX) max_v = v_top;
     arg_d = kd == INT_MAX ? -1 : row_cell + kd;
     arg_v = kv == INT_MAX ? -1 : row_cell + kv;
