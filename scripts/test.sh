@@ -34,7 +34,7 @@ ERODEM_CMAKE_ARGS="-DCMAKE_BUILD_TYPE=Debug -DERODEM_SANITIZE=ON -DERODEM_PYTHON
 # the whole suite, from a cold PoCL cache, reports no leak that way. tests/lsan.supp says
 # which third-party leaks are suppressed and why.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:intercept_tls_get_addr=0
-export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0
+export LSAN_OPTIONS="suppressions='$PWD/tests/lsan.supp':print_suppressions=0"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ./build-sanitize/tests/erodem_tests \
   --gtest_filter='-*LakeAtRestStaysAtRest*:*ClosedBoxConservesWaterAndMaterial*:*Agreement*'
