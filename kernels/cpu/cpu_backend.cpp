@@ -32,15 +32,15 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
 #else
   threads_ = 1;
 #endif
-  auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
-  auto to_field = [](const std::vector<double>& v) { return Field(v.begin(), v.end()); };
+  // the padded state's float64 arrays, rounded to Real, into a per-row array or a field
+  auto take = [](auto& dst, const std::vector<double>& v) { dst.assign(v.begin(), v.end()); };
   const std::size_t n = s.size();
   kind_ = s.kind;
-  dx_ = to_real(s.dx);
-  dy_ = to_real(s.dy);
-  area_ = to_real(s.area);
-  bed_ = to_field(s.bed);
-  depth_ = to_field(s.depth);
+  take(dx_, s.dx);
+  take(dy_, s.dy);
+  take(area_, s.area);
+  take(bed_, s.bed);
+  take(depth_, s.depth);
   bed_next_ = bed_;
   bed0_ = bed_;
   depth_next_ = depth_;
@@ -54,9 +54,9 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   velocity_y_.assign(n, Real(0));
   thermal_share_.assign(n, Real(0));
   wetness_ = depth_;
-  manning_ = to_field(s.manning);
-  hardness_ = to_field(s.hardness);
-  rain_factor_ = to_field(s.rain_factor);
+  take(manning_, s.manning);
+  take(hardness_, s.hardness);
+  take(rain_factor_, s.rain_factor);
   row_sums_a_.assign(H_, 0.0);
   row_sums_b_.assign(H_, 0.0);
   run_boundary();
