@@ -282,6 +282,13 @@ int run(const RunOptions& o) {
   std::printf("wrote %s (%zu snapshots of %zu fields, diagnostics of %ld steps) and %s\n",
               writer.path().c_str(), writer.snapshots(), p.output.fields.size(),
               sim.steps_done() - first_step, io::xdmf_path(writer.path()).c_str());
+  // The closures last, relative to what moved (ledger.hpp), for scripts that read the tail.
+  const Ledger& L = sim.ledger();
+  std::printf(
+      "closures: water %.3e m^3 (%.2e of %.3e m^3 moved), material %.3e m^3 (%.2e of %.3e m^3 "
+      "moved)\n",
+      L.closure_error(), L.relative_closure_error(), L.water_moved(), L.material_closure_error(),
+      L.relative_material_closure_error(), L.material_moved());
   return 0;
 }
 

@@ -439,11 +439,14 @@ void set_args(cl_kernel k, const Args&... args) {
 constexpr std::size_t kReduceMax = 256;      // ERODEM_REDUCE_MAX of stats.cl
 constexpr std::size_t kCellGroupMax = 1024;  // ERODEM_CELL_GROUP_MAX of reduce.cl
 constexpr std::size_t kReduceGroupsMax = 1024;
-constexpr std::size_t kTallySlots = 4;  // ERODEM_TALLY_SLOTS of reduce.cl
+constexpr std::size_t kTallySlots = 9;  // ERODEM_TALLY_SLOTS of reduce.cl
 constexpr int kTallyExchange = 0;       // ERODEM_TALLY_EXCHANGE of reduce.cl
 constexpr int kTallySediment = 2;       // ERODEM_TALLY_SEDIMENT of reduce.cl
+// one bit per slot of reduce.cl (1 << ERODEM_TALLY_*), then the transport change
 constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
-                   kEvaporatedBit = 1u << 3, kTallyBits = 0xfu, kChangeBit = 1u << 4;
+                   kEvaporatedBit = 1u << 3, kWaterGivenBit = 1u << 4, kErodedBit = 1u << 5,
+                   kDepositedBit = 1u << 6, kSedimentGivenBit = 1u << 7, kThermalBit = 1u << 8,
+                   kTallyBits = (1u << kTallySlots) - 1, kChangeBit = 1u << kTallySlots;
 
 /// A size from the environment (the tuning variable ERODEM_OPENCL_WG), else `fallback`. Where
 /// the kernels are built for rounded launches, the cell kernels' work-group is ERODEM_OPENCL_WG
@@ -502,6 +505,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   bed_ = upload(bed_r);
   bed_next_ = upload(bed_r);
   bed0_ = upload(bed_r);
+  bed_residual_ = upload(std::vector<Real>(bed_r.size(), Real(0)));
   depth_ = upload(depth_r);
   depth_next_ = upload(depth_r);
   sediment_ = upload(zeros);
@@ -722,6 +726,11 @@ void OpenClBackend::deliver_tallies() {
     if (pending_ & kClippedBit) t.clipped += v[1];
     if (pending_ & kSedimentBit) t.sediment_out += v[2];
     if (pending_ & kEvaporatedBit) t.evaporated += v[3];
+    if (pending_ & kWaterGivenBit) t.water_exchanged += v[4];
+    if (pending_ & kErodedBit) t.eroded += v[5];
+    if (pending_ & kDepositedBit) t.deposited += v[6];
+    if (pending_ & kSedimentGivenBit) t.sediment_exchanged += v[7];
+    if (pending_ & kThermalBit) t.thermal_moved += v[8];
   }
   if (pending_ & kChangeBit) {
     double change = 0.0;
@@ -759,13 +768,13 @@ void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
       run_water(dt, tally);
       break;
     case Process::erosion:
-      run_erosion(dt);
+      run_erosion(dt, tally);
       break;
     case Process::transport:
       run_transport(dt, tally);
       break;
     case Process::thermal:
-      run_thermal(dt);
+      run_thermal(dt, tally);
       break;
     case Process::evaporation:
       run_evaporation(dt, tally);
@@ -873,7 +882,7 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
            flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
            static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
            static_cast<cl_int>(tally_stride_));
-  defer(tally, kExchangeBit | kClippedBit);
+  defer(tally, kExchangeBit | kClippedBit | kWaterGivenBit);
   pending_water_dt_ = dt;
   launch_interior(k);
   launch_edge_tallies(kTallyExchange, dt);
@@ -881,15 +890,18 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
   std::swap(depth_, depth_next_);
 }
 
-void OpenClBackend::run_erosion(Real dt) {
+void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
   const auto& e = params_.erosion;
   const Real bedrock = e.bedrock_level ? static_cast<Real>(*e.bedrock_level)
                                        : -std::numeric_limits<Real>::infinity();
   cl_kernel k = kernel("erosion");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, sediment_, depth_, velocity_x_,
-           velocity_y_, hardness_, dx_, dy_, dt, static_cast<Real>(e.sediment_capacity),
-           static_cast<Real>(e.dissolving_rate), static_cast<Real>(e.deposition_rate),
-           static_cast<Real>(e.min_tilt), static_cast<Real>(e.min_depth), bedrock);
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_, depth_,
+           velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt,
+           static_cast<Real>(e.sediment_capacity), static_cast<Real>(e.dissolving_rate),
+           static_cast<Real>(e.deposition_rate), static_cast<Real>(e.min_tilt),
+           static_cast<Real>(e.min_depth), bedrock, tally_partials_,
+           static_cast<cl_int>(tally_stride_));
+  defer(tally, kErodedBit | kDepositedBit);
   launch_interior(k);
   std::swap(bed_, bed_next_);
 }
@@ -898,8 +910,9 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
   if (params_.transport.scheme == TransportScheme::conservative) {
     cl_kernel k = kernel("transport_conservative");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
-             flux_[1], flux_[2], flux_[3], area_, dt);
-    defer(tally, kSedimentBit);
+             flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
+             static_cast<cl_int>(tally_stride_));
+    defer(tally, kSedimentBit | kSedimentGivenBit);
     launch_interior(k);
     launch_edge_tallies(kTallySediment, dt);  // reads sediment_ before the swap
   } else {
@@ -915,7 +928,7 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
   std::swap(sediment_, sediment_next_);
 }
 
-void OpenClBackend::run_thermal(Real dt) {
+void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   const double pi = 3.14159265358979323846;
   const Real tan_talus = static_cast<Real>(std::tan(params_.thermal.talus_angle * pi / 180.0));
   const Real rate = static_cast<Real>(params_.thermal.rate);
@@ -924,8 +937,9 @@ void OpenClBackend::run_thermal(Real dt) {
            tan_talus);
   launch_interior(share);
   cl_kernel apply = kernel("thermal_apply");
-  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, thermal_share_, dx_, dy_, area_, bed_next_,
-           tan_talus);
+  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, thermal_share_, dx_, dy_,
+           area_, bed_next_, tan_talus, tally_partials_, static_cast<cl_int>(tally_stride_));
+  defer(tally, kThermalBit);
   launch_interior(apply);
   std::swap(bed_, bed_next_);
 }
@@ -947,8 +961,8 @@ void OpenClBackend::finish() {
 
 FieldStats OpenClBackend::stats() {
   cl_kernel k = kernel("field_stats");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, velocity_x_, velocity_y_,
-           area_, partial_a_, partial_cells_);
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, depth_, sediment_, velocity_x_,
+           velocity_y_, area_, partial_a_, partial_cells_);
   launch_interior(k);
   const int rows = H_ - 2;
   cl_kernel r = kernel("stats_rows");
@@ -1022,6 +1036,8 @@ Buffer* OpenClBackend::field_buffer(FieldId id) {
       return &manning_;
     case FieldId::initial_bed:
       return &bed0_;
+    case FieldId::bed_residual:
+      return &bed_residual_;
     case FieldId::erosion:
       return nullptr;
   }
@@ -1060,12 +1076,17 @@ void write_interior(cl_command_queue q, cl_mem b, int nx, int ny, const std::vec
 
 std::vector<double> OpenClBackend::field(FieldId id) const {
   auto* self = const_cast<OpenClBackend*>(this);
-  if (id == FieldId::erosion) {
-    const auto b0 = read_interior(queue_.get(), bed0_.get(), nx_, ny_);
+  if (id == FieldId::erosion || id == FieldId::bed) {
+    // the bed and the erosion include the bed's residual (exact in double)
     const auto b = read_interior(queue_.get(), bed_.get(), nx_, ny_);
+    const auto lo = read_interior(queue_.get(), bed_residual_.get(), nx_, ny_);
+    const auto b0 = id == FieldId::erosion ? read_interior(queue_.get(), bed0_.get(), nx_, ny_)
+                                           : std::vector<float>();
     std::vector<double> out(b.size());
     for (std::size_t i = 0; i < b.size(); ++i)
-      out[i] = static_cast<double>(b0[i]) - static_cast<double>(b[i]);
+      out[i] = id == FieldId::bed ? static_cast<double>(b[i]) + static_cast<double>(lo[i])
+                                  : (static_cast<double>(b0[i]) - static_cast<double>(b[i])) -
+                                        static_cast<double>(lo[i]);
     return out;
   }
   const auto v = read_interior(queue_.get(), self->field_buffer(id)->get(), nx_, ny_);
@@ -1086,6 +1107,13 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
   const std::vector<float> v(values.begin(), values.end());
   write_interior(queue_.get(), dst->get(), nx_, ny_, v);
   if (twin) write_interior(queue_.get(), twin->get(), nx_, ny_, v);
+  if (id == FieldId::bed) {
+    // a bed keeps what float cannot hold in its residual (set bed_residual after the bed)
+    std::vector<float> lo(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i)
+      lo[i] = static_cast<float>(values[i] - static_cast<double>(v[i]));
+    write_interior(queue_.get(), bed_residual_.get(), nx_, ny_, lo);
+  }
 }
 
 }  // namespace opencl

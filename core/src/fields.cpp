@@ -20,6 +20,8 @@ const std::vector<FieldInfo>& field_table() {
       {FieldId::erosion, "erosion", "m", "cumulative net erosion (negative: deposition)"},
       {FieldId::manning_n, "manning_n", "s m-1/3", "Manning roughness coefficient"},
       {FieldId::initial_bed, "initial_bed", "m", "bed elevation at the start of the run"},
+      {FieldId::bed_residual, "bed_residual", "m",
+       "bed elevation below the precision of bed (the bed is bed + bed_residual)"},
   };
   return table;
 }

@@ -11,8 +11,8 @@
 
 namespace erodem {
 
-const std::array<DiagnosticsSeries, 11>& diagnostics_series() {
-  static const std::array<DiagnosticsSeries, 11> table{{
+const std::array<DiagnosticsSeries, 16>& diagnostics_series() {
+  static const std::array<DiagnosticsSeries, 16> table{{
       {"time", &Diagnostics::time, "s", "time since the start of the run, at the end of the step"},
       {"dt", &Diagnostics::dt, "s", "time step"},
       {"water_volume", &Diagnostics::water_volume, "m3", "water volume on the grid"},
@@ -26,6 +26,16 @@ const std::array<DiagnosticsSeries, 11>& diagnostics_series() {
       {"closure_error", &Diagnostics::closure_error, "m3", "water ledger closure error"},
       {"max_depth", &Diagnostics::max_depth, "m", "largest water depth"},
       {"max_speed", &Diagnostics::max_speed, "m s-1", "largest flow speed"},
+      {"eroded_volume", &Diagnostics::eroded_volume, "m3",
+       "cumulative bed volume taken into suspension"},
+      {"deposited_volume", &Diagnostics::deposited_volume, "m3",
+       "cumulative sediment volume laid down on the bed"},
+      {"material_closure_error", &Diagnostics::material_closure_error, "m3",
+       "material ledger closure error"},
+      {"relative_closure_error", &Diagnostics::relative_closure_error, "1",
+       "water ledger closure error relative to the water moved"},
+      {"relative_material_closure_error", &Diagnostics::relative_material_closure_error, "1",
+       "material ledger closure error relative to the material moved"},
   }};
   return table;
 }
@@ -67,7 +77,7 @@ const std::vector<FieldId>& state_fields() {
   static const std::vector<FieldId> ids{
       FieldId::bed,        FieldId::initial_bed, FieldId::water_depth, FieldId::sediment,
       FieldId::velocity_x, FieldId::velocity_y,  FieldId::flux_left,   FieldId::flux_right,
-      FieldId::flux_top,   FieldId::flux_bottom, FieldId::wetness};
+      FieldId::flux_top,   FieldId::flux_bottom, FieldId::wetness,     FieldId::bed_residual};
   return ids;
 }
 
@@ -111,7 +121,12 @@ Diagnostics Simulation::diagnostics_now(double dt) const {
                      ledger_.evaporated,
                      ledger_.closure_error(),
                      stats_.max_depth,
-                     stats_.max_speed};
+                     stats_.max_speed,
+                     ledger_.eroded,
+                     ledger_.deposited,
+                     ledger_.material_closure_error(),
+                     ledger_.relative_closure_error(),
+                     ledger_.relative_material_closure_error()};
 }
 
 Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> backend)
@@ -292,6 +307,11 @@ void Simulation::step() {
   ledger_.clipped += tally.clipped;
   ledger_.sediment_out += tally.sediment_out;
   ledger_.transport_change += tally.transport_change;
+  ledger_.water_exchanged += tally.water_exchanged;
+  ledger_.eroded += tally.eroded;
+  ledger_.deposited += tally.deposited;
+  ledger_.sediment_exchanged += tally.sediment_exchanged;
+  ledger_.thermal_moved += tally.thermal_moved;
   ledger_.water = stats_.water_volume;
   ledger_.material = stats_.material_volume;
 

@@ -1057,11 +1057,19 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
   RestartPoint p;
   p.time = times_[index];
   p.steps = static_cast<long>(steps[index]);
-  for (const auto& e : ledger_entries())
+  // Files of erodem before the bed residual and the moved volumes (2026-11-25) lack those:
+  // they start at 0 (the residual then holds nothing yet, as in any new run).
+  for (const auto& e : ledger_entries()) {
+    const std::string name = std::string("restart/ledger_") + e.name;
     p.ledger.*e.member =
-        read_doubles(file_, std::string("restart/ledger_") + e.name, path_).at(index);
+        exists(file_, name) || !e.moved ? read_doubles(file_, name, path_).at(index) : 0.0;
+  }
   for (FieldId id : state_fields()) {
     const std::string name = std::string("restart/") + field_info(id).name;
+    if (id == FieldId::bed_residual && !exists(file_, name)) {
+      p.fields.emplace_back(grid_.cells(), 0.0);
+      continue;
+    }
     H5Id ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
     if (!ds.valid()) not_ours(path_, "no dataset " + name);
     H5Id space(H5Dget_space(ds));

@@ -3,6 +3,7 @@
 #define ERODEM_KERNELS_COMMON_EROSION_H
 
 #include "compat.h"
+#include "compensated.h"
 
 ERODEM_BEGIN_NAMESPACE
 
@@ -54,17 +55,26 @@ ERODEM_FN real transport_capacity(real capacity_k, real tilt_sin, real min_tilt,
 
 /* Erosion / deposition of active padded cell (x, y). If C > s, erode
  * min(1, K_s R dt) (C - s) from bed into suspension, never below `bedrock` (m); else
- * deposit min(1, K_d dt) (s - C). Reads bed (for the tilt); returns the new bed (m) and
- * writes the new suspended sediment (m) through *sediment_out. Rates K_s, K_d (1/s);
- * hardness R in [0, 1]. Branch-free (both cases evaluated, one selected), so loops over
- * cells vectorise. */
+ * deposit min(1, K_d dt) (s - C). Reads bed (for the tilt) and its residual (the bed is the
+ * pair bed + bed_residual, compensated.h); returns the new bed (m), writes the new residual
+ * (m) through *bed_residual_out, the new suspended sediment (m) through *sediment_out and
+ * the layer moved into suspension (m; negative where it deposits) through *moved_out.
+ * Rates K_s, K_d (1/s); hardness R in [0, 1].
+ *
+ * The transfer is exact: the sediment takes fl(s + m) and so gains m - e exactly (TwoSum),
+ * and the bed pair gives exactly m - e, so bed + sediment changes only by the rounding of
+ * the residual (about 2^-24 ulp(bed) in float32). A plain float bed would keep only the part
+ * of m above half an ulp of the bed: erosion and deposition below it were lost, or rounded
+ * one way (docs/model.md, "Precision"). Branch-free (both cases evaluated, one selected), so
+ * loops over cells vectorise. */
 ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                            GLOBAL const real* bed, GLOBAL const real* sediment,
-                            GLOBAL const real* depth, GLOBAL const real* velocity_x,
-                            GLOBAL const real* velocity_y, GLOBAL const real* hardness,
-                            GLOBAL const real* dx, GLOBAL const real* dy, real dt, real capacity_k,
-                            real dissolving_rate, real deposition_rate, real min_tilt,
-                            real min_depth, real bedrock, real* sediment_out) {
+                            GLOBAL const real* bed, GLOBAL const real* bed_residual,
+                            GLOBAL const real* sediment, GLOBAL const real* depth,
+                            GLOBAL const real* velocity_x, GLOBAL const real* velocity_y,
+                            GLOBAL const real* hardness, GLOBAL const real* dx,
+                            GLOBAL const real* dy, real dt, real capacity_k, real dissolving_rate,
+                            real deposition_rate, real min_tilt, real min_depth, real bedrock,
+                            real* bed_residual_out, real* sediment_out, real* moved_out) {
   const int i = x + y * W;
   const real u = velocity_x[i];
   const real v = velocity_y[i];
@@ -73,15 +83,22 @@ ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   const real capacity = transport_capacity(capacity_k, tilt, min_tilt, speed, depth[i], min_depth);
   const real s = sediment[i];
   const real b = bed[i];
+  const real lo = bed_residual[i];
   const real k_erode = dissolving_rate * hardness[i] * dt;
   const real erode = (k_erode < (real)1 ? k_erode : (real)1) * (capacity - s);
-  const real above_rock = b - bedrock > 0 ? b - bedrock : (real)0;
+  const real above = (b - bedrock) + lo; /* +inf without a bedrock level */
+  const real above_rock = above > 0 ? above : (real)0;
   const real eroded = erode < above_rock ? erode : above_rock;
   const real k_deposit = deposition_rate * dt;
   const real deposited = -(k_deposit < (real)1 ? k_deposit : (real)1) * (s - capacity);
   const real moved = capacity > s ? eroded : deposited;
-  *sediment_out = s + moved;
-  return b - moved;
+  real e_s, e_b;
+  const real s_new = two_sum(s, moved, &e_s); /* s + moved = s_new + e_s */
+  const real h = two_sum(b, -moved, &e_b);    /* b - moved = h + e_b */
+  *sediment_out = s_new;
+  *moved_out = moved;
+  /* (b + lo) - (moved - e_s) = h + (lo + e_b + e_s) */
+  return two_sum(h, (lo + e_b) + e_s, bed_residual_out);
 }
 
 ERODEM_END_NAMESPACE

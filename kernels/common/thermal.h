@@ -3,6 +3,7 @@
 #define ERODEM_KERNELS_COMMON_THERMAL_H
 
 #include "compat.h"
+#include "compensated.h"
 
 ERODEM_BEGIN_NAMESPACE
 
@@ -46,12 +47,16 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
 }
 
 /* Pass 2, active padded cell (x, y): bed after the transfers of pass 1,
- *   b_i <- b_i + (sum_n share_n e(n->i) - share_i sum_n e(i->n)) / area_i.
- * Every transfer is computed from the same numbers by giver and taker: conservative. */
+ *   b_i <- b_i + (sum_n share_n e(n->i) - share_i sum_n e(i->n)) / area_i,
+ * added to the bed pair (bed, bed_residual; compensated.h): returns the new bed (m) and
+ * writes the new residual (m) through *bed_residual_out and the volume the cell gave (m^3)
+ * through *given_out. Every transfer is computed from the same numbers by giver and taker:
+ * conservative. */
 ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                                  GLOBAL const real* bed, GLOBAL const real* share,
-                                  GLOBAL const real* dx, GLOBAL const real* dy,
-                                  GLOBAL const real* area, real tan_talus) {
+                                  GLOBAL const real* bed, GLOBAL const real* bed_residual,
+                                  GLOBAL const real* share, GLOBAL const real* dx,
+                                  GLOBAL const real* dy, GLOBAL const real* area, real tan_talus,
+                                  real* bed_residual_out, real* given_out) {
   const int i = x + y * W;
   const real b = bed[i];
   const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
@@ -72,7 +77,9 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
                      (has_b ? s_b * talus_excess(b_b, b, dist_b, tan_talus) : (real)0);
   /* times the reciprocal of the row's area (one division per row, hoisted out of the cell
    * loops; dividing every cell took 12 % of the PoCL pass at 4096^2) */
-  return b + (taken - share[i] * given) * ((real)1 / cell_area);
+  const real gave = share[i] * given;
+  *given_out = gave;
+  return bed_add(b, bed_residual[i], (taken - gave) * ((real)1 / cell_area), bed_residual_out);
 }
 
 ERODEM_END_NAMESPACE

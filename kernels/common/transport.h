@@ -36,14 +36,15 @@ ERODEM_FN real transport_boundary_out_cell(int i, int W, GLOBAL const erodem_kin
  * is the depth the flow step limited its outflows by (before the water update), so a cell
  * never gives more sediment than it holds:
  *   s_i <- s_i + dt / area_i * (sum_n c_n f_{n->i} - c_i sum_n f_{i->n}),  c = s / d.
- * Returns the new sediment (m) and through *boundary_out the volume (m^3) carried out of
- * the domain. Conserves sum(s * area) to rounding. Branch-free. */
+ * Returns the new sediment (m), through *boundary_out the volume (m^3) carried out of the
+ * domain and through *given the volume (m^3) the cell gave through all its faces. Conserves
+ * sum(s * area) to rounding. Branch-free. */
 ERODEM_FN real transport_conservative_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                            GLOBAL const real* sediment,
                                            GLOBAL const real* depth_flow, GLOBAL const real* f_left,
                                            GLOBAL const real* f_right, GLOBAL const real* f_top,
                                            GLOBAL const real* f_bottom, GLOBAL const real* area,
-                                           real dt, real* boundary_out) {
+                                           real dt, real* boundary_out, real* given_out) {
   const int i = x + y * W;
   const real c = sediment_concentration(sediment[i], depth_flow[i]);
   const real gained = sediment_concentration(sediment[i - 1], depth_flow[i - 1]) * f_right[i - 1] +
@@ -52,6 +53,7 @@ ERODEM_FN real transport_conservative_cell(int x, int y, int W, GLOBAL const ero
                       sediment_concentration(sediment[i + W], depth_flow[i + W]) * f_top[i + W];
   const real given = c * (f_left[i] + f_right[i] + f_top[i] + f_bottom[i]);
   const real s_new = sediment[i] + dt * (gained - given) / area[y];
+  *given_out = dt * given;
   *boundary_out = transport_boundary_out_cell(i, W, kind, sediment, depth_flow, f_left, f_right,
                                               f_top, f_bottom, dt);
   return s_new;

@@ -34,8 +34,9 @@ ERODEM_FN real water_exchange_cell(int i, int W, GLOBAL const erodem_kind_t* kin
  *   d <- d + dt (sum inflow - sum outflow) / area,
  * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the mean of the
  * depths before and after. Writes depth_out; returns through *exchange the net discharge
- * out of the domain through this cell's faces with ghosts (m^3/s) and through *clipped the
- * volume (m^3) added to lift a rounding-level negative depth back to zero. Branch-free. */
+ * out of the domain through this cell's faces with ghosts (m^3/s), through *clipped the
+ * volume (m^3) added to lift a rounding-level negative depth back to zero, and through *given
+ * the volume (m^3) the cell gave through its faces (0 for other cells). Branch-free. */
 ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                  GLOBAL const real* depth, GLOBAL real* depth_out,
                                  GLOBAL const real* f_left, GLOBAL const real* f_right,
@@ -43,7 +44,7 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
                                  GLOBAL const real* dx, GLOBAL const real* dy,
                                  GLOBAL const real* area, GLOBAL real* velocity_x,
                                  GLOBAL real* velocity_y, real dt, real velocity_min_depth,
-                                 real* exchange, real* clipped) {
+                                 real* exchange, real* clipped, real* given) {
   const int i = x + y * W;
   const int active = kind[i] == ERODEM_CELL_ACTIVE;
   /* what each neighbour gives to this cell */
@@ -62,6 +63,7 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   const real d_new = lift ? (real)0 : d_raw;
   const real clip = active & lift ? -d_raw * area[y] : (real)0;
   *clipped = clip;
+  *given = active ? dt * outflow : (real)0;
   depth_out[i] = active ? d_new : d_old;
 
   /* net outflow through faces shared with ghosts */

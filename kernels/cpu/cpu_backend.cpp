@@ -43,6 +43,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   take(depth_, s.depth);
   bed_next_ = bed_;
   bed0_ = bed_;
+  bed_residual_.assign(n, Real(0));
   depth_next_ = depth_;
   sediment_.assign(n, Real(0));
   sediment_next_ = sediment_;
@@ -59,6 +60,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   take(rain_factor_, s.rain_factor);
   row_sums_a_.assign(H_, 0.0);
   row_sums_b_.assign(H_, 0.0);
+  row_sums_c_.assign(H_, 0.0);
   run_boundary();
 }
 
@@ -93,13 +95,13 @@ void CpuBackend<Real>::run(Process p, const StepInputs& in, StepTally& tally) {
       run_water(dt, tally);
       break;
     case Process::erosion:
-      run_erosion(dt);
+      run_erosion(dt, tally);
       break;
     case Process::transport:
       run_transport(dt, tally);
       break;
     case Process::thermal:
-      run_thermal(dt);
+      run_thermal(dt, tally);
       break;
     case Process::evaporation:
       run_evaporation(dt, tally);
@@ -115,8 +117,8 @@ FieldStats CpuBackend<Real>::stats() {
   };
   std::vector<Row> rows(H_);
   const Kind* kind = kind_.data();
-  const Real *bed = bed_.data(), *depth = depth_.data(), *sediment = sediment_.data(),
-             *vx = velocity_x_.data(), *vy = velocity_y_.data();
+  const Real *bed = bed_.data(), *bed_lo = bed_residual_.data(), *depth = depth_.data(),
+             *sediment = sediment_.data(), *vx = velocity_x_.data(), *vy = velocity_y_.data();
   for_rows(1, H_ - 1, [&](int y) {
     Row row;
     const double a = area_[y];
@@ -129,7 +131,8 @@ FieldStats CpuBackend<Real>::stats() {
       const Real d = depth[i], b = bed[i], s = sediment[i];
       if (row.bad < 0 && !cell::cell_state_ok(b, d, s)) row.bad = row_cell + x;
       water += static_cast<double>(d) * a;
-      material += (static_cast<double>(b) + static_cast<double>(s)) * a;
+      material +=
+          (static_cast<double>(b) + static_cast<double>(bed_lo[i]) + static_cast<double>(s)) * a;
       sed += static_cast<double>(s) * a;
       if (d > max_d) {
         max_d = d;
@@ -206,6 +209,8 @@ typename CpuBackend<Real>::Field* CpuBackend<Real>::field_storage(FieldId id) {
       return &manning_;
     case FieldId::initial_bed:
       return &bed0_;
+    case FieldId::bed_residual:
+      return &bed_residual_;
     case FieldId::erosion:
       return nullptr;
   }
@@ -220,9 +225,12 @@ std::vector<double> CpuBackend<Real>::field(FieldId id) const {
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, r + 1);
+      // the bed and the erosion include the bed's residual (exact in double)
+      const double lo = static_cast<double>(bed_residual_[p]);
       out[static_cast<std::size_t>(r) * nx_ + c] =
-          src ? static_cast<double>((*src)[p])
-              : static_cast<double>(bed0_[p]) - static_cast<double>(bed_[p]);
+          !src                 ? (static_cast<double>(bed0_[p]) - static_cast<double>(bed_[p])) - lo
+          : id == FieldId::bed ? static_cast<double>(bed_[p]) + lo
+                               : static_cast<double>((*src)[p]);
     }
   return out;
 }
@@ -242,9 +250,12 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, r + 1);
-      const auto v = static_cast<Real>(values[static_cast<std::size_t>(r) * nx_ + c]);
+      const double value = values[static_cast<std::size_t>(r) * nx_ + c];
+      const auto v = static_cast<Real>(value);
       (*dst)[p] = v;
       if (twin) (*twin)[p] = v;
+      // a bed keeps what Real cannot hold in its residual (set bed_residual after the bed)
+      if (id == FieldId::bed) bed_residual_[p] = static_cast<Real>(value - static_cast<double>(v));
     }
 }
 

@@ -55,9 +55,9 @@ class CpuBackend final : public Backend {
   void run_sources(const StepInputs& in);
   void run_flow(Real dt);
   void run_water(Real dt, StepTally& tally);
-  void run_erosion(Real dt);
+  void run_erosion(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
-  void run_thermal(Real dt);
+  void run_thermal(Real dt, StepTally& tally);
   void run_evaporation(Real dt, StepTally& tally);
 
  private:
@@ -109,14 +109,16 @@ class CpuBackend final : public Backend {
   int threads_;
   std::vector<Kind> kind_;
   std::vector<Real> dx_, dy_, area_;  // per padded row
-  Field bed_, bed_next_, bed0_;
+  // The bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is only
+  // read and written at its own cell, so one buffer.
+  Field bed_, bed_next_, bed0_, bed_residual_;
   Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the
                               // flow step saw (used by conservative transport)
   Field sediment_, sediment_next_;
   std::array<Field, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
   Field velocity_x_, velocity_y_;
   Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
-  std::vector<double> row_sums_a_, row_sums_b_;  // scratch for per-row reductions
+  std::vector<double> row_sums_a_, row_sums_b_, row_sums_c_;  // scratch for per-row reductions
 };
 
 }  // namespace ERODEM_CPU_NAMESPACE

@@ -21,22 +21,25 @@ void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
                *ft = flux_[2].data(), *fb = flux_[3].data();
     for_rows(1, H - 1, [=](int y) {
       const Real step = dt;
-      const auto out_row = row_scratch(W);
-      Real* out = out_row.get();
+      const auto out_row = row_scratch(W), given_row = row_scratch(W);
+      Real *out = out_row.get(), *given = given_row.get();
       ERODEM_IVDEP
       for (int x = 1; x < W - 1; ++x) {
         const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
         const bool active = kind[i] == ERODEM_CELL_ACTIVE;
-        Real gone;
-        const Real s_new = cell::transport_conservative_cell(x, y, W, kind, sediment, depth_flow,
-                                                             fl, fr, ft, fb, area, step, &gone);
+        Real gone, gave;
+        const Real s_new = cell::transport_conservative_cell(
+            x, y, W, kind, sediment, depth_flow, fl, fr, ft, fb, area, step, &gone, &gave);
         const Real s_old = sediment[i];  // an unconditional load: if-convertible
         sediment_out[i] = active ? s_new : s_old;
         out[x] = active ? gone : Real(0);
+        given[x] = active ? gave : Real(0);
       }
       row_sums_a_[y] = sum_row(out, static_cast<std::size_t>(W));
+      row_sums_b_[y] = sum_row(given, static_cast<std::size_t>(W));
     });
     tally.sediment_out += sum_rows(row_sums_a_);
+    tally.sediment_exchanged += sum_rows(row_sums_b_);
   } else {
     const Real *u = velocity_x_.data(), *v = velocity_y_.data(), *dx = dx_.data(), *dy = dy_.data();
     for_rows(1, H - 1, [=](int y) {

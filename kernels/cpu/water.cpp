@@ -20,18 +20,21 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
   for_rows(1, H_ - 1, [=](int y) {
     // Locals, not closure members: stores to Real arrays could alias those.
     const Real step = dt, min_depth = d_min;
-    const auto exchange = row_scratch(W), clipped = row_scratch(W);
+    const auto exchange = row_scratch(W), clipped = row_scratch(W), given = row_scratch(W);
     Real* ex = exchange.get();
     Real* cl = clipped.get();
+    Real* gv = given.get();
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
       cell::water_update_cell(x, y, W, kind, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u, v,
-                              step, min_depth, ex + x, cl + x);
+                              step, min_depth, ex + x, cl + x, gv + x);
     row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
     row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
+    row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));
   });
   tally.boundary_water_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
   tally.clipped += sum_rows(row_sums_b_);
+  tally.water_exchanged += sum_rows(row_sums_c_);
   // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
   std::swap(depth_, depth_next_);
 }

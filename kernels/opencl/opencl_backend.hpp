@@ -137,9 +137,9 @@ class OpenClBackend final : public Backend {
   void run_sources(const StepInputs& in);
   void run_flow(Real dt);
   void run_water(Real dt, StepTally& tally);
-  void run_erosion(Real dt);
+  void run_erosion(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
-  void run_thermal(Real dt);
+  void run_thermal(Real dt, StepTally& tally);
   void run_evaporation(Real dt, StepTally& tally);
 
   /// A device buffer of `bytes`, filled from `data` where given. A buffer of a field (at
@@ -199,7 +199,9 @@ class OpenClBackend final : public Backend {
   std::size_t stagger_next_ = 0;   // make_buffer: the next field buffer's slot
   std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
   Buffer kind_, dx_, dy_, area_;
-  Buffer bed_, bed_next_, bed0_, depth_, depth_next_, sediment_, sediment_next_;
+  // the bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is read and
+  // written at its own cell only, so one buffer
+  Buffer bed_, bed_next_, bed0_, bed_residual_, depth_, depth_next_, sediment_, sediment_next_;
   std::array<Buffer, 4> flux_, flux_next_;
   Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;

@@ -51,11 +51,16 @@ typedef int8 acc8_mask_t;
 #define ERODEM_CELL_GROUP_MAX 1024
 
 /* The tally slots of the partials buffer. */
-#define ERODEM_TALLY_EXCHANGE 0   /* water: net discharge out through ghost faces (m^3/s) */
-#define ERODEM_TALLY_CLIPPED 1    /* water: volume added to lift rounding-level negatives */
-#define ERODEM_TALLY_SEDIMENT 2   /* conservative transport: sediment carried out */
-#define ERODEM_TALLY_EVAPORATED 3 /* evaporation: volume lost */
-#define ERODEM_TALLY_SLOTS 4
+#define ERODEM_TALLY_EXCHANGE 0       /* water: net discharge out through ghost faces (m^3/s) */
+#define ERODEM_TALLY_CLIPPED 1        /* water: volume added to lift rounding-level negatives */
+#define ERODEM_TALLY_SEDIMENT 2       /* conservative transport: sediment carried out */
+#define ERODEM_TALLY_EVAPORATED 3     /* evaporation: volume lost */
+#define ERODEM_TALLY_WATER_GIVEN 4    /* water: volume the cells gave through their faces */
+#define ERODEM_TALLY_ERODED 5         /* erosion: bed taken into suspension */
+#define ERODEM_TALLY_DEPOSITED 6      /* erosion: sediment laid down */
+#define ERODEM_TALLY_SEDIMENT_GIVEN 7 /* conservative transport: sediment the cells gave */
+#define ERODEM_TALLY_THERMAL 8        /* thermal: bed the cells gave to lower neighbours */
+#define ERODEM_TALLY_SLOTS 9
 
 /* Linear index of this work-group among the cell kernel's groups. */
 static inline int cell_group_index(void) {
@@ -111,4 +116,22 @@ static inline void cell_group_sum(__local real* s, real v, __global acc_t* out) 
    * kept per work-item (see field_stats in stats.cl) */
   if (get_local_id(0) == 0 && get_local_id(1) == 0)
     *out = cell_tallies_sum(s, (int)(get_local_size(0) * get_local_size(1)));
+}
+
+/* Two sums at once, a into *out_a and b into *out_b, each in the order of cell_group_sum;
+ * `s_a` and `s_b` hold at least the local size each. Every work-item must call it, once per
+ * kernel, instead of cell_group_sum (one barrier for both). Two arrays rather than two halves
+ * of one: PoCL did not vectorise the erosion kernel with stores at an offset of the local
+ * size (AMD EPYC without AVX-512, PoCL 3.1). */
+static inline void cell_group_sum2(__local real* s_a, __local real* s_b, real a, real b,
+                                   __global acc_t* out_a, __global acc_t* out_b) {
+  const int l = (int)get_local_id(0) + (int)get_local_id(1) * (int)get_local_size(0);
+  s_a[l] = a;
+  s_b[l] = b;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0 && get_local_id(1) == 0) {
+    const int n = (int)(get_local_size(0) * get_local_size(1));
+    *out_a = cell_tallies_sum(s_a, n);
+    *out_b = cell_tallies_sum(s_b, n);
+  }
 }

@@ -61,32 +61,35 @@ __kernel void reduce_change(int W, int H, __global const uchar* restrict kind,
  * writes partial g (see field_stats). ERODEM_GROUP_ONCE: see reduce.cl. */
 ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
                                          __local const real* s_d, __local const real* s_b,
-                                         __local const real* s_s, __local const real* s_u,
-                                         __local const real* s_v, __local const int* s_state,
-                                         __global const real* area, __global acc_t* sums,
-                                         __global long* cells) {
+                                         __local const real* s_r, __local const real* s_s,
+                                         __local const real* s_u, __local const real* s_v,
+                                         __local const int* s_state, __global const real* area,
+                                         __global acc_t* sums, __global long* cells) {
   const int last = min(n, W - x0); /* work-items inside the row */
   const acc_t a = (acc_t)area[row];
   const long row_cell = (long)(row - 1) * (long)(W - 2) - 1 + (long)x0; /* cell of local id 0 */
-  /* the three sums of cell_tallies_sum, in its order, in one loop: three chains of adds side
+  /* the four sums of cell_tallies_sum, in its order, in one loop: four chains of adds side
    * by side run in the time of one (each waits for its previous add) */
-  acc_t water = 0, bed_sum = 0, sed = 0;
+  acc_t water = 0, bed_sum = 0, res = 0, sed = 0;
   const int sum_blocks = last / 8;
   if (sum_blocks > 0) {
     acc8_t w8 = convert_acc8(vload8(0, s_d)), b8 = convert_acc8(vload8(0, s_b)),
-           s8 = convert_acc8(vload8(0, s_s));
+           r8 = convert_acc8(vload8(0, s_r)), s8 = convert_acc8(vload8(0, s_s));
     for (int k = 1; k < sum_blocks; ++k) {
       w8 += convert_acc8(vload8(k, s_d));
       b8 += convert_acc8(vload8(k, s_b));
+      r8 += convert_acc8(vload8(k, s_r));
       s8 += convert_acc8(vload8(k, s_s));
     }
     water = acc8_total(w8);
     bed_sum = acc8_total(b8);
+    res = acc8_total(r8);
     sed = acc8_total(s8);
   }
   for (int k = 8 * sum_blocks; k < last; ++k) {
     water += (acc_t)s_d[k];
     bed_sum += (acc_t)s_b[k];
+    res += (acc_t)s_r[k];
     sed += (acc_t)s_s[k];
   }
   /* maxima: the first largest value in local-id (= row) order, active cells only; lane j of
@@ -154,7 +157,7 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
     }
   }
   sums[5 * g + 0] = water * a;
-  sums[5 * g + 1] = (bed_sum + sed) * a;
+  sums[5 * g + 1] = ((bed_sum + res) + sed) * a; /* the bed pair (compensated.h) */
   sums[5 * g + 2] = sed * a;
   sums[5 * g + 3] = max_d;
   sums[5 * g + 4] = max_v;
@@ -173,15 +176,14 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
  * memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
  * cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row
  * (field_stats_group). */
-__kernel void field_stats(int W, int H, __global const uchar* restrict kind,
-                          __global const real* restrict bed, __global const real* restrict depth,
-                          __global const real* restrict sediment,
-                          __global const real* restrict velocity_x,
-                          __global const real* restrict velocity_y,
-                          __global const real* restrict area, __global acc_t* restrict sums,
-                          __global long* restrict cells) {
-  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_s[ERODEM_CELL_GROUP_MAX],
-      s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
+__kernel void field_stats(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict bed_residual, __global const real* restrict depth,
+    __global const real* restrict sediment, __global const real* restrict velocity_x,
+    __global const real* restrict velocity_y, __global const real* restrict area,
+    __global acc_t* restrict sums, __global long* restrict cells) {
+  __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_r[ERODEM_CELL_GROUP_MAX],
+      s_s[ERODEM_CELL_GROUP_MAX], s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
   __local int s_state[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
   /* work-items past the row (rounded global sizes only) read the row's first cell */
@@ -192,6 +194,7 @@ __kernel void field_stats(int W, int H, __global const uchar* restrict kind,
   /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
   s_d[l] = active ? d : (real)0;
   s_b[l] = active ? b : (real)0;
+  s_r[l] = active ? bed_residual[i] : (real)0;
   s_s[l] = active ? sd : (real)0;
   s_u[l] = active ? velocity_x[i] : (real)0;
   s_v[l] = active ? velocity_y[i] : (real)0;
@@ -206,7 +209,7 @@ __kernel void field_stats(int W, int H, __global const uchar* restrict kind,
                       (int)(get_group_id(0) * get_local_size(0) + get_global_offset(0)),
                       (int)get_local_size(0),
                       (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0), s_d,
-                      s_b, s_s, s_u, s_v, s_state, area, sums, cells);
+                      s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
 }
 
 /* The statistics of each padded row 1 .. H - 2 (r = y - 1 < rows) from the groups_x partials

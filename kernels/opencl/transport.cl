@@ -3,22 +3,31 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "transport.h"
 
-/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep their
- * sediment. The sediment carried out of the domain is summed over the cells beside ghosts
- * only (edges.cl). */
+/* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
+ * is rounded up, every work-item still reaches the group sum); ghosts keep their sediment.
+ * The sediment carried out of the domain is summed over the cells beside ghosts only
+ * (edges.cl); the sediment the cells gave per work-group into the tally partials. */
 __kernel void transport_conservative(
     int W, int H, __global const uchar* restrict kind, __global const real* restrict sediment,
     __global real* restrict sediment_out, __global const real* restrict depth_flow,
     __global const real* restrict f_left, __global const real* restrict f_right,
     __global const real* restrict f_top, __global const real* restrict f_bottom,
-    __global const real* restrict area, real dt) {
+    __global const real* restrict area, real dt, __global acc_t* restrict partials, int stride) {
+  __local real s_sum[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  if (ERODEM_PAST_ROW(x, W)) return;
-  const int i = x + y * W;
-  real carried; /* edge_tallies (unused here, so not computed) */
-  const real s_new = transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left,
-                                                 f_right, f_top, f_bottom, area, dt, &carried);
-  sediment_out[i] = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s_new : sediment[i];
+  real given = 0;
+  if (!ERODEM_PAST_ROW(x, W)) {
+    const int i = x + y * W;
+    const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+    real carried, gave; /* carried: edge_tallies (unused here) */
+    const real s_new =
+        transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left, f_right, f_top,
+                                    f_bottom, area, dt, &carried, &gave);
+    sediment_out[i] = active ? s_new : sediment[i];
+    given = active ? gave : (real)0;
+  }
+  cell_group_sum(s_sum, given,
+                 partials + ERODEM_TALLY_SEDIMENT_GIVEN * stride + cell_group_index());
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */

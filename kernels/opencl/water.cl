@@ -1,7 +1,8 @@
 /* erodem OpenCL — water process: kernels/common/water.h over the active cells (the CPU loop of
- * kernels/cpu/water.cpp). The volume lifted from rounding-level negatives is summed per
- * work-group into the tally partials (reduce.cl); the exchange through faces with ghosts is
- * summed over the cells beside ghosts only (edges.cl). The host swaps the depth buffers. */
+ * kernels/cpu/water.cpp). The volume lifted from rounding-level negatives and the volume the
+ * cells gave are summed per work-group into the tally partials (reduce.cl); the exchange through
+ * faces with ghosts is summed over the cells beside ghosts only (edges.cl). The host swaps the
+ * depth buffers. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "water.h"
 
@@ -19,11 +20,14 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
                            __global real* restrict velocity_x, __global real* restrict velocity_y,
                            real dt, real velocity_min_depth, __global acc_t* restrict partials,
                            int stride) {
-  __local real s[ERODEM_CELL_GROUP_MAX];
+  __local real s_clipped[ERODEM_CELL_GROUP_MAX], s_given[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  real exchange, clipped = 0; /* exchange: edge_tallies (unused here, so not computed) */
+  real exchange, clipped = 0, given = 0; /* exchange: edge_tallies (unused here) */
   if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, depth, depth_out, f_left, f_right, f_top, f_bottom, dx, dy,
-                      area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped);
-  cell_group_sum(s, clipped, partials + ERODEM_TALLY_CLIPPED * stride + cell_group_index());
+                      area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped,
+                      &given);
+  const int g = cell_group_index();
+  cell_group_sum2(s_clipped, s_given, clipped, given, partials + ERODEM_TALLY_CLIPPED * stride + g,
+                  partials + ERODEM_TALLY_WATER_GIVEN * stride + g);
 }

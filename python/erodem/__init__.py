@@ -620,9 +620,12 @@ class Simulation:
     def ledger(self) -> Dict[str, float]:
         """The conservation ledger (m^3, cumulative since the start): ``water_initial``,
         ``water``, ``rain``, ``inflow``, ``boundary_out``, ``evaporated``, ``clipped``,
-        ``closure_error``, ``relative_closure_error`` (1), ``material_initial``,
-        ``material``, ``sediment_out``, ``transport_change``, ``material_closure_error``,
-        ``relative_material_closure_error`` (1)."""
+        ``water_exchanged`` (given by cells through their faces), ``closure_error``,
+        ``water_moved``, ``relative_closure_error`` (1, of ``water_moved``),
+        ``material_initial``, ``material``, ``sediment_out``, ``transport_change``,
+        ``eroded``, ``deposited``, ``sediment_exchanged``, ``thermal_moved``,
+        ``material_closure_error``, ``material_moved``, ``relative_material_closure_error``
+        (1, of ``material_moved``). docs/model.md section 7 defines what moved."""
         return dict(self._sim.ledger)
 
     @property

@@ -24,7 +24,9 @@ METRICS = {
     "deposited_volume": "m^3: sum of max(bed - initial bed, 0) * cell area",
     "outflow_volume": "m^3: net water out through the boundary (ledger boundary_out)",
     "max_depth": "m: the largest max_depth over all steps",
-    "closure_error": "1: the water ledger's relative closure error at the end",
+    "closure_error": "1: the water ledger's closure error at the end, relative to the water moved",
+    "material_closure_error": "1: the material ledger's closure error at the end, relative to "
+    "the material moved",
     "wall_time": "s: wall time of the member (building the simulation and running it)",
 }
 
@@ -86,6 +88,7 @@ def run_member(spec: Dict[str, Any]) -> Dict[str, Any]:
             outflow_volume=ledger["boundary_out"],
             max_depth=sim.peak_depth,
             closure_error=ledger["relative_closure_error"],
+            material_closure_error=ledger["relative_material_closure_error"],
             steps=sim.steps_done,
             time=sim.time,
         )

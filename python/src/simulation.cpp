@@ -255,6 +255,8 @@ py::dict ledger_dict(const Ledger& l) {
   d["relative_closure_error"] = l.relative_closure_error();
   d["material_closure_error"] = l.material_closure_error();
   d["relative_material_closure_error"] = l.relative_material_closure_error();
+  d["water_moved"] = l.water_moved();
+  d["material_moved"] = l.material_moved();
   return d;
 }
 

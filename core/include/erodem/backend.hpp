@@ -46,12 +46,18 @@ struct StepTally {
   double clipped = 0.0;           ///< water added to lift rounding-level negative depths
   double sediment_out = 0.0;      ///< sediment carried out through the boundary
   double transport_change = 0.0;  ///< change of sum(s * area) by the transport step
+  // What moved inside the domain: the scales the ledger's closures are judged against.
+  double water_exchanged = 0.0;     ///< water the cells gave through their faces (m^3)
+  double eroded = 0.0;              ///< bed taken into suspension (m^3)
+  double deposited = 0.0;           ///< suspended sediment laid down on the bed (m^3)
+  double sediment_exchanged = 0.0;  ///< sediment the cells gave through their faces (m^3)
+  double thermal_moved = 0.0;       ///< bed moved between cells by slope collapse (m^3)
 };
 
 /// Reductions over the active cells, for the ledger and the stability check.
 struct FieldStats {
   double water_volume = 0.0;     ///< sum d * area (m^3)
-  double material_volume = 0.0;  ///< sum (b + s) * area (m^3)
+  double material_volume = 0.0;  ///< sum (b + b_residual + s) * area (m^3)
   double sediment_volume = 0.0;  ///< sum s * area (m^3)
   double max_depth = 0.0;        ///< m
   std::int64_t max_depth_cell = -1;

@@ -20,7 +20,8 @@ enum class FieldId {
   wetness,
   erosion,  ///< derived: initial bed - bed (m); negative = deposition
   manning_n,
-  initial_bed,  ///< bed at the start of the run (m); erosion = initial_bed - bed
+  initial_bed,   ///< bed at the start of the run (m); erosion = initial_bed - bed
+  bed_residual,  ///< the part of the bed below the precision of `bed` (m; compensated.h)
 };
 
 struct FieldInfo {

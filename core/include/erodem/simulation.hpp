@@ -27,6 +27,10 @@ struct Diagnostics {
   double rain_volume = 0.0, inflow_volume = 0.0, boundary_outflow_volume = 0.0;
   double evaporated_volume = 0.0, closure_error = 0.0;
   double max_depth = 0.0, max_speed = 0.0;
+  double eroded_volume = 0.0, deposited_volume = 0.0;  ///< cumulative (m^3)
+  double material_closure_error = 0.0;                 ///< m^3
+  double relative_closure_error = 0.0;                 ///< 1, of the water moved
+  double relative_material_closure_error = 0.0;        ///< 1, of the material moved
 };
 
 /// One series of the per-step diagnostics: its name (HDF5 `diagnostics/<name>`, a Python
@@ -39,7 +43,7 @@ struct DiagnosticsSeries {
 };
 
 /// Every series of the diagnostics, in file order.
-const std::array<DiagnosticsSeries, 11>& diagnostics_series();
+const std::array<DiagnosticsSeries, 16>& diagnostics_series();
 
 /// The state of a run between two steps: with the same terrain and parameters, a run
 /// restored from it continues exactly as the uninterrupted run would (same backend and
