@@ -23,12 +23,6 @@ class Physics : public ::testing::TestWithParam<Target> {
   double bound(double f64, double f32) const { return target().f64() ? f64 : f32; }
 };
 
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
-
 double max_speed(const Simulation& sim) {
   const auto u = sim.field(FieldId::velocity_x), v = sim.field(FieldId::velocity_y);
   double m = 0;
