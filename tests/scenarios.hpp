@@ -7,9 +7,11 @@
 #include <memory>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "erodem/backends.hpp"
 #include "erodem/simulation.hpp"
+#include "reference_solutions.hpp"
 
 namespace erodem::test {
 
@@ -98,6 +100,143 @@ inline Params quiet_params(FlowScheme scheme, double dt) {
   p.evaporation.rate = 0.0;
   p.rain.rate = 0.0;
   return p;
+}
+
+// ---- dam breaks -----------------------------------------------------------------------
+
+/// A 1-D dam break: a channel of `n` cells of `dx` m along x (3 rows between closed walls),
+/// water `h_up` m deep upstream of the dam at `x_dam` m from the west wall and `h_down`
+/// downstream, flat frictionless bed.
+struct DamBreak {
+  int n;
+  double dx, x_dam, h_up, h_down;
+  /// The channel's middle row, x measured from the dam.
+  Row row() const { return Row{n, dx, -x_dam}; }
+  Terrain terrain() const {
+    Terrain t = flat_terrain(n, 3, dx);
+    t.water_depth.assign(t.grid.cells(), 0.0);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < n; ++c)
+        t.water_depth[static_cast<std::size_t>(r) * n + c] = row().centre(c) < 0 ? h_up : h_down;
+    return t;
+  }
+  std::vector<double> initial_depth() const {
+    return row().sample([&](double x) { return x < 0 ? h_up : h_down; });
+  }
+};
+
+/// The middle row of a field of a 3-row channel.
+inline std::vector<double> middle_row(const Simulation& sim, FieldId id) {
+  const auto f = sim.field(id);
+  const int nx = sim.grid().nx;
+  return std::vector<double>(f.begin() + nx, f.begin() + 2 * nx);
+}
+
+/// A dam break's middle row after `t_end` s with `params`' fixed steps.
+struct DamBreakResult {
+  std::vector<double> depth, velocity;  ///< m, m/s (velocity_x)
+  double time = 0;                      ///< s
+  double water_drift = 0;               ///< relative change of the water volume
+};
+
+inline DamBreakResult run_dam_break(const DamBreak& db, const Params& params, double t_end,
+                                    const Target& target) {
+  auto sim = make_simulation(db.terrain(), params, target);
+  sim.step(static_cast<long>(t_end / params.time.dt + 0.5));
+  const auto& L = sim.ledger();
+  return {middle_row(sim, FieldId::water_depth), middle_row(sim, FieldId::velocity_x), sim.time(),
+          std::abs(L.water - L.water_initial) / L.water_initial};
+}
+
+// ---- processes run on a state held fixed ----------------------------------------------
+
+/// Sets a uniform flow eastwards on every cell: depth `h` (m), velocity_x `u` (m/s),
+/// velocity_y 0, and the outflow u h dy (m^3/s) through every east face (the last column's
+/// into the east ghost), none through the others. With the flow and water processes left out
+/// (run_processes) it stays so: the state erosion and transport see is held fixed.
+inline void set_uniform_flow(Simulation& sim, double h, double u) {
+  const Grid& g = sim.grid();
+  std::vector<double> east(g.cells());
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c) east[static_cast<std::size_t>(r) * g.nx + c] = u * h * g.dy[r];
+  const std::vector<double> zero(g.cells(), 0.0);
+  auto& b = sim.backend();
+  b.set_field(FieldId::water_depth, std::vector<double>(g.cells(), h));
+  b.set_field(FieldId::velocity_x, std::vector<double>(g.cells(), u));
+  b.set_field(FieldId::velocity_y, zero);
+  b.set_field(FieldId::flux_right, east);
+  b.set_field(FieldId::flux_left, zero);
+  b.set_field(FieldId::flux_top, zero);
+  b.set_field(FieldId::flux_bottom, zero);
+}
+
+/// Runs only `processes` of the simulation's backend, `steps` times with steps of `dt` s
+/// (Simulation::step always runs flow and water; Backend::run runs one process): every field
+/// the processes do not write stays as set. Returns the volumes that crossed the boundary.
+/// The simulation's time and ledger are left as they were.
+inline StepTally run_processes(Simulation& sim, const std::vector<Process>& processes, double dt,
+                               long steps) {
+  StepTally tally;
+  StepInputs in;
+  in.dt = dt;
+  for (long k = 0; k < steps; ++k) {
+    in.t = k * dt;
+    for (Process p : processes) sim.backend().run(p, in, tally);
+  }
+  sim.backend().stats();  // a backend may add to the tally as late as this
+  return tally;
+}
+
+/// Suspended sediment adapting to the capacity along a uniform flow held fixed: a channel of
+/// `length` m of `dx` m cells (3 rows), flat bed at 0, depth `depth`, speed `speed` eastwards,
+/// clear water entering through the west wall's face. Capacity C = K_c sin_min u (flat bed:
+/// the tilt's floor min_tilt applies), eroded at K_s with hardness 1. Steps of
+/// `courant` dx / u; erosion and transport only (run_processes).
+struct SedimentAdaptation {
+  double length = 100.0, depth = 1.0, speed = 1.0;   // m, m, m/s
+  double capacity_k = 0.02, dissolving_rate = 0.05;  // K_c (s), K_s (1/s)
+  double courant = 0.4;                              // u dt / dx
+  double capacity() const { return capacity_k * Params{}.erosion.min_tilt * speed; }
+  /// K_s dx / u: the adaptation length u / K_s in cells, inverted.
+  double resolution(double dx) const { return dissolving_rate * dx / speed; }
+  Params params(TransportScheme scheme, double dx) const {
+    Params p = quiet_params(FlowScheme::local_inertial, courant * dx / speed);
+    p.erosion.enabled = true;
+    p.erosion.sediment_capacity = capacity_k;
+    p.erosion.dissolving_rate = dissolving_rate;
+    p.transport.scheme = scheme;
+    return p;
+  }
+  struct Result {
+    Row row;
+    std::vector<double> sediment;  ///< middle row (m)
+    double material_closure;       ///< |sum (b + s) area + sediment out| / sum |b0 - b| area
+  };
+  /// Runs `duration` s and returns the middle row's sediment.
+  Result run(TransportScheme scheme, double dx, double duration, const Target& target) const {
+    const int n = static_cast<int>(length / dx + 0.5);
+    const Params p = params(scheme, dx);
+    auto sim = make_simulation(flat_terrain(n, 3, dx), p, target);
+    set_uniform_flow(sim, depth, speed);
+    const auto tally = run_processes(sim, {Process::erosion, Process::transport}, p.time.dt,
+                                     static_cast<long>(duration / p.time.dt + 0.5));
+    const auto bed = sim.field(FieldId::bed);
+    double moved = 0;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < n; ++c) moved += std::abs(bed[static_cast<std::size_t>(r) * n + c]);
+    moved *= dx * dx;
+    const double material = sim.backend().stats().material_volume;
+    return {Row{n, dx, 0.0}, middle_row(sim, FieldId::sediment),
+            std::abs(material + tally.sediment_out - tally.transport_change) / moved};
+  }
+};
+
+/// Sum of a row-major field times the cell areas (m^3 for a field in m).
+inline double volume_of(const Grid& g, const std::vector<double>& field) {
+  double v = 0;
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c) v += field[static_cast<std::size_t>(r) * g.nx + c] * g.area[r];
+  return v;
 }
 
 }  // namespace erodem::test

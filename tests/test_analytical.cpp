@@ -7,59 +7,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "reference_solutions.hpp"
 #include "scenarios.hpp"
 
 namespace erodem::test {
 namespace {
-
-constexpr double kG = 9.81;
-
-/// Stoker's (1957) wet-bed dam-break depth at distance x from the dam (m) and time t (s),
-/// upstream depth h0, downstream h1 (m), flat frictionless bed.
-struct Stoker {
-  double h0, h1, h2 = 0, u2 = 0, shock = 0;
-  Stoker(double up, double down) : h0(up), h1(down) {
-    // Middle state: rarefaction u2 = 2 (c0 - c2) equals the shock's u2 = S (1 - h1 / h2),
-    // S = sqrt(g h2 (h1 + h2) / (2 h1)); bisection on h2 in (h1, h0).
-    const double c0 = std::sqrt(kG * h0);
-    auto mismatch = [&](double h) {
-      const double s = std::sqrt(kG * h * (h1 + h) / (2 * h1));
-      return 2 * (c0 - std::sqrt(kG * h)) - s * (1 - h1 / h);
-    };
-    double lo = h1, hi = h0;
-    for (int k = 0; k < 200; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (mismatch(mid) > 0 ? lo : hi) = mid;
-    }
-    h2 = 0.5 * (lo + hi);
-    u2 = 2 * (c0 - std::sqrt(kG * h2));
-    shock = std::sqrt(kG * h2 * (h1 + h2) / (2 * h1));
-  }
-  double depth(double x, double t) const {
-    const double c0 = std::sqrt(kG * h0), c2 = std::sqrt(kG * h2);
-    if (x <= -c0 * t) return h0;
-    if (x <= (u2 - c2) * t) return std::pow(2 * c0 - x / t, 2) / (9 * kG);
-    if (x <= shock * t) return h2;
-    return h1;
-  }
-};
-
-/// A 1-D channel along x of `n` cells of `dx` m (3 rows between closed walls), water h_up
-/// upstream of x0 and h_down downstream.
-Terrain dam_break_terrain(int n, double dx, double x0, double h_up, double h_down) {
-  Terrain t = flat_terrain(n, 3, dx);
-  t.water_depth.assign(t.grid.cells(), 0.0);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < n; ++c)
-      t.water_depth[static_cast<std::size_t>(r) * n + c] = (c + 0.5) * dx < x0 ? h_up : h_down;
-  return t;
-}
-
-std::vector<double> middle_row(const Simulation& sim, FieldId id) {
-  const auto f = sim.field(id);
-  const int nx = sim.grid().nx;
-  return std::vector<double>(f.begin() + nx, f.begin() + 2 * nx);
-}
 
 class Analytical : public ::testing::TestWithParam<Target> {
  protected:
@@ -69,61 +21,198 @@ class Analytical : public ::testing::TestWithParam<Target> {
   }
 };
 
+// ---- dam breaks ------------------------------------------------------------------------
+//
+// Errors are taken over the region the wave reached, from the rarefaction's head x = -c0 t to
+// the downstream front, plus a margin of 20 m on each side; elsewhere every solver (an idle one
+// too) is exact, and a whole-channel norm would dilute the error (the old whole-channel Stoker
+// norm gave an idle solver 0.10 against a bound of 0.10). Each error is relative_l1: the L1
+// distance from the exact profile divided by that of the initial state, so a solver that does
+// nothing scores exactly 1 (depth) and 1 (velocity, the exact one is not 0 there). Fronts are
+// found by one depth threshold on the numerical and on the exact profile sampled at the same
+// cell centres.
+
+constexpr double kDamMargin = 20.0;  // m on each side of the reached region
+
+/// Depth and velocity errors of a dam-break result against an exact solution over [lo, hi].
+struct DamBreakErrors {
+  double depth, velocity, idle_depth, idle_velocity;
+};
+
+template <class Exact>
+DamBreakErrors dam_break_errors(const DamBreak& db, const DamBreakResult& r, const Exact& exact,
+                                double lo, double hi) {
+  const Row row = db.row();
+  const auto h = row.sample([&](double x) { return exact.depth(x, r.time); });
+  const auto u = row.sample([&](double x) { return exact.velocity(x, r.time); });
+  const auto h_idle = db.initial_depth();
+  const std::vector<double> u_idle(h_idle.size(), 0.0);
+  return {relative_l1(row, r.depth, h, h_idle, lo, hi),
+          relative_l1(row, r.velocity, u, u_idle, lo, hi),
+          relative_l1(row, h_idle, h, h_idle, lo, hi), relative_l1(row, u_idle, u, u_idle, lo, hi)};
+}
+
+/// Parameters of the dam-break runs: no friction, fixed steps of dt, the default theta (0.8,
+/// de Almeida et al. 2012). With theta = 1 (Bates et al. 2010) the local-inertial scheme has
+/// no dissipation at all: behind a shock it leaves grid-scale oscillations (+-0.3 m at 2 m
+/// and at 0.5 m cells) that do not shrink when dx does (LocalInertialDamBreakConverges
+/// prints that ladder too).
+Params dam_break_params(FlowScheme scheme, double dt, double theta = Params{}.flow.theta) {
+  Params p = quiet_params(scheme, dt);
+  p.flow.theta = theta;
+  return p;
+}
+
 TEST_P(Analytical, StokerWetDamBreak) {
-  const int n = 500;
-  const double dx = 2.0, x0 = 500.0, t_end = 40.0;
-  const Stoker exact(2.0, 1.0);
+  // 2 m onto 1 m, 1000 m channel of 2 m cells, 40 s with dt = 0.2 s (dt sqrt(g h0) / dx =
+  // 0.44). The rarefaction's head is then at -177 m, the shock at +212 m.
+  const DamBreak db{500, 2.0, 500.0, 2.0, 1.0};
+  const Stoker exact(db.h_up, db.h_down);
+  const double t_end = 40.0, lo = exact.head(t_end) - kDamMargin,
+               hi = exact.shock * t_end + kDamMargin;
+  const Row row = db.row();
+  const double h_mid = 0.5 * (exact.h1 + exact.h2);  // the shock is where h crosses this
+  const double shock_exact =
+      last_above(row, row.sample([&](double x) { return exact.depth(x, t_end); }), h_mid);
   for (FlowScheme scheme : {FlowScheme::local_inertial, FlowScheme::pipes}) {
-    Params p = quiet_params(scheme, 0.05);
-    p.flow.theta = 1.0;  // no diffusion, to see the scheme itself
-    p.flow.pipe_area = 1.0;
-    auto sim = make_simulation(dam_break_terrain(n, dx, x0, 2.0, 1.0), p, target());
-    sim.step(static_cast<long>(t_end / 0.05 + 0.5));
-    const auto d = middle_row(sim, FieldId::water_depth);
-    double err = 0, norm = 0;
-    for (int c = 0; c < n; ++c) {
-      const double h = exact.depth((c + 0.5) * dx - x0, sim.time());
-      err += std::abs(d[c] - h);
-      norm += h;
-    }
-    const double rel = err / norm;
+    Params p = dam_break_params(scheme, 0.2);
+    // The pipe model with a constant pipe area A is linear shallow water about the reference
+    // depth A / w (w = dy the face width): it moves A g dh / l per unit of surface drop, as a
+    // channel of depth A / w would, so its waves run at c^2 = g A dx / (l dy) whatever the
+    // depth. A = 1.5 m x 2 m makes that reference the mean depth 1.5 m (c = 3.84 m/s against
+    // Stoker's head at 4.43 m/s and shock at 5.30 m/s); it cannot form a shock or a fan of the
+    // right speeds, so its errors are reported, not bounded.
+    p.flow.pipe_area = 0.5 * (db.h_up + db.h_down) * db.dx;
+    const auto r = run_dam_break(db, p, t_end, target());
+    const auto e = dam_break_errors(db, r, exact, lo, hi);
+    const double shock = last_above(row, r.depth, h_mid);
+    const bool inertial = scheme == FlowScheme::local_inertial;
     std::printf(
-        "[Stoker] %s %s: relative L1 depth error %.4f at t = %.1f s (h2 = %.4f m, "
-        "shock %.3f m/s)%s\n",
-        target().label().c_str(), scheme_name(scheme), rel, sim.time(), exact.h2, exact.shock,
-        scheme == FlowScheme::local_inertial ? " (bound 0.10)" : " (reported)");
-    if (scheme == FlowScheme::local_inertial) {
-      EXPECT_LT(rel, 0.10);
+        "[Stoker] %s %s: over [%.0f, %.0f] m at t = %.1f s: depth error %.4f, velocity error "
+        "%.4f (bounds %s; idle solver %.4f, %.4f); shock at %.1f m, Stoker %.1f m (h2 = %.4f "
+        "m, u2 = %.4f m/s); water drift %.1e\n",
+        target().label().c_str(), scheme_name(scheme), lo, hi, r.time, e.depth, e.velocity,
+        inertial ? "0.35, 0.25" : "1, 1: it moved", e.idle_depth, e.idle_velocity, shock,
+        shock_exact, exact.h2, exact.u2, r.water_drift);
+    if (inertial) {
+      // Model error: without the advection term the scheme converges to another solution
+      // (LocalInertialDamBreakConverges), 0.27 / 0.19 from Stoker's at every dx from 4 m to
+      // 0.5 m, its shock 13 % slow. The bounds hold that model error with a margin that an
+      // idle solver (1, 1; its "shock" stays at the dam) or a scheme moving water the wrong
+      // way fails by far.
+      EXPECT_LT(e.depth, 0.35);
+      EXPECT_LT(e.velocity, 0.25);
+      EXPECT_GT(shock, 0.8 * shock_exact);
+      EXPECT_LT(shock, 1.05 * shock_exact);
+    } else {
+      EXPECT_LT(e.depth, 1.0) << "the pipes must have moved the water towards Stoker's profile";
+      EXPECT_LT(e.velocity, 1.0);
     }
   }
 }
 
-TEST_P(Analytical, RitterDryDamBreakFront) {
-  const int n = 500;
-  const double dx = 2.0, x0 = 400.0, h0 = 1.0, t_end = 30.0;
-  const double ritter = 2 * std::sqrt(kG * h0) * t_end;  // front travel (m)
-  for (FlowScheme scheme : {FlowScheme::local_inertial, FlowScheme::pipes}) {
-    Params p = quiet_params(scheme, 0.05);
-    auto sim = make_simulation(dam_break_terrain(n, dx, x0, h0, 0.0), p, target());
-    sim.step(static_cast<long>(t_end / 0.05 + 0.5));
-    const auto d = middle_row(sim, FieldId::water_depth);
-    int last = 0;
-    for (int c = 0; c < n; ++c)
-      if (d[c] > 1e-3 * h0) last = c;
-    const double front = (last + 1) * dx - x0;
-    const double rel = (front - ritter) / ritter;
-    std::printf(
-        "[Ritter] %s %s: front travelled %.1f m, Ritter 2 sqrt(g h0) t = %.1f m, "
-        "error %+.1f %%\n",
-        target().label().c_str(), scheme_name(scheme), front, ritter, 100 * rel);
-    // The local-inertial scheme drops advection, and near a dry front the flow is
-    // supercritical, where that term dominates: its front lags Ritter's (measured -56 % at
-    // 2 m cells, 2026-11-22). Bound with margin; a front that did not move or overtook the
-    // exact one would mean a broken scheme.
-    if (scheme == FlowScheme::local_inertial) {
-      EXPECT_GT(front, 0.3 * ritter);
-      EXPECT_LT(front, 1.05 * ritter);
+TEST_P(Analytical, LocalInertialDamBreakConverges) {
+  // The local-inertial scheme drops the advection term d(hu^2)/dx, so it converges to the
+  // solution of its own equations, not to Stoker's (its Stoker error stays at 0.27 from dx =
+  // 4 m to 0.5 m). This checks that it converges, and at what order, against its own finest
+  // solution: the Stoker set-up on 600 m with dx = 4, 2, 1 m against 0.5 m, dt / dx fixed at
+  // 0.1 s/m (dt sqrt(g h0) / dx = 0.44 on every grid), finer solutions restricted to the
+  // coarse cells by averaging. The distances from the 0.5 m solution overstate the order (at
+  // dx = 1 m that solution's own error is half the distance: a true order 1/2 would read 0.9
+  // and 1.3), so the bound is on the distances between successive grids, whose ratio is 2^p
+  // for an error C dx^p. A first-order scheme reaches 1 only asymptotically; with the
+  // rarefaction's corners and the shock smeared over a few cells it measured 0.55 and 0.62
+  // here (0.72 between 1 m and 0.5 m against 0.25 m), hence the bound 0.5. An idle or
+  // non-convergent solver fails it: unchanged states give 0 / 0, and theta = 1, whose
+  // oscillations do not shrink, 0.30 and 0.13 (printed on cpu_float64, not asserted).
+  const Stoker exact(2.0, 1.0);
+  const double t_end = 40.0, length = 600.0;
+  const double lo = exact.head(t_end) - kDamMargin, hi = exact.shock * t_end + kDamMargin;
+  const std::vector<double> sizes{4.0, 2.0, 1.0, 0.5};
+  for (double theta : {Params{}.flow.theta, 1.0}) {
+    const bool asserted = theta < 1.0;
+    if (!asserted && (target().backend != "cpu" || !target().f64())) continue;  // once is enough
+    std::vector<DamBreak> grids;
+    std::vector<DamBreakResult> runs;
+    for (double dx : sizes) {
+      grids.push_back(DamBreak{static_cast<int>(length / dx + 0.5), dx, 0.5 * length, 2.0, 1.0});
+      runs.push_back(run_dam_break(grids.back(),
+                                   dam_break_params(FlowScheme::local_inertial, 0.1 * dx, theta),
+                                   t_end, target()));
     }
+    // L1 distance (m^2, or m^2/s for the velocity) of level k from level j restricted to k
+    auto distance = [&](std::size_t k, std::size_t j, bool velocity) {
+      const int factor = static_cast<int>(sizes[k] / sizes[j] + 0.5);
+      const auto& a = velocity ? runs[k].velocity : runs[k].depth;
+      const auto& b = velocity ? runs[j].velocity : runs[j].depth;
+      return l1_in(grids[k].row(), a, restrict_mean(b, factor), lo, hi) * sizes[k];
+    };
+    for (bool velocity : {false, true}) {
+      double ref[3], succ[3];
+      for (std::size_t k = 0; k < 3; ++k) {
+        ref[k] = distance(k, 3, velocity);
+        succ[k] = distance(k, k + 1, velocity);
+      }
+      const double p1 = observed_order(succ[0], succ[1]), p2 = observed_order(succ[1], succ[2]);
+      std::printf(
+          "[local inertial convergence] %s theta %.1f %s: L1 from the 0.5 m solution at dx = "
+          "4, 2, 1 m: %.4g, %.4g, %.4g (orders %.3f, %.3f); between successive grids %.4g, "
+          "%.4g, %.4g: orders %.3f, %.3f (bound %s)\n",
+          target().label().c_str(), theta, velocity ? "velocity" : "depth", ref[0], ref[1], ref[2],
+          observed_order(ref[0], ref[1]), observed_order(ref[1], ref[2]), succ[0], succ[1], succ[2],
+          p1, p2, asserted ? "> 0.5" : "none: reported");
+      if (asserted) {
+        EXPECT_GT(p1, 0.5);
+        EXPECT_GT(p2, 0.5);
+        EXPECT_LT(ref[2], ref[1]);
+        EXPECT_LT(ref[1], ref[0]);
+      }
+    }
+    if (!asserted) continue;
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+      const auto e = dam_break_errors(grids[k], runs[k], exact, lo, hi);
+      std::printf(
+          "[local inertial vs Stoker] %s dx = %.1f m: depth error %.4f, velocity error %.4f "
+          "(model error: no advection term; reported)\n",
+          target().label().c_str(), sizes[k], e.depth, e.velocity);
+    }
+  }
+}
+
+TEST_P(Analytical, RitterDryDamBreak) {
+  // 1 m onto a dry bed, 1000 m channel of 2 m cells, 30 s with dt = 0.2 s. The fan runs from
+  // -94 m to Ritter's front at 2 c0 t = +188 m; the front is where h crosses 1 mm, on the
+  // exact profile at +179 m.
+  const DamBreak db{500, 2.0, 400.0, 1.0, 0.0};
+  const Ritter exact{db.h_up};
+  const double t_end = 30.0, h_th = 1e-3, lo = exact.head(t_end) - kDamMargin,
+               hi = exact.front(t_end) + kDamMargin;
+  const Row row = db.row();
+  const double front_exact =
+      last_above(row, row.sample([&](double x) { return exact.depth(x, t_end); }), h_th);
+  for (FlowScheme scheme : {FlowScheme::local_inertial, FlowScheme::pipes}) {
+    Params p = dam_break_params(scheme, 0.2);
+    p.flow.pipe_area = 0.5 * db.h_up * db.dx;  // reference depth h0 / 2 (StokerWetDamBreak)
+    const auto r = run_dam_break(db, p, t_end, target());
+    const auto e = dam_break_errors(db, r, exact, lo, hi);
+    const double front = last_above(row, r.depth, h_th);
+    std::printf(
+        "[Ritter] %s %s: over [%.0f, %.0f] m: depth error %.4f, velocity error %.4f (bounds "
+        "0.8, 0.9; idle solver %.4f, %.4f); front (h > %.0e m) at %.1f m, Ritter %.1f m (%+.0f "
+        "%%, bound -70 .. +5 %%); water drift %.1e\n",
+        target().label().c_str(), scheme_name(scheme), lo, hi, e.depth, e.velocity, e.idle_depth,
+        e.idle_velocity, h_th, front, front_exact, 100 * (front / front_exact - 1), r.water_drift);
+    // Neither scheme has the advection term that dominates the supercritical flow near a dry
+    // front: the fronts lag Ritter's by 64 % (local inertial) and 58 % (pipes) here, and no
+    // less on finer grids (local inertial 74, 65, 62, 59 m and pipes 82, 75, 73, 70 m at
+    // dx = 4, 2, 1, 0.5 m: model error, not resolution); the region errors sit at 0.5 - 0.8
+    // of an idle solver's.
+    // The bounds are sanity bounds: a front that did not move (idle: 0 m) or overtook
+    // Ritter's, or profiles no closer than an idle solver's, fail.
+    EXPECT_LT(e.depth, 0.8);
+    EXPECT_LT(e.velocity, 0.9);
+    EXPECT_GT(front, 0.3 * front_exact);
+    EXPECT_LT(front, 1.05 * front_exact);
   }
 }
 
@@ -210,18 +299,125 @@ TEST_P(Analytical, ThermalRelaxesToTalusAngle) {
       if (c + 1 < n) worst = std::max(worst, std::abs(b[i] - b[i + 1]) / dx);
       if (r + 1 < n) worst = std::max(worst, std::abs(b[i] - b[i + n]) / dx);
     }
-  const double tan_talus = std::tan(talus * M_PI / 180.0);
+  // The steepest slope left between two neighbours, as an angle: relaxation stops exactly
+  // when no drop exceeds dx tan(talus), and the last transfers approach that from above, so
+  // the angle must sit at the talus angle from both sides. The upper side catches a scheme
+  // that stops early (an idle one keeps the block's 87.1 deg walls); the lower side a scheme
+  // that slumps too far or uses another angle (a block relaxed with a talus of 30 deg reads
+  // 30.0 deg here: 5 deg outside the band, since its steepest drop is dx tan(30 deg) and the
+  // block, 20 m high on 10 m, keeps some drop at the talus).
+  const double angle = std::atan(worst) * 180.0 / M_PI;
   const auto& L = sim.ledger();
   const double drift = std::abs(L.material - L.material_initial) / L.material_initial;
   const double peak = *std::max_element(b.begin(), b.end());
   std::printf(
-      "[thermal] %s: steepest slope %.5f, tan(talus) %.5f, ratio %.5f (bound 1.01); "
-      "peak %.2f m; material drift %.2e (bound %.0e)\n",
-      target().label().c_str(), worst, tan_talus, worst / tan_talus, peak, drift,
+      "[thermal] %s: steepest slope %.4f deg, talus %.1f deg (bound +-1 deg; idle solver %.1f "
+      "deg); peak %.2f m; material drift %.2e (bound %.0e)\n",
+      target().label().c_str(), angle, talus, std::atan(20.0 / dx) * 180.0 / M_PI, peak, drift,
       target().f64() ? 1e-12 : 1e-5);
-  EXPECT_LT(worst, 1.01 * tan_talus);
+  EXPECT_NEAR(angle, talus, 1.0);
   EXPECT_LT(peak, 19.0) << "the block must have collapsed";
   EXPECT_LT(drift, target().f64() ? 1e-12 : 1e-5);
+}
+
+TEST_P(Analytical, SedimentAdaptsToCapacityAlongUniformFlow) {
+  const SedimentAdaptation set;
+  const double cap = set.capacity(), duration = 2 * set.length / set.speed;
+  const std::vector<double> sizes{1.0, 0.5, 0.25};
+  auto error = [&](const Row& row, const std::vector<double>& s) {
+    const auto exact = row.sample(
+        [&](double x) { return adapted_sediment(cap, set.dissolving_rate, set.speed, x); });
+    return l1_in(row, s, exact, 0, set.length) / (row.n * cap);
+  };
+  const Row coarse{static_cast<int>(set.length / sizes[0] + 0.5), sizes[0], 0.0};
+  const double idle = error(coarse, std::vector<double>(coarse.n, 0.0));
+  const double untransported = error(coarse, std::vector<double>(coarse.n, cap));
+  // Uniform flow of 1 m/s, 1 m deep, held fixed (SedimentAdaptation: erosion and transport
+  // run alone on a state set with set_field, since Simulation::step always runs flow and
+  // water); C = 1 mm, K_s = 0.05 /s, so the adaptation length u / K_s is 20 m and the 100 m
+  // channel is 5 of them; 200 s (twice the transit time) reaches the steady state. Hardness 1,
+  // K_s dt <= 0.02 (no clamp), s < C everywhere (erosion only), bed change <= 1 cm on a flat
+  // bed (its tilt stays below min_tilt, so C stays K_c min_tilt u). The resolution
+  // a = K_s dx / u is 0.05, 0.025, 0.0125 at u dt / dx = 0.4: at a = 0.5 the first cell would
+  // already sit near C and the test could not fail. Error: mean |s - s_exact| / C over the
+  // channel (s_exact at the cell centres). Upwind transport after a split erosion step
+  // relaxes by r = (1 - a nu) / (1 + a (1 - nu)) per cell (nu = u dt / dx), a decay rate
+  // wrong by a (1 - 2 nu) / 2 relative, and its first cell is off by a (nu - 1/2): first order,
+  // with an error about a / 50 here (so not nu = 1/2, where the leading terms cancel). The
+  // bounds: order > 0.8 on both halvings, and the error < a / 10 at each a. An idle solver
+  // scores 0.80 and erosion without transport 0.20 (s = C everywhere), at every a (order 0).
+  for (TransportScheme scheme : {TransportScheme::conservative, TransportScheme::semi_lagrangian}) {
+    double e[3], closure = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto r = set.run(scheme, sizes[k], duration, target());
+      e[k] = error(r.row, r.sediment);
+      closure = std::max(closure, r.material_closure);
+    }
+    std::printf(
+        "[sediment adaptation] %s %s: mean |s - C(1 - exp(-K_s x/u))| / C at K_s dx/u = %.4g, "
+        "%.4g, %.4g: %.4g, %.4g, %.4g (orders %.3f, %.3f); idle solver %.4f, erosion without "
+        "transport %.4f; material closure %.1e\n",
+        target().label().c_str(), scheme_name(scheme), set.resolution(sizes[0]),
+        set.resolution(sizes[1]), set.resolution(sizes[2]), e[0], e[1], e[2],
+        observed_order(e[0], e[1]), observed_order(e[1], e[2]), idle, untransported, closure);
+    if (scheme == TransportScheme::semi_lagrangian) {
+      // Not asserted: the departure point is clamped to the grid, so the first cell reads its
+      // own sediment, not the clear water entering through the wall. The inflow boundary is
+      // zero-gradient, every cell settles at C, and the scheme scores exactly as erosion
+      // without transport (0.1986 at every a): it cannot represent a clear inflow.
+      continue;
+    }
+    EXPECT_GT(observed_order(e[0], e[1]), 0.8);
+    EXPECT_GT(observed_order(e[1], e[2]), 0.8);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_LT(e[k], 0.1 * set.resolution(sizes[k]));
+    EXPECT_LT(closure, target().f64() ? 1e-12 : 1e-4) << "erosion and transport conserve";
+  }
+}
+
+TEST_P(Analytical, EvaporationFollowsTheExplicitDecay) {
+  // A lake at rest, 1 m deep, on 10 x 10 cells of 100 m; K_e = 0.01 /s with dt = 10 s, so
+  // K_e dt = 0.1 and 20 steps leave d0 0.9^20 = 0.1216 m. The step is large on purpose: the
+  // exact ODE's d0 exp(-K_e t) = 0.1353 m is 11 % off, so a scheme integrating anything but
+  // the explicit rule fails, as does an idle one (d0: +723 %). Bounds: rounding, 1e-12 in
+  // float64 and 1e-5 in float32 (20 float steps of 2^-24 each), on every cell's depth and on
+  // the evaporated volume the ledger books against the volume the lake lost.
+  const double d0 = 1.0, rate = 0.01, dt = 10.0;
+  const long n = 20;
+  Params p = quiet_params(FlowScheme::local_inertial, dt);
+  p.evaporation.rate = rate;
+  p.initial.water_depth.value = d0;
+  auto sim = make_simulation(flat_terrain(10, 10, 100.0), p, target());
+  sim.step(n);
+  const double expected = evaporated_depth(d0, rate, dt, n);
+  const auto d = sim.field(FieldId::water_depth);
+  double worst = 0;
+  for (double v : d) worst = std::max(worst, std::abs(v - expected) / expected);
+  const auto& L = sim.ledger();
+  const double lost = L.water_initial - L.water;
+  const double booked = std::abs(L.evaporated - lost) / lost;
+  std::printf(
+      "[evaporation] %s: depth after %ld steps %.6f m, d0 (1 - K_e dt)^n = %.6f m, worst relative "
+      "error %.2e (idle solver %.2f, d0 exp(-K_e t) %.4f); evaporated %.4f m^3 booked vs lost "
+      "%.2e\n",
+      target().label().c_str(), n, d[0], expected, worst, (d0 - expected) / expected,
+      std::abs(d0 * std::exp(-rate * dt * n) - expected) / expected, L.evaporated, booked);
+  const double limit = target().f64() ? 1e-12 : 1e-5;
+  EXPECT_LT(worst, limit);
+  EXPECT_LT(booked, limit);
+  EXPECT_LT(max_abs(sim.field(FieldId::velocity_x)), limit) << "the lake stays at rest";
+
+  // K_e dt = 1.5 is clamped to 1: one step evaporates everything, and books all of it.
+  p.evaporation.rate = 0.15;
+  auto dry = make_simulation(flat_terrain(10, 10, 100.0), p, target());
+  dry.step();
+  const auto d1 = dry.field(FieldId::water_depth);
+  const auto& L1 = dry.ledger();
+  std::printf(
+      "[evaporation] %s: K_e dt = 1.5: max depth after one step %.3e m; evaporated %.6g "
+      "of %.6g m^3\n",
+      target().label().c_str(), max_abs(d1), L1.evaporated, L1.water_initial);
+  EXPECT_EQ(max_abs(d1), 0.0);
+  EXPECT_NEAR(L1.evaporated, L1.water_initial, limit * L1.water_initial);
 }
 
 }  // namespace
