@@ -65,8 +65,8 @@ ERODEM_FN real transport_capacity(real capacity_k, real tilt_sin, real min_tilt,
  * and the bed pair gives exactly m - e, so bed + sediment changes only by the rounding of
  * the residual (about 2^-24 ulp(bed) in float32). A plain float bed would keep only the part
  * of m above half an ulp of the bed: erosion and deposition below it were lost, or rounded
- * one way (docs/model.md, "Precision"). Branch-free (both cases evaluated, one selected), so
- * loops over cells vectorise. */
+ * one way (docs/model.md section 1, "The bed is a compensated pair"). Branch-free (both cases
+ * evaluated, one selected), so loops over cells vectorise. */
 ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                             GLOBAL const real* bed, GLOBAL const real* bed_residual,
                             GLOBAL const real* sediment, GLOBAL const real* depth,

@@ -52,6 +52,7 @@ FIELDS = (
     "erosion",
     "manning_n",
     "initial_bed",
+    "bed_residual",
 )
 
 Settings = List[Tuple[str, str]]

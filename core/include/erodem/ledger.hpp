@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 
 namespace erodem {
@@ -31,7 +32,7 @@ struct Ledger {
 
   /// The relative closures' floor: the closure of a run in which nothing moved is judged
   /// against this fraction of the volume on the grid (the rounding of a double sum).
-  static constexpr double kVolumeEpsilon = 2.220446049250313e-16;
+  static constexpr double kVolumeEpsilon = std::numeric_limits<double>::epsilon();
 
   /// V(t) - V(0) - rain - inflow + out + evaporated - clipped: 0 up to rounding (m^3).
   double closure_error() const {
