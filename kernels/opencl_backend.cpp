@@ -878,8 +878,8 @@ void OpenClBackend::run_flow(Real dt) {
 
 void OpenClBackend::run_water(Real dt, StepTally& tally) {
   cl_kernel k = kernel("water_update");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, depth_next_, flux_[0], flux_[1], flux_[2],
-           flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
+           flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
            static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
            static_cast<cl_int>(tally_stride_));
   defer(tally, kExchangeBit | kClippedBit | kWaterGivenBit);

@@ -94,6 +94,31 @@ inline double evaporated_depth(double d0, double rate, double dt, long n) {
   return d0 * std::pow(1 - std::min(1.0, rate * dt), static_cast<double>(n));
 }
 
+/// Rain of intensity `rain` (m/s) from t = 0 on a dry plane of length `length` (m), slope
+/// `slope` (1, the sine's tangent) and Manning n `manning` (s m^-1/3): the kinematic-wave
+/// discharge per unit width at its foot (Eagleson 1970; Singh 1996): h = i t and
+/// q = alpha h^(5/3), alpha = sqrt(S) / n, until the characteristic from the top arrives at
+/// t_e = (L / (alpha i^(2/3)))^(3/5); from then on q = i L.
+struct KinematicPlane {
+  double length, slope, manning, rain;
+  double alpha() const { return std::sqrt(slope) / manning; }
+  double t_equilibrium() const {
+    return std::pow(length / (alpha() * std::pow(rain, 2.0 / 3.0)), 0.6);
+  }
+  /// Discharge per unit width (m^2/s) leaving the foot at time t (s).
+  double outlet(double t) const {
+    const double te = t_equilibrium();
+    return t < te ? alpha() * std::pow(rain * t, 5.0 / 3.0) : rain * length;
+  }
+  /// Volume per unit width (m^2) that left the foot between t = 0 and t (s).
+  double outlet_volume(double t) const {
+    const double te = t_equilibrium();
+    const double rising = 0.375 * alpha() * std::pow(rain, 5.0 / 3.0);  // 3/8 alpha i^(5/3)
+    return t < te ? rising * std::pow(t, 8.0 / 3.0)
+                  : rising * std::pow(te, 8.0 / 3.0) + rain * length * (t - te);
+  }
+};
+
 // ---- profiles on a 1-D row of cells ----------------------------------------------------
 
 /// A 1-D profile sampled at the centres of `n` cells of `dx` m, the first one's west face at

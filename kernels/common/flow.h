@@ -175,6 +175,18 @@ ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_k
  * from 0. */
 #define ERODEM_FACE_DEPTH_MIN 1.0e-16f
 
+/* Flow depth (m) at the face between cells a and b of depths d and beds b (m): the water
+ * above the higher bed, max(b_a + d_a, b_b + d_b) - max(b_a, b_b), written with the bed step
+ * db = b_b - b_a as max(d_a, d_b + db) - max(db, 0). The two are equal in exact arithmetic,
+ * but the first subtracts elevations: in float32 at 9000 m it rounds to ulp(9000 m) = 1e-3 m,
+ * the depth of a whole film. The step between neighbours is exact by Sterbenz wherever their
+ * beds are within a factor of two, so this form rounds only at the size of d and db. The
+ * local-inertial discharge and every cell velocity (water.h) use it. */
+ERODEM_FN real face_flow_depth(real d_a, real d_b, real b_a, real b_b) {
+  const real db = b_b - b_a;
+  return erodem_max(d_a, d_b + db) - erodem_max(db, (real)0);
+}
+
 /* Discharge per unit width (m^2/s) across a face at the old time, from the outflow of the
  * cell before it towards the cell after it, out_ab, the outflow back, out_ba (m^3/s), and
  * the face width (m). */
@@ -182,19 +194,31 @@ ERODEM_FN real face_unit_discharge(real out_ab, real out_ba, real width) {
   return (out_ab - out_ba) / width;
 }
 
-/* New discharge per unit width q (m^2/s) across one face, positive from a to b:
- *   q <- (theta q + (1 - theta)/2 (q_up + q_down) - g h_f dt (eta_b - eta_a) / dist)
- *        / (1 + g dt n^2 |q| / h_f^(7/3)),   h_f = max(eta_a, eta_b) - max(b_a, b_b).
+/* New discharge per unit width q' (m^2/s) across one face, positive from a to b, with the
+ * friction implicit in the new discharge:
+ *   q' (1 + F |q'|) = N,   N = theta q + (1 - theta)/2 (q_up + q_down)
+ *                              - g h_f dt (eta_b - eta_a) / dist,
+ *   F = g dt n^2 / h_f^(7/3),   h_f = max(eta_a, eta_b) - max(b_a, b_b) (face_flow_depth),
+ * solved exactly: q' = 2 N / (1 + sqrt(1 + 4 F |N|)) (the root of the quadratic without
+ * cancellation). de Almeida et al. (2012) take |q| of the old time in F instead; where
+ * F |N| >> 1 (a thin film on a steep cell: 1 mm on a slope of 0.5 with dt = 5 s gives
+ * 4 F |N| ~ 4e4) that iteration q -> (q + G) / (1 + F q) has slope -> -1 at its fixed
+ * point, so the discharge swings about the Manning value from step to step and its
+ * peaks, limited only by what the cell holds, reached dx/dt (59.9 m/s on Big Tujunga).
+ * The implicit root is the Manning discharge h_f^(5/3) S^(1/2) / n there whatever dt is,
+ * and the same fixed point as before wherever flow is steady (docs/model.md section 5,
+ * "Friction"). n = 0 gives q' = N exactly (2N / 2), so frictionless runs are unchanged.
  * q, q_up, q_down: this face and its two neighbours in the same direction at the old time
- * (m^2/s); eta, b: water surface and bed of both cells (m); n: Manning n of the face
+ * (m^2/s); d, b: depth and bed of both cells (m), eta = b + d; n: Manning n of the face
  * (s m^-1/3); dist between cell centres (m); dt (s); gravity (m/s^2); theta in [0, 1];
  * faces with h_f <= dry_depth (m), or h_f <= ERODEM_FACE_DEPTH_MIN whatever dry_depth is,
  * carry nothing. Branch-free: a dry face is evaluated on h_f = 1 and its result replaced
  * by 0. */
-ERODEM_FN real local_inertial_q(real q, real q_up, real q_down, real eta_a, real eta_b, real b_a,
+ERODEM_FN real local_inertial_q(real q, real q_up, real q_down, real d_a, real d_b, real b_a,
                                 real b_b, real n, real dist, real dt, real gravity, real theta,
                                 real dry_depth) {
-  const real h_raw = (eta_a > eta_b ? eta_a : eta_b) - (b_a > b_b ? b_a : b_b);
+  const real eta_a = b_a + d_a, eta_b = b_b + d_b;
+  const real h_raw = face_flow_depth(d_a, d_b, b_a, b_b);
   /* one threshold, the same for every face (hoisted out of the cell loops) */
   const real wet_above =
       dry_depth > (real)ERODEM_FACE_DEPTH_MIN ? dry_depth : (real)ERODEM_FACE_DEPTH_MIN;
@@ -203,25 +227,27 @@ ERODEM_FN real local_inertial_q(real q, real q_up, real q_down, real eta_a, real
   const real numerator = theta * q + ((real)1 - theta) * (real)0.5 * (q_up + q_down) -
                          gravity * h_f * dt * (eta_b - eta_a) / dist;
   const real h_f_7_3 = h_f * h_f * erodem_cbrt_positive(h_f); /* normal, > 0 */
-  const real denominator = (real)1 + gravity * dt * n * n * fabs(q) / h_f_7_3;
-  const real q_new = numerator / denominator;
+  /* 4 F |N|: |N| in the numerator, so N = 0 gives 0 (never 0 * inf); an overflow to inf
+   * gives q' = 0 */
+  const real four_f_n = (real)4 * gravity * dt * n * n * fabs(numerator) / h_f_7_3;
+  const real q_new = (real)2 * numerator / ((real)1 + sqrt((real)1 + four_f_n));
   return wet ? q_new : (real)0;
 }
 
 /* Discharge (m^3/s) across one face, positive from cell a to cell b, from the unit
  * discharges of the previous step: q of this face, q_up of the face before a and q_down of
  * the face after b (m^2/s), each used when the cell beyond is no wall (up_open, down_open;
- * else q stands in). open: whether water crosses the face at all (face_open). Surfaces
- * eta = bed + depth and beds b (m), Manning n of both cells (s m^-1/3), face width and
+ * else q stands in). open: whether water crosses the face at all (face_open). Depths d
+ * and beds b (m), Manning n of both cells (s m^-1/3), face width and
  * distance between the cell centres (m), dt (s), gravity (m/s^2), theta (1), dry_depth (m). */
 ERODEM_FN real local_inertial_face(int open, int up_open, int down_open, real q, real q_up,
-                                   real q_down, real eta_a, real eta_b, real b_a, real b_b,
-                                   real n_a, real n_b, real width, real dist, real dt, real gravity,
+                                   real q_down, real d_a, real d_b, real b_a, real b_b, real n_a,
+                                   real n_b, real width, real dist, real dt, real gravity,
                                    real theta, real dry_depth) {
   const real n = (real)0.5 * (n_a + n_b);
   const real discharge =
-      width * local_inertial_q(q, up_open ? q_up : q, down_open ? q_down : q, eta_a, eta_b, b_a,
-                               b_b, n, dist, dt, gravity, theta, dry_depth);
+      width * local_inertial_q(q, up_open ? q_up : q, down_open ? q_down : q, d_a, d_b, b_a, b_b, n,
+                               dist, dt, gravity, theta, dry_depth);
   return open ? discharge : (real)0;
 }
 
@@ -239,9 +265,9 @@ ERODEM_FN real local_inertial_face_at(int a, int b, int up, int down, int up_ope
   return local_inertial_face(face_open(kind[a], kind[b]), up_open, down_open,
                              face_unit_discharge(out_ab[a], out_ba[b], width),
                              face_unit_discharge(out_ab[up], out_ba[a], width_up),
-                             face_unit_discharge(out_ab[b], out_ba[down], width_down),
-                             bed[a] + depth[a], bed[b] + depth[b], bed[a], bed[b], manning[a],
-                             manning[b], width, dist, dt, gravity, theta, dry_depth);
+                             face_unit_discharge(out_ab[b], out_ba[down], width_down), depth[a],
+                             depth[b], bed[a], bed[b], manning[a], manning[b], width, dist, dt,
+                             gravity, theta, dry_depth);
 }
 
 /* Discharge (m^3/s) across the face between padded cells (x, y) and (x + 1, y), positive

@@ -6,15 +6,24 @@
 
 ERODEM_BEGIN_NAMESPACE
 
-/* Depth-averaged velocity (m/s) from the discharge through the two opposite faces of a cell:
- * through_a, through_b (m^3/s, positive in the velocity's direction), the face width (m)
- * and the mean depth (m); 0 where the mean depth is below min_depth (m). Branch-free, so
- * loops over cells vectorise. */
-ERODEM_FN real face_velocity(real through_a, real through_b, real width, real mean_depth,
-                             real min_depth) {
+/* Depth-averaged velocity (m/s) of a cell along one axis: the mean of the velocities through
+ * its two opposite faces, each the face's discharge through_a, through_b (m^3/s, positive in
+ * the velocity's direction) over its flow area, width (m) times its flow depth depth_a,
+ * depth_b (m; face_flow_depth, the depth the flow step used). 0 where the cell's mean depth of
+ * the step, mean_depth (m), is below min_depth (m); a face depth below min_depth counts as
+ * min_depth. The flow depth, not the cell's mean depth: a thin cell that a deep neighbour
+ * pours into carries the neighbour's discharge at the neighbour's depth (a 0.5 m pool spilling
+ * into a 1 mm cell read 73 m/s from discharge over mean depth, and the adaptive step, which
+ * takes the largest speed, shrank to milliseconds). Branch-free, so loops over cells
+ * vectorise. */
+ERODEM_FN real face_velocity(real through_a, real depth_a, real through_b, real depth_b, real width,
+                             real mean_depth, real min_depth) {
   const int flowing = (mean_depth >= min_depth) & (mean_depth > 0);
-  const real safe_depth = flowing ? mean_depth : (real)1;
-  const real v = (through_a + through_b) * (real)0.5 / (width * safe_depth);
+  const real floor =
+      min_depth > (real)ERODEM_FACE_DEPTH_MIN ? min_depth : (real)ERODEM_FACE_DEPTH_MIN;
+  const real h_a = depth_a > floor ? depth_a : floor;
+  const real h_b = depth_b > floor ? depth_b : floor;
+  const real v = (through_a / h_a + through_b / h_b) * (real)0.5 / width;
   return flowing ? v : (real)0;
 }
 
@@ -32,19 +41,21 @@ ERODEM_FN real water_exchange_cell(int i, int W, GLOBAL const erodem_kind_t* kin
 
 /* Water update of padded cell (x, y) (active cells change; others keep their depth):
  *   d <- d + dt (sum inflow - sum outflow) / area,
- * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the mean of the
- * depths before and after. Writes depth_out; returns through *exchange the net discharge
- * out of the domain through this cell's faces with ghosts (m^3/s), through *clipped the
- * volume (m^3) added to lift a rounding-level negative depth back to zero, and through *given
- * the volume (m^3) the cell gave through its faces (0 for other cells). Branch-free. */
+ * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the faces' flow depths
+ * (face_velocity; bed (m) gives those, unchanged since the flow step). Writes depth_out; returns
+ * through *exchange the net discharge out of the domain through this cell's faces with ghosts
+ * (m^3/s), through *clipped the volume (m^3) added to lift a rounding-level negative depth back to
+ * zero, and through *given the volume (m^3) the cell gave through its faces (0 for other cells).
+ * Branch-free. */
 ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                                 GLOBAL const real* depth, GLOBAL real* depth_out,
-                                 GLOBAL const real* f_left, GLOBAL const real* f_right,
-                                 GLOBAL const real* f_top, GLOBAL const real* f_bottom,
-                                 GLOBAL const real* dx, GLOBAL const real* dy,
-                                 GLOBAL const real* area, GLOBAL real* velocity_x,
-                                 GLOBAL real* velocity_y, real dt, real velocity_min_depth,
-                                 real* exchange, real* clipped, real* given) {
+                                 GLOBAL const real* bed, GLOBAL const real* depth,
+                                 GLOBAL real* depth_out, GLOBAL const real* f_left,
+                                 GLOBAL const real* f_right, GLOBAL const real* f_top,
+                                 GLOBAL const real* f_bottom, GLOBAL const real* dx,
+                                 GLOBAL const real* dy, GLOBAL const real* area,
+                                 GLOBAL real* velocity_x, GLOBAL real* velocity_y, real dt,
+                                 real velocity_min_depth, real* exchange, real* clipped,
+                                 real* given) {
   const int i = x + y * W;
   const int active = kind[i] == ERODEM_CELL_ACTIVE;
   /* what each neighbour gives to this cell */
@@ -70,10 +81,17 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   *exchange = active ? water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom) : (real)0;
 
   const real d_mean = (real)0.5 * (d_old + d_new);
-  const real u =
-      face_velocity(in_left - f_left[i], f_right[i] - in_right, dy[y], d_mean, velocity_min_depth);
-  const real v =
-      face_velocity(in_bottom - f_bottom[i], f_top[i] - in_top, dx[y], d_mean, velocity_min_depth);
+  /* the flow depths of the four faces, as the flow step saw them (same bed and depth) */
+  const real b = bed[i];
+  const real b_l = bed[i - 1], b_r = bed[i + 1], b_t = bed[i - W], b_b = bed[i + W];
+  const real h_l = face_flow_depth(depth[i - 1], d_old, b_l, b);
+  const real h_r = face_flow_depth(d_old, depth[i + 1], b, b_r);
+  const real h_t = face_flow_depth(depth[i - W], d_old, b_t, b);
+  const real h_b = face_flow_depth(d_old, depth[i + W], b, b_b);
+  const real u = face_velocity(in_left - f_left[i], h_l, f_right[i] - in_right, h_r, dy[y], d_mean,
+                               velocity_min_depth);
+  const real v = face_velocity(in_bottom - f_bottom[i], h_b, f_top[i] - in_top, h_t, dx[y], d_mean,
+                               velocity_min_depth);
   velocity_x[i] = active ? u : (real)0;
   velocity_y[i] = active ? v : (real)0;
 }

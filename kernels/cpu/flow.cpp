@@ -62,10 +62,10 @@ void face_y_row(int j, int W, int H, const int* __restrict k_up, const int* __re
   const Real dt = p.dt, g = p.gravity, theta = p.theta, dry = p.dry_depth;
   ERODEM_IVDEP
   for (int x = 0; x < W; ++x)
-    out[x] = cell::local_inertial_face(cell::face_open(k_a[x], k_b[x]), k_up[x] != ERODEM_CELL_WALL,
-                                       k_down[x] != ERODEM_CELL_WALL, q[x], qu[x], qd[x],
-                                       b_a[x] + d_a[x], b_b[x] + d_b[x], b_a[x], b_b[x], n_a[x],
-                                       n_b[x], width, dist, dt, g, theta, dry);
+    out[x] =
+        cell::local_inertial_face(cell::face_open(k_a[x], k_b[x]), k_up[x] != ERODEM_CELL_WALL,
+                                  k_down[x] != ERODEM_CELL_WALL, q[x], qu[x], qd[x], d_a[x], d_b[x],
+                                  b_a[x], b_b[x], n_a[x], n_b[x], width, dist, dt, g, theta, dry);
 }
 
 /// Discharges (m^3/s) of the faces east of the cells x = 0 .. W - 2 of padded row y; `q` is
@@ -86,8 +86,8 @@ void face_x_row(int y, int W, const int* __restrict k, const Real* __restrict be
   // used when cells x - 1 and x + 2 are no walls (outside the row: walls).
   auto face = [&](int x, int up_open, int down_open, Real q_up, Real q_down) {
     return cell::local_inertial_face(cell::face_open(k[x], k[x + 1]), up_open, down_open, q[x],
-                                     q_up, q_down, b[x] + d[x], b[x + 1] + d[x + 1], b[x], b[x + 1],
-                                     n[x], n[x + 1], width, dist, dt, g, theta, dry);
+                                     q_up, q_down, d[x], d[x + 1], b[x], b[x + 1], n[x], n[x + 1],
+                                     width, dist, dt, g, theta, dry);
   };
   // W >= 3: the padded raster has at least one DEM column.
   out[0] = face(0, 0, k[2] != ERODEM_CELL_WALL, q[0], q[1]);

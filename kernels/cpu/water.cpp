@@ -12,8 +12,8 @@ template <class Real>
 void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
   const Real d_min = static_cast<Real>(params_.numerics.velocity_min_depth);
   const Kind* kind = kind_.data();
-  const Real *depth = depth_.data(), *fl = flux_[0].data(), *fr = flux_[1].data(),
-             *ft = flux_[2].data(), *fb = flux_[3].data();
+  const Real *bed = bed_.data(), *depth = depth_.data(), *fl = flux_[0].data(),
+             *fr = flux_[1].data(), *ft = flux_[2].data(), *fb = flux_[3].data();
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   Real *depth_out = depth_next_.data(), *u = velocity_x_.data(), *v = velocity_y_.data();
   const int W = W_;
@@ -26,8 +26,8 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
     Real* gv = given.get();
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
-      cell::water_update_cell(x, y, W, kind, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u, v,
-                              step, min_depth, ex + x, cl + x, gv + x);
+      cell::water_update_cell(x, y, W, kind, bed, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u,
+                              v, step, min_depth, ex + x, cl + x, gv + x);
     row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
     row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
     row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));

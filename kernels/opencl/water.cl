@@ -11,8 +11,8 @@
  * branch-free and keeps the ghosts' depth (the first and last column are ghosts; their
  * velocity is 0). */
 __kernel void water_update(int W, int H, __global const uchar* restrict kind,
-                           __global const real* restrict depth, __global real* restrict depth_out,
-                           __global const real* restrict f_left,
+                           __global const real* restrict bed, __global const real* restrict depth,
+                           __global real* restrict depth_out, __global const real* restrict f_left,
                            __global const real* restrict f_right,
                            __global const real* restrict f_top,
                            __global const real* restrict f_bottom, __global const real* restrict dx,
@@ -24,8 +24,8 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real exchange, clipped = 0, given = 0; /* exchange: edge_tallies (unused here) */
   if (!ERODEM_PAST_ROW(x, W))
-    water_update_cell(x, y, W, kind, depth, depth_out, f_left, f_right, f_top, f_bottom, dx, dy,
-                      area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped,
+    water_update_cell(x, y, W, kind, bed, depth, depth_out, f_left, f_right, f_top, f_bottom, dx,
+                      dy, area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped,
                       &given);
   const int g = cell_group_index();
   cell_group_sum2(s_clipped, s_given, clipped, given, partials + ERODEM_TALLY_CLIPPED * stride + g,
