@@ -148,6 +148,34 @@ inline DamBreakResult run_dam_break(const DamBreak& db, const Params& params, do
           std::abs(L.water - L.water_initial) / L.water_initial};
 }
 
+// ---- uniform flow down a plane ---------------------------------------------------------
+
+/// A channel of `n` cells of `dx` m (3 rows) of slope `slope` falling eastwards to an open
+/// outlet, Manning n `manning`, fed with `q` m^2/s by a line inflow across the first column,
+/// starting at half the normal depth (q n / sqrt S)^(3/5). Local inertial.
+struct ManningPlane {
+  int n = 200;
+  double dx = 10.0, slope = 1e-3, manning = 0.03, q = 0.5;
+  double normal_depth() const { return std::pow(q * manning / std::sqrt(slope), 0.6); }
+  Terrain terrain() const {
+    Terrain t = flat_terrain(n, 3, dx);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < n; ++c)
+        t.bed[static_cast<std::size_t>(r) * n + c] = slope * (n - c - 0.5) * dx;
+    t.water_depth.assign(t.grid.cells(), 0.5 * normal_depth());
+    return t;
+  }
+  /// Fixed steps of `dt` s (the caller may make them adaptive).
+  Params params(double dt) const {
+    Params p = quiet_params(FlowScheme::local_inertial, dt);
+    p.flow.manning_n.value = manning;
+    p.boundary.east = BoundaryKind::open;
+    const double width = 3 * dx;
+    p.inflow.push_back(InflowSpec{{{0.5 * dx, 0.0}, {0.5 * dx, width}}, {{0.0, q * width}}});
+    return p;
+  }
+};
+
 // ---- processes run on a state held fixed ----------------------------------------------
 
 /// Sets a uniform flow eastwards on every cell: depth `h` (m), velocity_x `u` (m/s),

@@ -10,6 +10,7 @@
 
 #include "erodem/error.hpp"
 #include "scenarios.hpp"
+#include "validation_record.hpp"
 
 namespace erodem::test {
 namespace {
@@ -22,6 +23,11 @@ class Physics : public ::testing::TestWithParam<Target> {
   }
   /// Rounding-level bound: `f64` in float64, `f32` in float32.
   double bound(double f64, double f32) const { return target().f64() ? f64 : f32; }
+  /// A figure of the validation report (validation_record.hpp) measured on this target.
+  validation::Figure figure(const char* case_id, const char* scheme, const char* quantity,
+                            double resolution, const char* reference) const {
+    return {case_id, target().label(), scheme, quantity, resolution, reference};
+  }
 };
 
 double max_speed(const Simulation& sim) {
@@ -127,9 +133,14 @@ TEST_P(Physics, SemiLagrangianLossIsMeasured) {
       closure, bound(1e-12, 1e-5));
   // The loss is the scheme's, not rounding: a conservative scheme, or an idle one (nothing
   // eroded: 0 / 0), fails the first bound.
-  EXPECT_GT(lost, 0.01) << "semi-Lagrangian advection loses part of the eroded material";
-  EXPECT_GT(v_eroded, 1e-3 * L.material_initial) << "erosion must have moved material";
-  EXPECT_LT(closure, bound(1e-12, 1e-5)) << "the ledger must account for the change";
+  auto fig = [&](const char* quantity) {
+    return figure("semi_lagrangian_loss", "semi_lagrangian", quantity, 10.0,
+                  "conservation (a conservative scheme loses 0)");
+  };
+  validation::expect_above(fig("lost / eroded volume"), lost, 0.01);
+  validation::expect_above(fig("eroded / initial material"), v_eroded / L.material_initial, 1e-3);
+  validation::expect_below(fig("ledger closure with transport_change"), closure,
+                           bound(1e-12, 1e-5));
 }
 
 // ---- a non-erodible floor -------------------------------------------------------------
@@ -205,11 +216,23 @@ TEST_P(Physics, BedrockLevelIsNeverCut) {
       "the floor the bed reaches %.3f m\n",
       target().label().c_str(), rock, steps, deepest, tol_bed, max_abs(offset), v_eroded, v_above,
       vol_error, bound(1e-12, 1e-5), closure, free_low);
-  EXPECT_LT(free_low, rock - 0.05) << "the case must be one where erosion would cut the floor";
-  EXPECT_GE(deepest, -tol_bed) << "the bed went below the floor (or below its start)";
-  EXPECT_LT(max_abs(offset), tol_bed) << "every cell ends at min(start, floor)";
-  EXPECT_LT(vol_error, bound(1e-12, 1e-5));
-  EXPECT_LT(closure, bound(1e-12, 1e-5));
+  auto fig = [&](const char* quantity) {
+    return figure("bedrock", "conservative", quantity, 1.0,
+                  "the floor: no cell below min(start, bedrock_level)");
+  };
+  // the case must be one where erosion would cut the floor
+  validation::expect_below(fig("lowest bed without the floor (m)"), free_low, rock - 0.05);
+  // the bed never went below the floor (or below its start)
+  validation::expect_above(fig("lowest b - min(b0, floor) over the run (m)"), deepest, -tol_bed);
+  validation::expect_below(fig("final max |b - min(b0, floor)| (m)"), max_abs(offset), tol_bed);
+  validation::expect_below(fig("eroded vs volume above the floor (relative)"), vol_error,
+                           bound(1e-12, 1e-5));
+  validation::expect_below(fig("material closure (relative)"), closure, bound(1e-12, 1e-5));
+  const Row row{60, 1.0, 0.0};
+  validation::profile(
+      fig(""), "bed", {"x", "bed", "bed_initial", "floor"},
+      {row.sample([](double x) { return x; }), std::vector<double>(b.begin() + 60, b.begin() + 120),
+       std::vector<double>(b0.begin() + 60, b0.begin() + 120), std::vector<double>(60, rock)});
 }
 
 // ---- depth never negative; instability stops the run ----------------------------------
