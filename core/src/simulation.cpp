@@ -278,7 +278,10 @@ double Simulation::source_rise_rate() const {
 }
 
 std::vector<Process> Simulation::sequence() const {
-  std::vector<Process> seq{Process::boundary, Process::sources, Process::flow, Process::water};
+  // The sources run after the flow: the fluxes of a step come from the depth at its start,
+  // and the step's rain and inflows enter the continuity update with them (model.md
+  // section 2).
+  std::vector<Process> seq{Process::boundary, Process::flow, Process::sources, Process::water};
   if (params_.erosion.enabled) {
     seq.push_back(Process::erosion);
     seq.push_back(Process::transport);
