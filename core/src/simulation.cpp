@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "erodem/error.hpp"
@@ -73,6 +74,13 @@ double series_value(const Series& s, double t) {
   return lo->value + w * (hi->value - lo->value);
 }
 
+double series_max(const Series& s, double t0, double t1) {
+  double m = std::max(series_value(s, t0), series_value(s, t1));
+  for (const auto& p : s)
+    if (p.t > t0 && p.t < t1) m = std::max(m, p.value);
+  return m;
+}
+
 const std::vector<FieldId>& state_fields() {
   static const std::vector<FieldId> ids{
       FieldId::bed,        FieldId::initial_bed, FieldId::water_depth, FieldId::sediment,
@@ -106,22 +114,32 @@ void Simulation::restore(const RestartPoint& point) {
   time_ = point.time;
   steps_ = point.steps;
   ledger_ = point.ledger;
-  stats_ = backend_->stats();
+  state_changed();
   diag_ = diagnostics_now(0.0);
 }
 
+const FieldStats& Simulation::current_stats() const {
+  if (stale_) {
+    stats_ = backend_->stats();
+    if (!coast_cells_.empty()) coast_depth_ = coast_depth(backend_->field(FieldId::bed));
+    stale_ = false;
+  }
+  return stats_;
+}
+
 Diagnostics Simulation::diagnostics_now(double dt) const {
+  const FieldStats& stats = current_stats();
   return Diagnostics{time_,
                      dt,
-                     stats_.water_volume,
-                     stats_.material_volume,
+                     stats.water_volume,
+                     stats.material_volume,
                      ledger_.rain,
                      ledger_.inflow,
                      ledger_.boundary_out,
                      ledger_.evaporated,
                      ledger_.closure_error(),
-                     stats_.max_depth,
-                     stats_.max_speed,
+                     stats.max_depth,
+                     stats.max_speed,
                      ledger_.eroded,
                      ledger_.deposited,
                      ledger_.material_closure_error(),
@@ -137,11 +155,21 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
       const auto i = static_cast<std::size_t>(r) * g.nx + c;
-      if (terrain_.active(i))
-        rain_area_ += g.area[r] * (terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[i]);
+      if (!terrain_.active(i)) continue;
+      const double factor = terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[i];
+      rain_area_ += g.area[r] * factor;
+      rain_factor_max_ = std::max(rain_factor_max_, factor);
     }
+  if (!terrain_.rain_factor.empty()) {
+    rain_factor_max_ = 0.0;
+    for (std::size_t i = 0; i < terrain_.rain_factor.size(); ++i)
+      if (terrain_.active(i))
+        rain_factor_max_ = std::max(rain_factor_max_, terrain_.rain_factor[i]);
+  }
   resolve_inflows();
+  find_coast_cells();
   stats_ = backend_->stats();
+  coast_depth_ = coast_depth(terrain_.bed);
   if (stats_.bad_cell >= 0)
     throw Error(ExitCode::data, "initial state: cell " + cell_name(stats_.bad_cell) +
                                     " has a NaN, infinite or negative value");
@@ -190,10 +218,70 @@ void Simulation::resolve_inflows() {
                          "are in the DEM's CRS and inside the grid)");
     inflows_.push_back(std::move(ic));
   }
+  std::map<std::int64_t, std::size_t> slot;  // cell -> index into source_cells_
+  for (std::size_t k = 0; k < inflows_.size(); ++k)
+    for (auto cell : inflows_[k].cells) {
+      const auto [it, added] = slot.emplace(cell, source_cells_.size());
+      if (added) source_cells_.push_back({g.area[static_cast<std::size_t>(cell / g.nx)], {}});
+      source_cells_[it->second].inflows.push_back(k);
+    }
+}
+
+void Simulation::find_coast_cells() {
+  const auto& g = terrain_.grid;
+  const auto& b = params_.boundary;
+  const bool sea = b.nodata == NodataKind::sea;
+  // Whether the neighbour (c, r) of an active cell is a fixed-level cell: an edge ghost of a
+  // fixed_level edge, or a nodata cell that is sea (initial_state.cpp gives the kinds).
+  auto fixed = [&](int c, int r) {
+    if (c < 0) return b.west == BoundaryKind::fixed_level;
+    if (c >= g.nx) return b.east == BoundaryKind::fixed_level;
+    if (r < 0) return b.north == BoundaryKind::fixed_level;
+    if (r >= g.ny) return b.south == BoundaryKind::fixed_level;
+    return sea && !terrain_.active(static_cast<std::size_t>(r) * g.nx + c);
+  };
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * g.nx + c;
+      if (terrain_.active(i) &&
+          (fixed(c - 1, r) || fixed(c + 1, r) || fixed(c, r - 1) || fixed(c, r + 1)))
+        coast_cells_.push_back(static_cast<std::int64_t>(i));
+    }
+}
+
+double Simulation::coast_depth(const std::vector<double>& bed) const {
+  // A fixed-level cell g beside active cell a holds its surface at sea_level over a bed no
+  // higher than a's (boundary.h, initial_state.cpp), so the flow kernel's face depth
+  // h_f = max(eta_g, eta_a) - max(b_g, b_a) = max(sea_level - b_a, d_a).
+  double h = 0.0;
+  for (auto cell : coast_cells_)
+    h = std::max(h, params_.boundary.sea_level - bed[static_cast<std::size_t>(cell)]);
+  return h;
+}
+
+double Simulation::source_rise_rate() const {
+  // Inputs are taken at the step's midpoint t + dt / 2 (inputs_for), within [t, t + dt_max / 2].
+  const double t0 = time_, t1 = time_ + 0.5 * params_.time.dt_max;
+  const auto& rain = params_.rain;
+  const double rain_rate = rain.series.empty() ? rain.rate : series_max(rain.series, t0, t1);
+  double per_cell_max = 0.0;  // the largest inflow rise rate of one cell (m/s)
+  std::vector<double> q(inflows_.size());
+  for (std::size_t k = 0; k < inflows_.size(); ++k)
+    q[k] = series_max(params_.inflow[inflows_[k].spec].hydrograph, t0, t1) /
+           static_cast<double>(inflows_[k].cells.size());
+  for (const auto& sc : source_cells_) {
+    double sum = 0.0;
+    for (auto k : sc.inflows) sum += q[k];
+    per_cell_max = std::max(per_cell_max, sum / sc.area);
+  }
+  return std::max(rain_rate, 0.0) * rain_factor_max_ + per_cell_max;
 }
 
 std::vector<Process> Simulation::sequence() const {
-  std::vector<Process> seq{Process::boundary, Process::sources, Process::flow, Process::water};
+  // The sources run after the flow: the fluxes of a step come from the depth at its start,
+  // and the step's rain and inflows enter the continuity update with them (model.md
+  // section 2).
+  std::vector<Process> seq{Process::boundary, Process::flow, Process::sources, Process::water};
   if (params_.erosion.enabled) {
     seq.push_back(Process::erosion);
     seq.push_back(Process::transport);
@@ -209,16 +297,40 @@ double Simulation::next_dt() const {
   if (t.adaptive) {
     const double g = params_.flow.gravity;
     const double dx_min = terrain_.grid.dx_min();
+    const FieldStats& stats = current_stats();
+    // The depth the flow kernel sees in this step: the deepest cell's after this step's
+    // sources, d_max + s dt (s: source_rise_rate), and at a fixed-level face the sea's depth
+    // over the active cell's bed (coast_depth). dt is the largest step whose fastest signal
+    // crosses at most alpha dx_min.
+    const double reach = t.cfl * dx_min;
+    const double d = std::max(stats.max_depth, 0.0), s = source_rise_rate();
     dt = t.dt_max;
-    // The fastest signal: gravity waves (sqrt(g d)) carried by the flow (|u|). Local
-    // inertial drops advection, so sqrt(g d) alone keeps it stable (Bates et al. 2010), but
-    // a thin film on a steep cell is supercritical (1 mm on a slope of 1: u = 0.33 m/s,
-    // sqrt(g d) = 0.10 m/s): where its kinematic wave crosses more than a cell per step the
-    // outflow limit cuts the discharge and the run-off lags (on a 100 m plane of slope 1
-    // with 1 m cells and dt = 5 s the outlet reached half its equilibrium discharge at 213 s,
-    // not 112 s; tests/test_runoff.cpp).
-    const double signal = stats_.max_speed + std::sqrt(g * stats_.max_depth);
-    if (signal > 0) dt = std::min(dt, t.cfl * dx_min / signal);
+    if (coast_depth_ > 0) dt = std::min(dt, reach / std::sqrt(g * coast_depth_));
+    // The fastest signal is a gravity wave carried by the flow, u + sqrt(g h). Local inertial
+    // drops advection, so sqrt(g h) alone keeps it stable (Bates et al. 2010), but a thin
+    // film on a steep cell is supercritical (1 mm on a slope of 1: u = 0.33 m/s,
+    // sqrt(g h) = 0.10 m/s), and where its kinematic wave crosses more than a cell per step
+    // the outflow limit cuts the discharge and the run-off lags (a 100 m plane of slope 1,
+    // 1 m cells, dt = 5 s: the outlet reached half its equilibrium discharge at 213 s, not
+    // 112 s; tests/test_runoff.cpp). So dt is the root of the increasing, convex
+    // f(dt) = dt (u_max + sqrt(g (d_max + s dt))) - alpha dx_min.
+    const double u = std::max(stats.max_speed, 0.0);
+    if (d > 0 || s > 0 || u > 0) {
+      // Newton from the right of the root: both starts have f >= 0, and f is convex and
+      // increasing for dt > 0, so the iterates fall monotonically onto the root.
+      double x = HUGE_VAL;
+      if (d > 0 || u > 0) x = reach / (u + std::sqrt(g * d));
+      if (s > 0) x = std::min(x, std::cbrt(reach * reach / (g * s)));
+      for (int k = 0; k < 100; ++k) {
+        const double c = std::sqrt(g * (d + s * x));
+        const double f = x * (u + c) - reach;
+        const double slope = u + c + (c > 0 ? x * g * s / (2.0 * c) : 0.0);
+        const double next = x - f / slope;
+        if (!(next < x)) break;
+        x = next;
+      }
+      dt = std::min(dt, x);
+    }
     if (params_.flow.scheme == FlowScheme::pipes) {
       // Stability of the pipe oscillator: dt < sqrt(l * area / (2 A g)).
       double area_min = HUGE_VAL;
@@ -273,26 +385,31 @@ std::string Simulation::cell_name(std::int64_t cell) const {
   return fmt::format("(col {}, row {}; x {:.6g}, y {:.6g})", col, row, xy[0], xy[1]);
 }
 
+std::string Simulation::stability_advice() const {
+  return params_.time.adaptive ? "lower time.cfl or time.dt_max"
+                               : "lower time.dt or set time.adaptive = true";
+}
+
 void Simulation::check_stability(double dt) const {
-  if (stats_.bad_cell >= 0) {
-    const auto c = static_cast<std::size_t>(stats_.bad_cell);
+  const FieldStats& stats = current_stats();
+  if (stats.bad_cell >= 0) {
+    const auto c = static_cast<std::size_t>(stats.bad_cell);
     const auto d = backend_->field(FieldId::water_depth)[c];
     const auto b = backend_->field(FieldId::bed)[c];
     throw Error(ExitCode::unstable,
                 fmt::format("unstable at step {} (t = {:.6g} s): cell {} has depth {:.6g} m, "
-                            "bed {:.6g} m; lower time.dt or set time.adaptive = true",
-                            steps_, time_, cell_name(stats_.bad_cell), d, b));
+                            "bed {:.6g} m; {}",
+                            steps_, time_, cell_name(stats.bad_cell), d, b, stability_advice()));
   }
-  if (params_.flow.scheme == FlowScheme::local_inertial && stats_.max_depth > 0) {
+  if (params_.flow.scheme == FlowScheme::local_inertial && stats.max_depth > 0) {
     const double courant =
-        dt * std::sqrt(params_.flow.gravity * stats_.max_depth) / terrain_.grid.dx_min();
+        dt * std::sqrt(params_.flow.gravity * stats.max_depth) / terrain_.grid.dx_min();
     if (courant > 1.0)
-      throw Error(
-          ExitCode::unstable,
-          fmt::format("CFL violated at step {} (t = {:.6g} s): cell {} with depth "
-                      "{:.6g} m has dt sqrt(g d) / dx = {:.4g} > 1; lower time.dt or "
-                      "set time.adaptive = true",
-                      steps_, time_, cell_name(stats_.max_depth_cell), stats_.max_depth, courant));
+      throw Error(ExitCode::unstable,
+                  fmt::format("CFL violated at step {} (t = {:.6g} s): cell {} with depth "
+                              "{:.6g} m has dt sqrt(g d) / dx = {:.4g} > 1; {}",
+                              steps_, time_, cell_name(stats.max_depth_cell), stats.max_depth,
+                              courant, stability_advice()));
   }
 }
 
@@ -305,6 +422,7 @@ void Simulation::step() {
   time_ += dt;
   ++steps_;
   stats_ = backend_->stats();
+  stale_ = false;  // (coast_depth_ keeps the bed of the last refresh: see model.md section 5)
 
   double added = 0.0;
   for (const auto& p : in.points) added += p.volume;

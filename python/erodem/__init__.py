@@ -377,7 +377,8 @@ class Simulation:
     buffer and swap), so take a fresh one after stepping; it keeps the simulation alive. On
     OpenCL, and for the derived field ``erosion``, they are read-only copies; assigning
     (``sim.water_depth = a``) uploads on every backend. A change made from Python is not in
-    the ledger's inputs: it shows as closure error.
+    the ledger's inputs: it shows as closure error. The next adaptive step sees it (the
+    statistics it is chosen from are taken again after a field is read or set).
 
     Not thread-safe: use one simulation from one thread at a time.
     """

@@ -12,7 +12,8 @@
 
 namespace erodem {
 
-/// The processes of one step, in the order they run (MODEL.md "One step").
+/// The processes of one step (MODEL.md "One step"). Simulation::sequence() runs them in this
+/// order but for sources, which run after flow (model.md section 2).
 enum class Process {
   boundary,     ///< ghost cells take the state the edge conditions give them
   sources,      ///< rain and point/line inflows

@@ -18,6 +18,8 @@ namespace erodem {
 
 /// Value of a piecewise-linear series at time t (s); held constant beyond its ends.
 double series_value(const Series& s, double t);
+/// The largest value of the series (as series_value) over the times [t0, t1] (s).
+double series_max(const Series& s, double t0, double t1);
 
 /// One row of the per-step diagnostics (HDF5 `diagnostics/`).
 struct Diagnostics {
@@ -87,15 +89,26 @@ class Simulation {
   /// The time step the next step will take (s).
   double next_dt() const;
 
+  /// Tells the simulation that its state was changed outside step(): the statistics the
+  /// next time step is chosen from (and the stability check) are taken again before they
+  /// are used. backend() (non-const) calls it, since whoever holds the backend may change
+  /// the state (Backend::set_field, or a host view written in place before the next step).
+  void state_changed() { stale_ = true; }
+
   double time() const { return time_; }
   long steps_done() const { return steps_; }
   const Ledger& ledger() const { return ledger_; }
   const Diagnostics& diagnostics() const { return diag_; }
-  const FieldStats& last_stats() const { return stats_; }
+  const FieldStats& last_stats() const { return current_stats(); }
   const Params& params() const { return params_; }
   const Terrain& terrain() const { return terrain_; }
   const Grid& grid() const { return terrain_.grid; }
-  Backend& backend() { return *backend_; }
+  /// The backend, to change the state with: the statistics are taken again before the next
+  /// step (state_changed()).
+  Backend& backend() {
+    state_changed();
+    return *backend_;
+  }
   const Backend& backend() const { return *backend_; }
   /// A field, row-major (ny, nx), in SI units.
   std::vector<double> field(FieldId id) const { return backend_->field(id); }
@@ -114,6 +127,17 @@ class Simulation {
     std::size_t spec = 0;             ///< index into params.inflow
   };
   void resolve_inflows();
+  void find_coast_cells();
+  /// The statistics of the current state (taken again when state_changed() was called).
+  const FieldStats& current_stats() const;
+  /// The largest face depth a fixed-level cell presents to an active cell beside it, less
+  /// the active cell's own depth: max(0, sea_level - bed) over those active cells (m).
+  double coast_depth(const std::vector<double>& bed) const;
+  /// An upper bound of the depth per second (m/s) that this step's rain and inflows add to
+  /// any one cell, for any step starting now no longer than time.dt_max.
+  double source_rise_rate() const;
+  /// What to change when a run goes unstable (time.cfl / time.dt_max, or time.dt).
+  std::string stability_advice() const;
   void check_stability(double dt) const;
   /// The diagnostics row of the current state after a step of `dt` seconds.
   Diagnostics diagnostics_now(double dt) const;
@@ -122,11 +146,25 @@ class Simulation {
   Params params_;
   std::unique_ptr<Backend> backend_;
   std::vector<InflowCells> inflows_;
-  double rain_area_ = 0.0;  ///< sum(rain_factor * area) over active cells (m^2)
+  /// Every DEM cell that an inflow enters: its area (m^2) and the inflows (indices into
+  /// inflows_) that share it.
+  struct SourceCell {
+    double area = 0.0;
+    std::vector<std::size_t> inflows;
+  };
+  std::vector<SourceCell> source_cells_;
+  double rain_area_ = 0.0;        ///< sum(rain_factor * area) over active cells (m^2)
+  double rain_factor_max_ = 1.0;  ///< largest rain_factor over active cells (1)
+  /// Active DEM cells beside a fixed-level cell (an edge ghost or a sea nodata cell).
+  std::vector<std::int64_t> coast_cells_;
   double time_ = 0.0;
   long steps_ = 0;
   Ledger ledger_;
-  FieldStats stats_;
+  // The statistics after the last step, and coast_depth() of the bed then; taken again by
+  // current_stats() when stale_ (the state was changed from outside).
+  mutable FieldStats stats_;
+  mutable double coast_depth_ = 0.0;
+  mutable bool stale_ = false;
   Diagnostics diag_;
 };
 
