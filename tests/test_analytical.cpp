@@ -308,7 +308,12 @@ TEST_P(Analytical, RainOnTiltedPlaneReachesEquilibrium) {
     p.time.dt_max = 2.0;
     p.boundary.south = BoundaryKind::open;
     auto sim = make_simulation(t, p, target());
-    while (sim.time() < 5400.0) sim.step();
+    // The outflow averaged over 3600-6000 s. Local inertial is steady from about 3000 s. The
+    // frictionless pipes never settle: their stored water swings between about 25 and 80 m^3
+    // with a period of about 1200 s, so a 600 s window measured the swing (ratios 0.96 and
+    // 1.03 in alternate windows), not the balance; over two periods the change of storage is
+    // at most about 60 m^3 of the 5,300 m^3 that fall, 1.1 %.
+    while (sim.time() < 3600.0) sim.step();
     const double out0 = sim.ledger().boundary_out, t0 = sim.time();
     while (sim.time() < 6000.0) sim.step();
     const double outflow = (sim.ledger().boundary_out - out0) / (sim.time() - t0);

@@ -106,7 +106,9 @@ PlaneRun run_plane(const KinematicPlane& kp, double dx, double dt_max, const Tar
 //   exact ones, t <= t_e. An idle solver scores 1; a limb that lags by 2 % of t_e scores about
 //   0.053 (the distance of a shift d is about f(t_e) d / (3/8 f(t_e) t_e)), hence the bound
 //   0.05 at the user's defaults (dt_max 5 s, CFL 0.7) on 2 m cells.
-// - the time the outlet passes half the equilibrium discharge, exact 2^(-3/5) t_e: within 3 %.
+// - the time the outlet passes half the equilibrium discharge, exact 2^(-3/5) t_e: within two
+//   steps of dt_max (10 s, 6 % of it at S = 0.3): the outlet is recorded once a step, and the
+//   step's rain enters after its flow (model.md section 2), a lag of one step.
 // - the outflow after 1.5 t_e against rain x length: within 1 % (the ledger closes to 1e-12).
 // - the largest cell speed over Manning's speed of its own depth, alpha h^(2/3): uniform flow
 //   is the implicit friction's fixed point, so only the cell velocity's mean depth of the step
@@ -126,15 +128,15 @@ TEST_P(Runoff, KinematicWaveOnSteepPlane) {
     const PlaneRun r = run_plane(kp, 2.0, 5.0, target());
     std::printf(
         "[kinematic plane] %s S %.1f, 2 m cells, dt_max 5 s: t_e %.1f s; rising-limb error %.4f "
-        "(bound 0.05; idle %.1f); half rise at %.1f s, exact %.1f s (bound 3 %%); late outflow / "
+        "(bound 0.05; idle %.1f); half rise at %.1f s, exact %.1f s (bound 10 s); late outflow / "
         "iL %.4f (bound 1 %%); largest speed %.3f m/s = %.3f x Manning (bound 1.1); %ld steps\n",
         target().label().c_str(), slope, te, r.rising_error, r.idle_error, r.half_rise_time,
         half_rise, r.late_ratio, r.max_speed, r.speed_ratio, r.steps);
     vr::profile(fig("", 2.0), slope < 0.5 ? "S0.3" : "S1.0", {"t", "q", "q_exact"},
                 {r.t, r.q, r.q_exact});
     vr::expect_below(fig("rising-limb error (relative L1), defaults", 2.0), r.rising_error, 0.05);
-    vr::expect_between(fig("half-rise time / exact", 2.0), r.half_rise_time / half_rise, 0.97,
-                       1.03);
+    vr::expect_between(fig("half-rise time - exact (s)", 2.0), r.half_rise_time - half_rise,
+                       -2 * 5.0, 2 * 5.0);
     vr::expect_between(fig("late outflow / (i L)", 2.0), r.late_ratio, 0.99, 1.01);
     vr::expect_below(fig("largest speed / Manning speed", 2.0), r.speed_ratio, 1.1);
     const bool full = vr::full_ladder();
