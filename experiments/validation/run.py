@@ -4,7 +4,7 @@ and on OpenCL (float32), with the full resolution ladders, and writes docs/valid
 one figure per case (docs/images/validation/*.png) and the table of every measured figure.
 
 The cases are the gtest cases themselves (tests/test_analytical.cpp, test_validation.cpp,
-test_physics.cpp, test_precision.cpp): this script builds nothing; it runs the built test
+test_runoff.cpp, test_waves.cpp, test_physics.cpp, test_precision.cpp): this script builds nothing; it runs the built test
 binary with ERODEM_VALIDATION_DIR (each case appends its figures to records.jsonl and writes its
 profiles as CSV, tests/validation_record.hpp) and ERODEM_VALIDATION_LADDER=full. A failing case
 is recorded and shown failing; the script runs them all, writes the report, then exits 1 if any
@@ -366,7 +366,7 @@ def write_report(recs, records: Path, out_md: Path, images: Path, rc: int, wall:
         "Do not edit by hand: rerun the command.",
         "",
         "Every case is a gtest case (`tests/test_analytical.cpp`, `test_validation.cpp`, "
-        "`test_physics.cpp`, `test_precision.cpp`) run on the CPU reference in float32 and "
+        "`test_runoff.cpp`, `test_waves.cpp`, `test_physics.cpp`, `test_precision.cpp`) run on the CPU reference in float32 and "
         "float64 and on OpenCL in float32; ctest runs the same cases at their coarse "
         "resolutions (label `validation`), this report the full ladders"
         + ("" if full else " (**this run: coarse only**)")
