@@ -314,7 +314,11 @@ double Simulation::next_dt() const {
     // 1 m cells, dt = 5 s: the outlet reached half its equilibrium discharge at 213 s, not
     // 112 s; tests/test_runoff.cpp). So dt is the root of the increasing, convex
     // f(dt) = dt (u_max + sqrt(g (d_max + s dt))) - alpha dx_min.
-    const double u = std::max(stats.max_speed, 0.0);
+    // (local inertial only: the pipes' discharge does not depend on the face depth, so their
+    // velocity over it is no speed a signal travels at; their waves move at sqrt(g A dx /
+    // (l dy)), bounded below)
+    const double u =
+        params_.flow.scheme == FlowScheme::local_inertial ? std::max(stats.max_speed, 0.0) : 0.0;
     if (d > 0 || s > 0 || u > 0) {
       // Newton from the right of the root: both starts have f >= 0, and f is convex and
       // increasing for dt > 0, so the iterates fall monotonically onto the root.
