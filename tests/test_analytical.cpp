@@ -10,6 +10,7 @@
 
 #include "reference_solutions.hpp"
 #include "scenarios.hpp"
+#include "target_test.hpp"
 #include "validation_record.hpp"
 
 namespace erodem::test {
@@ -17,18 +18,7 @@ namespace {
 
 namespace vr = validation;
 
-class Analytical : public ::testing::TestWithParam<Target> {
- protected:
-  const Target& target() const { return GetParam(); }
-  /// A figure of the validation report (validation_record.hpp) measured on this target.
-  vr::Figure figure(const char* case_id, const std::string& scheme, const char* quantity,
-                    double resolution, const char* reference) const {
-    return {case_id, target().label(), scheme, quantity, resolution, reference};
-  }
-  void SetUp() override {
-    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
-  }
-};
+class Analytical : public TargetTest {};
 
 // ---- dam breaks ------------------------------------------------------------------------
 //
@@ -507,14 +497,6 @@ TEST_P(Analytical, EvaporationFollowsTheExplicitDecay) {
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Cpu, Analytical,
-                         ::testing::Values(Target{"cpu", Precision::float32},
-                                           Target{"cpu", Precision::float64}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#ifdef ERODEM_HAVE_OPENCL
-INSTANTIATE_TEST_SUITE_P(OpenCl, Analytical,
-                         ::testing::Values(Target{"opencl", Precision::float32}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#endif
+ERODEM_INSTANTIATE_TARGETS(Analytical);
 
 }  // namespace erodem::test

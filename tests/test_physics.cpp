@@ -10,25 +10,13 @@
 
 #include "erodem/error.hpp"
 #include "scenarios.hpp"
+#include "target_test.hpp"
 #include "validation_record.hpp"
 
 namespace erodem::test {
 namespace {
 
-class Physics : public ::testing::TestWithParam<Target> {
- protected:
-  const Target& target() const { return GetParam(); }
-  void SetUp() override {
-    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
-  }
-  /// Rounding-level bound: `f64` in float64, `f32` in float32.
-  double bound(double f64, double f32) const { return target().f64() ? f64 : f32; }
-  /// A figure of the validation report (validation_record.hpp) measured on this target.
-  validation::Figure figure(const char* case_id, const char* scheme, const char* quantity,
-                            double resolution, const char* reference) const {
-    return {case_id, target().label(), scheme, quantity, resolution, reference};
-  }
-};
+class Physics : public TargetTest {};
 
 double max_speed(const Simulation& sim) {
   const auto u = sim.field(FieldId::velocity_x), v = sim.field(FieldId::velocity_y);
@@ -305,13 +293,6 @@ TEST_P(Physics, CflViolationStopsTheRun) {
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Cpu, Physics,
-                         ::testing::Values(Target{"cpu", Precision::float32},
-                                           Target{"cpu", Precision::float64}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#ifdef ERODEM_HAVE_OPENCL
-INSTANTIATE_TEST_SUITE_P(OpenCl, Physics, ::testing::Values(Target{"opencl", Precision::float32}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#endif
+ERODEM_INSTANTIATE_TARGETS(Physics);
 
 }  // namespace erodem::test

@@ -11,6 +11,7 @@
 
 #include "reference_solutions.hpp"
 #include "scenarios.hpp"
+#include "target_test.hpp"
 #include "validation_record.hpp"
 
 namespace erodem::test {
@@ -18,13 +19,7 @@ namespace {
 
 namespace vr = validation;
 
-class Runoff : public ::testing::TestWithParam<Target> {
- protected:
-  const Target& target() const { return GetParam(); }
-  void SetUp() override {
-    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
-  }
-};
+class Runoff : public TargetTest {};
 
 /// A plane of `n` cells of `dx` m falling eastwards at `slope`, 3 rows between walls, open at
 /// its foot (east), dry, under rain.
@@ -159,13 +154,6 @@ TEST_P(Runoff, KinematicWaveOnSteepPlane) {
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Cpu, Runoff,
-                         ::testing::Values(Target{"cpu", Precision::float32},
-                                           Target{"cpu", Precision::float64}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#ifdef ERODEM_HAVE_OPENCL
-INSTANTIATE_TEST_SUITE_P(OpenCl, Runoff, ::testing::Values(Target{"opencl", Precision::float32}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#endif
+ERODEM_INSTANTIATE_TARGETS(Runoff);
 
 }  // namespace erodem::test

@@ -10,19 +10,12 @@
 
 #include "erodem/error.hpp"
 #include "scenarios.hpp"
+#include "target_test.hpp"
 
 namespace erodem::test {
 namespace {
 
-class Sources : public ::testing::TestWithParam<Target> {
- protected:
-  const Target& target() const { return GetParam(); }
-  void SetUp() override {
-    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
-  }
-  /// Rounding-level bound: `f64` in float64, `f32` in float32.
-  double bound(double f64, double f32) const { return target().f64() ? f64 : f32; }
-};
+class Sources : public TargetTest {};
 
 /// Every process but flow off, closed edges, Manning n `n`, the default adaptive step
 /// (time.cfl 0.7, time.dt_max 5 s) for `duration` s.
@@ -381,13 +374,6 @@ TEST_P(Sources, HunterFloodFrontOnAFrictionalBed) {
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Cpu, Sources,
-                         ::testing::Values(Target{"cpu", Precision::float32},
-                                           Target{"cpu", Precision::float64}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#ifdef ERODEM_HAVE_OPENCL
-INSTANTIATE_TEST_SUITE_P(OpenCl, Sources, ::testing::Values(Target{"opencl", Precision::float32}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#endif
+ERODEM_INSTANTIATE_TARGETS(Sources);
 
 }  // namespace erodem::test

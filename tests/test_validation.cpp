@@ -15,6 +15,7 @@
 
 #include "reference_solutions.hpp"
 #include "scenarios.hpp"
+#include "target_test.hpp"
 #include "validation_record.hpp"
 
 namespace erodem::test {
@@ -22,19 +23,7 @@ namespace {
 
 namespace vr = validation;
 
-class Validation : public ::testing::TestWithParam<Target> {
- protected:
-  const Target& target() const { return GetParam(); }
-  void SetUp() override {
-    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
-  }
-  vr::Figure figure(const char* case_id, const std::string& scheme, const char* quantity,
-                    double resolution, const char* reference) const {
-    return {case_id, target().label(), scheme, quantity, resolution, reference};
-  }
-  /// Rounding-level bound: `f64` in float64, `f32` in float32.
-  double bound(double f64, double f32) const { return target().f64() ? f64 : f32; }
-};
+class Validation : public TargetTest {};
 
 /// Linear interpolation through the (x, y) vertices, held constant outside them.
 double piecewise(const std::vector<std::array<double, 2>>& v, double x) {
@@ -484,14 +473,6 @@ TEST_P(Validation, LocalInertialTimeStepSensitivity) {
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Cpu, Validation,
-                         ::testing::Values(Target{"cpu", Precision::float32},
-                                           Target{"cpu", Precision::float64}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#ifdef ERODEM_HAVE_OPENCL
-INSTANTIATE_TEST_SUITE_P(OpenCl, Validation,
-                         ::testing::Values(Target{"opencl", Precision::float32}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#endif
+ERODEM_INSTANTIATE_TARGETS(Validation);
 
 }  // namespace erodem::test

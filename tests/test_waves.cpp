@@ -8,18 +8,13 @@
 
 #include "reference_solutions.hpp"
 #include "scenarios.hpp"
+#include "target_test.hpp"
 #include "validation_record.hpp"
 
 namespace erodem::test {
 namespace {
 
-class Waves : public ::testing::TestWithParam<Target> {
- protected:
-  const Target& target() const { return GetParam(); }
-  void SetUp() override {
-    if (target().backend == "opencl" && !opencl_available()) GTEST_SKIP() << "no OpenCL device";
-  }
-};
+class Waves : public TargetTest {};
 
 /// A lake `depth` m deep in a frictionless channel of `n` cells of `dx` m (3 rows between
 /// walls) with a Gaussian bump of `amplitude` m and width `sigma` m on its surface at the
@@ -125,13 +120,6 @@ TEST_P(Waves, SmallBumpTravelsAtTheSchemesWaveSpeed) {
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Cpu, Waves,
-                         ::testing::Values(Target{"cpu", Precision::float32},
-                                           Target{"cpu", Precision::float64}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#ifdef ERODEM_HAVE_OPENCL
-INSTANTIATE_TEST_SUITE_P(OpenCl, Waves, ::testing::Values(Target{"opencl", Precision::float32}),
-                         [](const ::testing::TestParamInfo<Target>& i) { return i.param.label(); });
-#endif
+ERODEM_INSTANTIATE_TARGETS(Waves);
 
 }  // namespace erodem::test
