@@ -886,7 +886,8 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
   pending_water_dt_ = dt;
   launch_interior(k);
   launch_edge_tallies(kTallyExchange, dt);
-  // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
+  // depth_next_ keeps the depth the water update started from (after this step's sources):
+  // conservative transport needs it.
   std::swap(depth_, depth_next_);
 }
 

@@ -160,12 +160,6 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
       rain_area_ += g.area[r] * factor;
       rain_factor_max_ = std::max(rain_factor_max_, factor);
     }
-  if (!terrain_.rain_factor.empty()) {
-    rain_factor_max_ = 0.0;
-    for (std::size_t i = 0; i < terrain_.rain_factor.size(); ++i)
-      if (terrain_.active(i))
-        rain_factor_max_ = std::max(rain_factor_max_, terrain_.rain_factor[i]);
-  }
   resolve_inflows();
   find_coast_cells();
   stats_ = backend_->stats();

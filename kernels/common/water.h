@@ -9,8 +9,8 @@ ERODEM_BEGIN_NAMESPACE
 /* Depth-averaged velocity (m/s) of a cell along one axis: the mean of the velocities through
  * its two opposite faces, each the face's discharge through_a, through_b (m^3/s, positive in
  * the velocity's direction) over its flow area, width (m) times its flow depth depth_a,
- * depth_b (m; face_flow_depth, the depth the flow step used). 0 where the cell's mean depth of
- * the step, mean_depth (m), is below min_depth (m); a face depth below min_depth counts as
+ * depth_b (m; face_flow_depth of the depths the update starts from). 0 where the cell's mean depth
+ * of the step, mean_depth (m), is below min_depth (m); a face depth below min_depth counts as
  * min_depth. The flow depth, not the cell's mean depth: a thin cell that a deep neighbour
  * pours into carries the neighbour's discharge at the neighbour's depth (a 0.5 m pool spilling
  * into a 1 mm cell read 73 m/s from discharge over mean depth, and the adaptive step, which
@@ -42,7 +42,7 @@ ERODEM_FN real water_exchange_cell(int i, int W, GLOBAL const erodem_kind_t* kin
 /* Water update of padded cell (x, y) (active cells change; others keep their depth):
  *   d <- d + dt (sum inflow - sum outflow) / area,
  * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the faces' flow depths
- * (face_velocity; bed (m) gives those, unchanged since the flow step). Writes depth_out; returns
+ * (face_velocity; bed (m) gives those). Writes depth_out; returns
  * through *exchange the net discharge out of the domain through this cell's faces with ghosts
  * (m^3/s), through *clipped the volume (m^3) added to lift a rounding-level negative depth back to
  * zero, and through *given the volume (m^3) the cell gave through its faces (0 for other cells).
@@ -81,7 +81,8 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   *exchange = active ? water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom) : (real)0;
 
   const real d_mean = (real)0.5 * (d_old + d_new);
-  /* the flow depths of the four faces, as the flow step saw them (same bed and depth) */
+  /* the flow depths of the four faces, from the depths this update starts from: those the flow
+   * step saw plus this step's sources, which run between the two (model.md section 2) */
   const real b = bed[i];
   const real b_l = bed[i - 1], b_r = bed[i + 1], b_t = bed[i - W], b_b = bed[i + W];
   const real h_l = face_flow_depth(depth[i - 1], d_old, b_l, b);

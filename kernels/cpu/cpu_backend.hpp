@@ -112,8 +112,8 @@ class CpuBackend final : public Backend {
   // The bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is only
   // read and written at its own cell, so one buffer.
   Field bed_, bed_next_, bed0_, bed_residual_;
-  Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the
-                              // flow step saw (used by conservative transport)
+  Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the water update
+                              // started from (used by conservative transport)
   Field sediment_, sediment_next_;
   std::array<Field, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
   Field velocity_x_, velocity_y_;

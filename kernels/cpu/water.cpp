@@ -35,7 +35,8 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
   tally.boundary_water_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
   tally.clipped += sum_rows(row_sums_b_);
   tally.water_exchanged += sum_rows(row_sums_c_);
-  // depth_next_ keeps the depth the flow step saw: conservative transport needs it.
+  // depth_next_ keeps the depth the water update started from (after this step's sources):
+  // conservative transport needs it.
   std::swap(depth_, depth_next_);
 }
 

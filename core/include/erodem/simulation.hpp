@@ -154,7 +154,7 @@ class Simulation {
   };
   std::vector<SourceCell> source_cells_;
   double rain_area_ = 0.0;        ///< sum(rain_factor * area) over active cells (m^2)
-  double rain_factor_max_ = 1.0;  ///< largest rain_factor over active cells (1)
+  double rain_factor_max_ = 0.0;  ///< largest rain_factor over active cells (1)
   /// Active DEM cells beside a fixed-level cell (an edge ghost or a sea nodata cell).
   std::vector<std::int64_t> coast_cells_;
   double time_ = 0.0;
