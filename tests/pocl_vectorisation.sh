@@ -18,7 +18,10 @@
 # 2-vCPU AMD EPYC with AVX-512), one for AVX2 without it (measured 2026-11-25 on a 2-vCPU AMD
 # EPYC without AVX-512, where PoCL leaves flow_pipes, water_update and thermal_share scalar
 # with the code before the bed pair too, so its 8-wide counts are lower). The peeled counts
-# grew by the group sums of erosion, transport and thermal (the ledger's moved volumes).
+# grew by the group sums of erosion, transport and thermal (the ledger's moved volumes). The
+# AVX-512 table was checked again on 2026-11-26: the cell velocity from the faces' flow depths
+# (water.h) had left water_update scalar there (36 < 39: SLP packed its four face depths),
+# which the AVX2 table could not show, since PoCL leaves water_update scalar on AVX2 anyway.
 # Usage: pocl_vectorisation.sh path/to/erodem
 set -euo pipefail
 erodem=$1
@@ -36,10 +39,10 @@ trap 'rm -rf "$cache"' EXIT
 status=0
 if grep -qw avx512f /proc/cpuinfo 2>/dev/null; then
   # flow scheme, transport scheme, least loops 8 wide, most loops 4 wide, least loops peeled
-  table='local_inertial conservative 39 6 12
-local_inertial semi_lagrangian 45 9 15
-pipes conservative 33 6 12
-pipes semi_lagrangian 39 9 15'
+  table='local_inertial conservative 39 6 21
+local_inertial semi_lagrangian 45 9 21
+pipes conservative 33 6 21
+pipes semi_lagrangian 39 9 21'
   isa="AVX-512"
 else
   table='local_inertial conservative 33 0 21
