@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "erodem/error.hpp"
 #include "scenarios.hpp"
 #include "target_test.hpp"
+#include "validation_record.hpp"
 
 namespace erodem::test {
 namespace {
@@ -75,13 +77,15 @@ TEST_P(Sources, FixedLevelEdgeFillsADryChannelAtRittersSpeed) {
       "%%, bound -70 .. +5 %%)\n",
       target().label().c_str(), dt0, dt_bound, o.courant, h_th, front, t_end, front_exact,
       100 * (front / front_exact - 1));
-  EXPECT_LE(dt0, dt_bound * (1 + 1e-12));
-  EXPECT_LE(o.courant, 1.0);
+  auto fig = [&](const char* quantity) {
+    return figure("fixed_level_fill", "local_inertial", quantity, dx, "Ritter (1892)");
+  };
+  validation::expect_below(fig("first dt / (cfl dx / sqrt(g h0))"), dt0 / dt_bound, 1 + 1e-12);
+  validation::expect_below(fig("largest Courant number"), o.courant, 1.0);
   // The local-inertial front lags Ritter's by 64 % in RitterDryDamBreak (no advection term:
   // model error, the same at every dx), so the bounds are that test's: a grid that did not
   // fill (front at the first cell) or a front faster than Ritter's fails.
-  EXPECT_GT(front, 0.3 * front_exact);
-  EXPECT_LT(front, 1.05 * front_exact);
+  validation::expect_between(fig("front position / Ritter's"), front / front_exact, 0.3, 1.05);
 }
 
 // ---- a large inflow hydrograph into a dry basin -----------------------------------------
@@ -107,12 +111,17 @@ TEST_P(Sources, LargeInflowHydrographIntoADryBasin) {
       "m^3, inflow %.1f m^3 (hydrograph integral %.1f m^3), relative closure %.1e (bound %.0e)\n",
       target().label().c_str(), sim.steps_done(), o.courant, L.water, L.inflow, exact_inflow,
       closure, bound(1e-12, 1e-5));
-  EXPECT_LE(o.courant, 1.0);
+  auto fig = [&](const char* quantity) {
+    return figure("inflow_hydrograph", "local_inertial", quantity, 5.0,
+                  "the hydrograph's integral (closed basin)");
+  };
+  validation::expect_below(fig("largest Courant number"), o.courant, 1.0);
   // Closed basin: all the water that came in is on the grid. An idle solver (nothing poured)
   // misses 57,000 m^3; the inflow's midpoint volumes are exact but for the step across the
   // hydrograph's corner at 60 s (a fraction of one step's volume, < 1e-3 of the total).
-  EXPECT_LT(closure, bound(1e-12, 1e-5));
-  EXPECT_NEAR(L.water, exact_inflow, 1e-3 * exact_inflow);
+  validation::expect_below(fig("ledger closure (relative to moved)"), closure, bound(1e-12, 1e-5));
+  validation::expect_below(fig("|water on the grid / integral - 1|"),
+                           std::abs(L.water / exact_inflow - 1), 1e-3);
 }
 
 // ---- state written between steps -------------------------------------------------------
@@ -277,23 +286,30 @@ TEST_P(Sources, LineInflowOnAPlainStaysSmoothAndSymmetric) {
       100 * (a.speed / ref.speed - 1), a.error.empty() ? "" : "; ", a.error.c_str());
   ASSERT_EQ(a.error, "");
   ASSERT_EQ(ref.error, "");
+  auto fig = [&](const char* quantity) {
+    return figure("line_inflow", "local_inertial", quantity, LinePlain::cell,
+                  "fixed steps of 0.25 s (Courant 0.13 at the source); mirror symmetry");
+  };
   // Mirror symmetry: every face flux is computed mirror-exactly and only the order of the
   // water update's sums differs between mirrored cells, so the asymmetry is rounding (it is
   // exactly 0 here); it grows to decimetres only when the scheme is unstable. (An idle solver
   // is symmetric too: the next two checks fail it.)
-  EXPECT_LE(a.asymmetry, sym_bound);
+  validation::expect_below(fig("largest |h - mirror(h)| (m)"), a.asymmetry, sym_bound);
   // No checkerboard: the cells fed by the source stand above their neighbours, as in the
   // reference; the oscillating source cells stood 0.05 - 0.19 m below them. An idle solver
   // (all dry) has no dip below 0.
-  EXPECT_LT(a.dip_end, 0.0);
-  EXPECT_LT(a.dip_hi, 0.0);
+  validation::expect_below(fig("ring minus inflow cells at the end (m)"), a.dip_end, 0.0);
+  validation::expect_below(fig("ring minus inflow cells, largest of the second half (m)"), a.dip_hi,
+                           0.0);
   // No oscillation in time: the dip moves by less than 0.03 m over the second half (it swung
   // by 0.14 m when the source cells oscillated).
-  EXPECT_LT(a.dip_hi - a.dip_lo, 0.03);
+  validation::expect_below(fig("spread of that difference over the second half (m)"),
+                           a.dip_hi - a.dip_lo, 0.03);
   // Speeds: the source's outflow, q = 20 m^3/s over the line's 50 m perimeter at a few dm of
   // depth; the adaptive step's first-order error in time at the source keeps the speed within
   // 25 % of the reference (an idle solver: 0, -100 %).
-  EXPECT_LT(std::abs(a.speed / ref.speed - 1), 0.25);
+  validation::expect_below(fig("|largest speed / fixed-dt reference's - 1|"),
+                           std::abs(a.speed / ref.speed - 1), 0.25);
 }
 
 // ---- Hunter et al. (2005): a flood front over a flat frictional bed ---------------------
@@ -316,6 +332,7 @@ struct HunterFront {
 struct HunterResult {
   double depth_error, front, front_exact, froude2;
   long steps;
+  std::vector<double> x, h, h_exact;  ///< the middle row's profile (m)
 };
 
 /// The front fed through the west column of a closed channel of 3 rows of `dx` m cells, 5 km
@@ -339,8 +356,16 @@ HunterResult run_hunter(const HunterFront& exact, double dx, double t_end, const
   const std::vector<double> idle(h.size(), 0.0);  // the dry bed the front runs over
   const double reach = exact.u * t_end, h_th = 1e-3;
   const double h0 = exact.depth(0.0, t_end);
-  return {relative_l1(row, h, h_exact, idle, 0.0, reach), last_above(row, h, h_th),
-          last_above(row, h_exact, h_th), exact.u * exact.u / (kG * h0), sim.steps_done()};
+  std::vector<double> x(h.size());
+  for (std::size_t c = 0; c < x.size(); ++c) x[c] = (static_cast<double>(c) + 0.5) * dx;
+  return {relative_l1(row, h, h_exact, idle, 0.0, reach),
+          last_above(row, h, h_th),
+          last_above(row, h_exact, h_th),
+          exact.u * exact.u / (kG * h0),
+          sim.steps_done(),
+          x,
+          h,
+          h_exact};
 }
 
 TEST_P(Sources, HunterFloodFrontOnAFrictionalBed) {
@@ -349,11 +374,14 @@ TEST_P(Sources, HunterFloodFrontOnAFrictionalBed) {
   // all inertia).
   const HunterFront exact{1.0, 0.01};
   const double t_end = 3600.0;
-  for (double dx : {50.0, 25.0}) {
+  // ctest: 50 and 25 m; the report adds 12.5 m
+  std::vector<double> ladder{50.0, 25.0};
+  if (validation::full_ladder()) ladder.push_back(12.5);
+  for (double dx : ladder) {
     const auto r = run_hunter(exact, dx, t_end, target());
     const double front_error = r.front / r.front_exact - 1;
     std::printf(
-        "[Hunter] %s dx %.0f m: %ld steps; depth error over [0, %.0f] m %.4f (bound Fr^2 at x = "
+        "[Hunter] %s dx %g m: %ld steps; depth error over [0, %.0f] m %.4f (bound Fr^2 at x = "
         "0 = %.3f; idle solver 1); front (h > 1e-03 m) at %.1f m, exact %.1f m (%+.1f %%, "
         "bound -6 .. +2 %%)\n",
         target().label().c_str(), dx, r.steps, exact.u * t_end, r.depth_error, r.froude2, r.front,
@@ -363,12 +391,18 @@ TEST_P(Sources, HunterFloodFrontOnAFrictionalBed) {
     // error is model error, not resolution (0.039 at 50 m, 0.043 at 25 m); a solver that moved
     // nothing scores 1 (and Manning's n off by a factor 2 would put the depth 1.8 times off,
     // h ~ n^(6/7)).
-    EXPECT_LT(r.depth_error, r.froude2);
+    auto fig = [&](const char* quantity) {
+      return figure("hunter", "local_inertial", quantity, dx, "Hunter et al. (2005)");
+    };
+    validation::expect_below(fig("depth error over the reached region (relative L1)"),
+                             r.depth_error, r.froude2);
     // The front lags by 1.4 % at 50 m and 3.5 % at 25 m: at the tip the dropped advection
     // dominates, and the finer grid resolves more of the tip. A front that did not move (idle:
     // -99 %) or that outran the exact one fails.
-    EXPECT_GT(front_error, -0.06);
-    EXPECT_LT(front_error, 0.02);
+    validation::expect_between(fig("front position / exact - 1 (h > 1 mm)"), front_error, -0.06,
+                               0.02);
+    if (dx == ladder.back())
+      validation::profile(fig(""), "depth", {"x", "h", "depth_exact"}, {r.x, r.h, r.h_exact});
   }
 }
 

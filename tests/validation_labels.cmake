@@ -4,7 +4,10 @@
 # (erodem_tests_TESTS).
 foreach(t IN LISTS erodem_tests_TESTS)
   if(t MATCHES "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves)\\." OR t MATCHES
-     "Physics\\.(SemiLagrangianLossIsMeasured|BedrockLevelIsNeverCut)/" OR t MATCHES
+     "Physics\\.(SemiLagrangianLossIsMeasured|BedrockLevelIsNeverCut|LakeAtRestStaysAtRest|ClosedBoxConservesWaterAndMaterial)/"
+     OR t MATCHES
+     "Sources\\.(FixedLevelEdgeFillsADryChannelAtRittersSpeed|LargeInflowHydrographIntoADryBasin|LineInflowOnAPlainStaysSmoothAndSymmetric|HunterFloodFrontOnAFrictionalBed)/"
+     OR t MATCHES
      "^Precision\\.Float32")
     set_tests_properties("${t}" PROPERTIES LABELS validation)
   endif()
