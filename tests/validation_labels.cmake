@@ -3,12 +3,13 @@
 # their full ladders. ctest includes this after the list gtest_discover_tests found
 # (erodem_tests_TESTS).
 foreach(t IN LISTS erodem_tests_TESTS)
-  if(t MATCHES "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves)\\." OR t MATCHES
+  if(t MATCHES
+     "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves|BoundarySediment|RasterParameters)\\."
+     OR t MATCHES
      "Physics\\.(SemiLagrangianLossIsMeasured|BedrockLevelIsNeverCut|LakeAtRestStaysAtRest|ClosedBoxConservesWaterAndMaterial)/"
      OR t MATCHES
      "Sources\\.(FixedLevelEdgeFillsADryChannelAtRittersSpeed|LargeInflowHydrographIntoADryBasin|LineInflowOnAPlainStaysSmoothAndSymmetric|HunterFloodFrontOnAFrictionalBed)/"
-     OR t MATCHES
-     "^Precision\\.Float32")
+     OR t MATCHES "^Precision\\.Float32")
     set_tests_properties("${t}" PROPERTIES LABELS validation)
   endif()
 endforeach()
