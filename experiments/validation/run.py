@@ -4,7 +4,8 @@ and on OpenCL (float32), with the full resolution ladders, and writes docs/valid
 one figure per case (docs/images/validation/*.png) and the table of every measured figure.
 
 The cases are the gtest cases themselves (tests/test_analytical.cpp, test_validation.cpp,
-test_runoff.cpp, test_waves.cpp, test_physics.cpp, test_sources.cpp, test_precision.cpp): this script builds nothing; it runs the built test
+test_runoff.cpp, test_waves.cpp, test_physics.cpp, test_sources.cpp,
+test_boundaries_rasters.cpp, test_precision.cpp): this script builds nothing; it runs the built test
 binary with ERODEM_VALIDATION_DIR (each case appends its figures to records.jsonl and writes its
 profiles as CSV, tests/validation_record.hpp) and ERODEM_VALIDATION_LADDER=full. A failing case
 is recorded and shown failing; the script runs them all, writes the report, then exits 1 if any
@@ -55,6 +56,8 @@ GTEST_FILTER = ":".join(
         "*/Sources.LargeInflowHydrographIntoADryBasin/*",
         "*/Sources.LineInflowOnAPlainStaysSmoothAndSymmetric/*",
         "*/Sources.HunterFloodFrontOnAFrictionalBed/*",
+        "*/BoundarySediment.*",
+        "*/RasterParameters.*",
         "Precision.Float32*",
     ]
 )
@@ -212,6 +215,34 @@ CASES = {
         "collapse at 20 deg, 10000 steps of 0.2 s.",
         "Nothing enters or leaves: water and material on the grid must not change beyond the "
         "rounding of what moved (the ledger's measure, not the whole volume).",
+    ),
+    "boundary_sediment": (
+        "Sediment across open and fixed-level edges",
+        "A 100 m x 8 m channel of 2 m cells (slope 0.02, n = 0.03) fed 0.1 m^2/s at its head, "
+        "erosion on (K_c 0.2, K_s 0.5 /s), 1000 steps of 0.2 s, draining through an open or a "
+        "fixed-level east edge (sea half the normal depth above the last bed); the material "
+        "that left, summed per step from the fields ((bed + suspended) x area before minus "
+        "after), against what the ledger books. A second case floods a dry basin 0.5-1.1 m "
+        "below the sea through a fixed-level west edge for 150 s.",
+        "Conservative transport: sediment leaves only with the water that leaves, at the edge "
+        "cell's concentration, and the sea enters clear; the books close to rounding. "
+        "Semi-Lagrangian transport has no boundary flux: it carries nothing out of a uniform "
+        "concentration, lets the inlet cell keep its own concentration under clear inflow and "
+        "makes material at wet/dry fronts (+12.6 m^3 in the flood case), all booked as "
+        "transport_change. The frictionless pipes cut the channel about 1.5 m deep in 200 s: "
+        "that run checks the books, not the physics.",
+    ),
+    "raster_parameters": (
+        "Raster parameters: Manning n, hardness, rain factor, initial depth",
+        "Every parameter written as a GeoTIFF and read through the DEM path. Two 2 km channels "
+        "(3 x 200 cells of 10 m, slope 1e-3) apart by a nodata row, n = 0.03 and 0.06 from a "
+        "raster, 0.5 m^2/s each from half their normal depth (an initial-depth raster), 8000 "
+        "s; a hardness raster of 0 (north) and 1 (south) under a held uniform flow, against a "
+        "uniform run; 50 mm/h for 600 s on three closed basins with rain factors 0.5, 2 and 0.",
+        "Each Manning region reaches its own normal depth and speed; hardness 0 stops erosion "
+        "exactly and hardness-1 cells compute as in the uniform run; the rain factor scales "
+        "each basin's water to rounding. Parameters are per cell: the velocity at a change of "
+        "n inside one channel is not checked.",
     ),
     "precision_ridged": (
         "float32 against float64: ridged 0-9000 m relief",
@@ -523,7 +554,7 @@ def write_report(recs, records: Path, out_md: Path, images: Path, rc: int, wall:
         "",
         "Every case is a gtest case (`tests/test_analytical.cpp`, `test_validation.cpp`, "
         "`test_runoff.cpp`, `test_waves.cpp`, `test_physics.cpp`, `test_sources.cpp`, "
-        "`test_precision.cpp`) run on the CPU reference in float32 and "
+        "`test_boundaries_rasters.cpp`, `test_precision.cpp`) run on the CPU reference in float32 and "
         "float64 and on OpenCL in float32; ctest runs the same cases at their coarse "
         "resolutions (label `validation`), this report the full ladders"
         + ("" if full else " (**this run: coarse only**)")
