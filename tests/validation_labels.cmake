@@ -3,7 +3,7 @@
 # their full ladders. ctest includes this after the list gtest_discover_tests found
 # (erodem_tests_TESTS).
 foreach(t IN LISTS erodem_tests_TESTS)
-  if(t MATCHES "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves)\\." OR t MATCHES
+  if(t MATCHES "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves|RealDemLake)\\." OR t MATCHES
      "Physics\\.(SemiLagrangianLossIsMeasured|BedrockLevelIsNeverCut)/" OR t MATCHES
      "^Precision\\.Float32")
     set_tests_properties("${t}" PROPERTIES LABELS validation)
