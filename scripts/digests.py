@@ -22,6 +22,7 @@ import argparse
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -155,7 +156,7 @@ TARGETS = {
 
 def opencl_available(erodem):
     out = subprocess.run([erodem, "devices"], capture_output=True, text=True, check=False).stdout
-    return "OpenCL" in out and "no OpenCL" not in out
+    return re.search(r"^\s*\*?\s*\[0\]", out, re.M) is not None
 
 
 def dataset_digests(path):
