@@ -16,6 +16,7 @@
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
+#include "erodem/process.hpp"
 #include "erodem/schema.hpp"
 #include "erodem/simulation.hpp"
 #include "erodem/terrain_synth.hpp"
@@ -63,72 +64,19 @@ Params bench_params(const BenchOptions& o) {
 
 // ---- the byte model ---------------------------------------------------------------------
 //
-// The bytes each process must move per cell and step: every distinct field a sweep over the
-// grid reads, once, plus every field it writes, once; 4 bytes per float32 field, 1 byte for
-// the cell-kind field. Neighbour reads of a field count once (they hit the cache lines the
-// sweep brings in anyway); per-row arrays (dx, dy, area) are negligible; write-allocate
-// traffic is not counted, as STREAM does not count it. Counted from the cell functions of
-// kernels/common/*.h and the loops of kernels/cpu/*.cpp:
-//   boundary     boundary_fill_cell (boundary.h), cpu/boundary.cpp: halo cells only
-//   sources      rain_cell (sources.h), run_sources: reads kind, depth, rain_factor;
-//                writes depth (points only when it does not rain: nothing per cell)
-//   flow         local_inertial_face + local_inertial_split (flow.h), run_flow: reads
-//                kind, bed, depth, manning, 4 fluxes; writes 4 new fluxes (the CPU keeps
-//                the face discharges in row buffers; the OpenCL face pass also writes and
-//                reads two face fields, 16 B/cell not counted). Pipes: no manning.
-//   water        water_update_cell (water.h), run_water: reads kind, depth, 4 fluxes;
-//                writes depth_next, velocity_x, velocity_y
-//   erosion      erosion_cell (erosion.h), run_erosion: reads kind, bed, sediment, depth,
-//                velocity_x, velocity_y, hardness; writes bed_next, sediment
-//   transport    transport_conservative_cell (transport.h), run_transport: reads kind,
-//                sediment, depth_next (the depth the flow saw), 4 fluxes; writes
-//                sediment_next. Semi-Lagrangian: reads kind, sediment, velocity_x,
-//                velocity_y; writes sediment_next
-//   thermal      two sweeps, thermal_share_cell then thermal_apply_cell (thermal.h),
-//                run_thermal: reads kind, bed, writes share; then reads kind, bed, share,
-//                writes bed_next
-//   evaporation  evaporation_cell, wetness_cell (sources.h), run_evaporation: reads kind,
-//                depth, wetness; writes depth (when the rate > 0), wetness
-//   stats        CpuBackend::stats, cell_state_ok (stats.h): reads kind, bed, depth,
-//                sediment, velocity_x, velocity_y; the driver runs it after every step
-// The OpenCL backend moves the same fields, plus the face fields of its local-inertial face
-// pass and per-group partial tallies (water, transport, evaporation), not counted here.
-struct BytesPerCell {
-  int read = 0, write = 0;
-  const char* reads;
-  const char* writes;
-  int total() const { return read + write; }
-};
-
-BytesPerCell bytes_per_cell(const std::string& process, const Params& p) {
-  constexpr int F = 4, K = 1;  // float32 field, cell kind
-  if (process == "boundary") return {0, 0, "(halo cells only)", ""};
-  if (process == "sources")
-    return p.rain.rate > 0 || !p.rain.series.empty()
-               ? BytesPerCell{K + 2 * F, F, "kind depth rain_factor", "depth"}
-               : BytesPerCell{0, 0, "(inflow cells only)", ""};
-  if (process == "flow")
-    return p.flow.scheme == FlowScheme::local_inertial
-               ? BytesPerCell{K + 7 * F, 4 * F, "kind bed depth manning flux*4", "flux*4"}
-               : BytesPerCell{K + 6 * F, 4 * F, "kind bed depth flux*4", "flux*4"};
-  if (process == "water")
-    return {K + 5 * F, 3 * F, "kind depth flux*4", "depth velocity_x velocity_y"};
-  if (process == "erosion")
-    return {K + 6 * F, 2 * F, "kind bed sediment depth velocity_x velocity_y hardness",
-            "bed sediment"};
-  if (process == "transport")
-    return p.transport.scheme == TransportScheme::conservative
-               ? BytesPerCell{K + 6 * F, F, "kind sediment depth_flow flux*4", "sediment"}
-               : BytesPerCell{K + 3 * F, F, "kind sediment velocity_x velocity_y", "sediment"};
-  if (process == "thermal")
-    return {(K + F) + (K + 2 * F), 2 * F, "kind bed | kind bed share", "share | bed"};
-  if (process == "evaporation")
-    return p.evaporation.rate > 0
-               ? BytesPerCell{K + 2 * F, 2 * F, "kind depth wetness", "depth wetness"}
-               : BytesPerCell{K + 2 * F, F, "kind depth wetness", "wetness"};
-  if (process == "stats")
-    return {K + 5 * F, 0, "kind bed depth sediment velocity_x velocity_y", ""};
-  return {0, 0, "", ""};
+// The bytes each process must move per cell and step, from the fields its sweeps read and
+// write in the process table (core/include/erodem/process.hpp, sweep_bytes): every distinct
+// field a sweep reads, once, plus every field it writes, once; 4 bytes per float32 field (8 in
+// float64), 1 byte for the cell kind; neighbour reads once, per-row arrays and halo or point
+// sweeps not counted, no write-allocate traffic (as STREAM counts). "stats" is the driver's
+// reduction after every step. The OpenCL backend moves the same fields, plus the face fields
+// of its local-inertial face pass and per-group partial tallies, not counted here.
+int bytes_per_cell(const std::string& process, const Params& p) {
+  const int real = p.numerics.precision == Precision::float64 ? 8 : 4;
+  if (process == "stats") return sweep_bytes(stats_sweep(), real).total();
+  for (const auto& e : process_table())
+    if (process == e.name) return process_bytes(e.id, p, real).total();
+  return 0;
 }
 
 struct Row {
@@ -192,7 +140,7 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
     const std::string name = k < seq.size() ? process_name(seq[k])
                              : k == n_stats ? "stats"
                                             : "full_step";
-    const int bytes = k == n_full ? full_bytes : bytes_per_cell(name, p).total();
+    const int bytes = k == n_full ? full_bytes : bytes_per_cell(name, p);
     full_bytes += bytes;
     const double sps = median(per_step[k]);
     rows.push_back({backend, device, name, threads, bytes, sps, cells / sps});

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "erodem/error.hpp"
+#include "erodem/process.hpp"
 
 namespace erodem {
 
@@ -41,28 +42,6 @@ const std::array<DiagnosticsSeries, 16>& diagnostics_series() {
   return table;
 }
 
-const char* process_name(Process p) {
-  switch (p) {
-    case Process::boundary:
-      return "boundary";
-    case Process::sources:
-      return "sources";
-    case Process::flow:
-      return "flow";
-    case Process::water:
-      return "water";
-    case Process::erosion:
-      return "erosion";
-    case Process::transport:
-      return "transport";
-    case Process::thermal:
-      return "thermal";
-    case Process::evaporation:
-      return "evaporation";
-  }
-  return "?";
-}
-
 double series_value(const Series& s, double t) {
   if (s.empty()) return 0.0;
   if (t <= s.front().t) return s.front().value;
@@ -79,14 +58,6 @@ double series_max(const Series& s, double t0, double t1) {
   for (const auto& p : s)
     if (p.t > t0 && p.t < t1) m = std::max(m, p.value);
   return m;
-}
-
-const std::vector<FieldId>& state_fields() {
-  static const std::vector<FieldId> ids{
-      FieldId::bed,        FieldId::initial_bed, FieldId::water_depth, FieldId::sediment,
-      FieldId::velocity_x, FieldId::velocity_y,  FieldId::flux_left,   FieldId::flux_right,
-      FieldId::flux_top,   FieldId::flux_bottom, FieldId::wetness,     FieldId::bed_residual};
-  return ids;
 }
 
 RestartPoint Simulation::restart_point() const {
@@ -151,6 +122,8 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     : terrain_(std::move(terrain)), params_(std::move(params)), backend_(std::move(backend)) {
   if (!backend_) throw Error(ExitCode::internal, "simulation: no backend");
   terrain_.grid.validate();
+  // every field a sweep of the step reads is provided before it (process.hpp)
+  check_sweeps(step_sweeps(params_));
   const auto& g = terrain_.grid;
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
@@ -272,17 +245,10 @@ double Simulation::source_rise_rate() const {
 }
 
 std::vector<Process> Simulation::sequence() const {
-  // The sources run after the flow: the fluxes of a step come from the depth at its start,
-  // and the step's rain and inflows enter the continuity update with them (model.md
-  // section 2).
-  std::vector<Process> seq{Process::boundary, Process::flow, Process::sources, Process::water};
-  if (params_.erosion.enabled) {
-    seq.push_back(Process::erosion);
-    seq.push_back(Process::transport);
-  }
-  if (params_.thermal.enabled) seq.push_back(Process::thermal);
-  seq.push_back(Process::evaporation);
-  return seq;
+  // The enabled entries of the process table, in its order (process.hpp): the sources run
+  // after the flow, so the fluxes of a step come from the depth at its start and the step's
+  // rain and inflows enter the continuity update with them (model.md section 2).
+  return step_sequence(params_);
 }
 
 double Simulation::next_dt() const {
@@ -426,16 +392,7 @@ void Simulation::step() {
   for (const auto& p : in.points) added += p.volume;
   ledger_.rain += in.rain_rate * dt * rain_area_;
   ledger_.inflow += added;
-  ledger_.boundary_out += tally.boundary_water_out;
-  ledger_.evaporated += tally.evaporated;
-  ledger_.clipped += tally.clipped;
-  ledger_.sediment_out += tally.sediment_out;
-  ledger_.transport_change += tally.transport_change;
-  ledger_.water_exchanged += tally.water_exchanged;
-  ledger_.eroded += tally.eroded;
-  ledger_.deposited += tally.deposited;
-  ledger_.sediment_exchanged += tally.sediment_exchanged;
-  ledger_.thermal_moved += tally.thermal_moved;
+  for (const auto& t : tally_table()) ledger_.*t.ledger += tally.*t.step;
   ledger_.water = stats_.water_volume;
   ledger_.material = stats_.material_volume;
 

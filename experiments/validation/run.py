@@ -413,8 +413,9 @@ def run_full_size(build: Path, records: Path) -> bool:
         ref = rows["cpu_float64"]
 
         def rec(target, quantity, value, bound):
+            value = None if value is None else float(value)
             relation = "" if bound is None else "<"
-            passed = bound is None or (value is not None and abs(value) < bound)
+            passed = bool(bound is None or (value is not None and abs(value) < bound))
             return json.dumps({
                 "case": cid, "target": target, "scheme": "local_inertial", "quantity": quantity,
                 "resolution": cell[case], "value": value, "order": None, "relation": relation,
@@ -661,6 +662,10 @@ def main() -> int:
         rc = run_cases(build, records, not args.coarse)
         gtest_wall = time.time() - start
         full = not args.coarse and not args.no_full_size
+        # written now too, so --full-size-only can follow a run whose full-size part failed
+        (records / "run.json").write_text(json.dumps(
+            {"rc": rc, "wall": gtest_wall, "gtest_wall": gtest_wall, "coarse": args.coarse,
+             "full_size": False}))
         if full and not run_full_size(build, records):
             rc = rc or 1
         wall = time.time() - start

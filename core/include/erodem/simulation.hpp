@@ -58,9 +58,6 @@ struct RestartPoint {
   std::vector<std::vector<double>> fields;
 };
 
-/// The fields a backend keeps from one step to the next (everything else is derived from
-/// the terrain and the parameters, or recomputed within a step).
-const std::vector<FieldId>& state_fields();
 
 class Simulation {
  public:

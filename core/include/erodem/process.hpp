@@ -1,0 +1,116 @@
+// erodem — the process table: one entry per process of the step (MODEL.md "One step"), in step
+// order, with what the rest of the code derives from it instead of writing it again: the step
+// sequence and the process names (Simulation), the sweeps over the grid each process runs with
+// the fields they read and write (the bench's byte model, the check that every field a sweep
+// reads is provided), the ledger tallies each process books (the ledger's update), whether the
+// bed changes (the gauges), and the schema section of its parameters. The per-cell physics
+// stays in kernels/common/*.h; docs/architecture.md ("Adding a process") says how an entry is
+// added.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "erodem/backend.hpp"
+#include "erodem/ledger.hpp"
+#include "erodem/params.hpp"
+
+namespace erodem {
+
+/// How a sweep touches a field.
+enum class Access : std::uint8_t {
+  read,             ///< its own cell
+  read_neighbours,  ///< its own cell and its four neighbours
+  write,            ///< writes its own cell, without reading the old value
+  update,           ///< reads the old value (and possibly the neighbours') and writes the new one
+};
+
+/// Which cells a sweep visits: the cells of the DEM (every interior row), the ghost cells
+/// around them, a list of point cells (inflows), or none per cell (bookkeeping only).
+enum class Domain : std::uint8_t { cells, halo, points };
+
+/// One field a sweep uses, by name: a field of field_table() ("bed", "water_depth", ...), or
+/// a grid input or intermediate of grid_inputs() / intermediate_fields() ("kind",
+/// "rain_factor", "thermal_share", "depth_flow").
+struct FieldUse {
+  const char* field;
+  Access access;
+};
+
+/// One pass over the grid: the unit of execution. A sweep may compose the cell functions of
+/// several processes (a fused pass is then one entry with the union of their uses); its bytes
+/// per cell are those of its distinct fields.
+struct SweepInfo {
+  const char* name;  ///< e.g. "erosion"; the OpenCL kernels that run it are `opencl_kernels`
+  Domain domain;
+  std::vector<FieldUse> uses;
+  std::vector<const char*> opencl_kernels;
+  /// Intermediates it leaves for later sweeps of the step at no traffic of its own (the
+  /// water update leaves "depth_flow", the depth it started from, in its second buffer).
+  std::vector<const char*> leaves = {};
+};
+
+/// One tally of the ledger: a volume (m^3) a process books per step, added to a Ledger
+/// member. The ledger adds the tallies in the order of tally_table().
+struct TallyInfo {
+  const char* name;  ///< the Ledger entry's name (ledger_entries())
+  double StepTally::*step;
+  double Ledger::*ledger;
+};
+
+struct ProcessInfo {
+  Process id;
+  const char* name;            ///< process_name(), the bench's row names
+  const char* schema_section;  ///< the config section of its parameters ("" for none)
+  /// Whether the process runs in a step with these parameters.
+  bool (*enabled)(const Params&);
+  /// The sweeps it runs in one step with these parameters, in order (none: nothing per cell).
+  std::vector<SweepInfo> (*sweeps)(const Params&);
+  /// The Ledger members its tallies are booked into (entries of tally_table()).
+  std::vector<const char*> tallies;
+};
+
+/// Every process, in step order (the sources run after the flow: model.md section 2).
+const std::vector<ProcessInfo>& process_table();
+/// The entry of `p`.
+const ProcessInfo& process_info(Process p);
+/// Every tally of the step, in the order the ledger adds them.
+const std::vector<TallyInfo>& tally_table();
+
+/// The grid inputs every sweep may read: the cell kinds and the per-row spacings and areas,
+/// and the parameter fields (rasters or uniform values).
+const std::vector<std::string>& grid_inputs();
+
+/// The processes that run in a step with `params`, in order.
+std::vector<Process> step_sequence(const Params& params);
+/// The sweeps of those processes, in order, each with its process.
+std::vector<std::pair<Process, SweepInfo>> step_sweeps(const Params& params);
+
+/// Checks that every field a sweep of the sequence reads is provided before it: a grid input,
+/// a state field (fields with `state` in field_table()), or a field an earlier sweep of the
+/// step writes or leaves. Throws Error(ExitCode::internal) naming the sweep and the field.
+void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps);
+
+/// Whether a sweep of the sequence writes the bed (erosion, slope collapse): the gauges must
+/// then read the bed every step.
+bool bed_changes(const Params& params);
+
+/// The bytes a sweep moves per cell and step: every distinct field it reads, once, plus every
+/// field it writes, once; `real_bytes` (4 or 8) per field, 1 byte for the cell kind. Neighbour
+/// reads count once (they hit the cache lines the sweep brings in anyway); per-row arrays and
+/// sweeps over the halo or point cells count 0. Writes count no write-allocate traffic (as
+/// STREAM counts). `reads` and `writes` name the fields.
+struct SweepBytes {
+  int read = 0, write = 0;
+  std::string reads, writes;
+  int total() const { return read + write; }
+};
+SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes);
+/// The bytes per cell of every sweep of process `p` with these parameters, together.
+SweepBytes process_bytes(Process p, const Params& params, int real_bytes);
+/// The driver's reductions after every step (Simulation::step: the ledger's volumes, the
+/// maxima, the first bad cell), as a sweep.
+const SweepInfo& stats_sweep();
+
+}  // namespace erodem

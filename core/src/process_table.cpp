@@ -1,0 +1,306 @@
+// erodem — the entries of the process table (process.hpp). Each entry says what its sweeps
+// read and write as the cell functions of kernels/common/*.h and the loops of kernels/cpu/*.cpp
+// and kernels/opencl/*.cl do; tests/test_process_table.cpp checks the derived sequence, byte
+// model and bed-change set.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <set>
+
+#include "erodem/error.hpp"
+#include "erodem/fields.hpp"
+#include "erodem/process.hpp"
+
+namespace erodem {
+namespace {
+
+constexpr Access R = Access::read, N = Access::read_neighbours, Wr = Access::write,
+                 U = Access::update;
+
+bool always(const Params&) {
+  return true;
+}
+bool erosion_on(const Params& p) {
+  return p.erosion.enabled;
+}
+bool thermal_on(const Params& p) {
+  return p.thermal.enabled;
+}
+bool rains(const Params& p) {
+  return p.rain.rate > 0 || !p.rain.series.empty();
+}
+
+// ---- the sweeps of each process --------------------------------------------------------
+
+std::vector<SweepInfo> boundary_sweeps(const Params&) {
+  // boundary_fill_cell (boundary.h): the ghosts take the bed and depth their edge gives them
+  return {{"boundary_fill",
+           Domain::halo,
+           {{"kind", R}, {"bed", U}, {"water_depth", U}},
+           {"boundary_fill"}}};
+}
+
+std::vector<SweepInfo> sources_sweeps(const Params& p) {
+  // rain_cell (sources.h) over the cells where it rains; the inflows add at their cells
+  std::vector<SweepInfo> s;
+  if (rains(p))
+    s.push_back({"sources_rain",
+                 Domain::cells,
+                 {{"kind", R}, {"rain_factor", R}, {"water_depth", U}},
+                 {"sources_rain"}});
+  if (!p.inflow.empty())
+    s.push_back({"sources_points", Domain::points, {{"water_depth", U}}, {"sources_points"}});
+  return s;
+}
+
+std::vector<SweepInfo> flow_sweeps(const Params& p) {
+  const std::vector<FieldUse> fluxes{
+      {"flux_left", U}, {"flux_right", U}, {"flux_top", U}, {"flux_bottom", U}};
+  if (p.flow.scheme == FlowScheme::local_inertial) {
+    // local_inertial_face + local_inertial_split (flow.h): the face discharges from the old
+    // outflows, the levels and the face's Manning n; then the outflows of each cell
+    std::vector<FieldUse> uses{{"kind", N}, {"bed", N}, {"water_depth", N}, {"manning_n", N}};
+    uses.insert(uses.end(), fluxes.begin(), fluxes.end());
+    return {{"flow_local_inertial",
+             Domain::cells,
+             uses,
+             {"flow_local_inertial_faces", "flow_local_inertial_faces_x_interior",
+              "flow_local_inertial_faces_y_interior", "flow_local_inertial_split",
+              "flow_local_inertial_split_interior"}}};
+  }
+  // flow_pipes_outflows (flow.h): each pipe from the surface drop to its neighbour
+  std::vector<FieldUse> uses{{"kind", N}, {"bed", N}, {"water_depth", N}};
+  uses.insert(uses.end(), fluxes.begin(), fluxes.end());
+  return {{"flow_pipes", Domain::cells, uses, {"flow_pipes", "flow_pipes_interior"}}};
+}
+
+std::vector<SweepInfo> water_sweeps(const Params&) {
+  // water_update_cell (water.h): the depth from the outflows in and out, the velocity from the
+  // faces' discharges over their flow depths (bed and depth of the neighbours); the depth it
+  // started from stays in the second buffer for conservative transport ("depth_flow")
+  return {{"water_update",
+           Domain::cells,
+           {{"kind", N},
+            {"bed", N},
+            {"water_depth", U},
+            {"flux_left", N},
+            {"flux_right", N},
+            {"flux_top", N},
+            {"flux_bottom", N},
+            {"velocity_x", Wr},
+            {"velocity_y", Wr}},
+           {"water_update", "edge_tallies"},
+           {"depth_flow"}}};
+}
+
+std::vector<SweepInfo> erosion_sweeps(const Params&) {
+  // erosion_cell (erosion.h): capacity from the speed and the bed's tilt, the exact transfer
+  // between the bed pair and the sediment
+  return {{"erosion",
+           Domain::cells,
+           {{"kind", R},
+            {"bed", U},
+            {"bed_residual", U},
+            {"sediment", U},
+            {"water_depth", R},
+            {"velocity_x", R},
+            {"velocity_y", R},
+            {"hardness", R}},
+           {"erosion"}}};
+}
+
+std::vector<SweepInfo> transport_sweeps(const Params& p) {
+  if (p.transport.scheme == TransportScheme::conservative)
+    // transport_conservative_cell (transport.h): sediment moves with the outflows at the
+    // concentration of the depth the flow saw
+    return {{"transport_conservative",
+             Domain::cells,
+             {{"kind", N},
+              {"sediment", U},
+              {"depth_flow", N},
+              {"flux_left", N},
+              {"flux_right", N},
+              {"flux_top", N},
+              {"flux_bottom", N}},
+             {"transport_conservative", "edge_tallies"}}};
+  // transport_semi_lagrangian_cell (transport.h): back-traced along the velocity
+  return {{"transport_semi_lagrangian",
+           Domain::cells,
+           {{"kind", N}, {"sediment", U}, {"velocity_x", R}, {"velocity_y", R}},
+           {"transport_semi_lagrangian", "reduce_change"}}};
+}
+
+std::vector<SweepInfo> thermal_sweeps(const Params&) {
+  // thermal_share_cell then thermal_apply_cell (thermal.h): what each cell gives, then what
+  // it keeps and takes from its neighbours
+  return {{"thermal_share",
+           Domain::cells,
+           {{"kind", N}, {"bed", N}, {"thermal_share", Wr}},
+           {"thermal_share"}},
+          {"thermal_apply",
+           Domain::cells,
+           {{"kind", N}, {"bed", U}, {"bed_residual", U}, {"thermal_share", N}},
+           {"thermal_apply"}}};
+}
+
+std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
+  // evaporation_cell and wetness_cell (sources.h): the depth decays (when the rate > 0) and
+  // the wetness follows it
+  return {{"evaporation",
+           Domain::cells,
+           {{"kind", R}, {"water_depth", p.evaporation.rate > 0 ? U : R}, {"wetness", U}},
+           {"evaporation"}}};
+}
+
+}  // namespace
+
+const std::vector<ProcessInfo>& process_table() {
+  static const std::vector<ProcessInfo> table{
+      {Process::boundary, "boundary", "boundary", always, boundary_sweeps, {}},
+      {Process::flow, "flow", "flow", always, flow_sweeps, {}},
+      {Process::sources, "sources", "rain", always, sources_sweeps, {}},
+      {Process::water,
+       "water",
+       "",
+       always,
+       water_sweeps,
+       {"boundary_out", "clipped", "water_exchanged"}},
+      {Process::erosion, "erosion", "erosion", erosion_on, erosion_sweeps, {"eroded", "deposited"}},
+      // erosion.enabled switches transport too: what erosion lifts must move
+      {Process::transport,
+       "transport",
+       "transport",
+       erosion_on,
+       transport_sweeps,
+       {"sediment_out", "transport_change", "sediment_exchanged"}},
+      {Process::thermal, "thermal", "thermal", thermal_on, thermal_sweeps, {"thermal_moved"}},
+      {Process::evaporation,
+       "evaporation",
+       "evaporation",
+       always,
+       evaporation_sweeps,
+       {"evaporated"}},
+  };
+  return table;
+}
+
+const std::vector<TallyInfo>& tally_table() {
+  // the order in which Simulation::step has always added them
+  static const std::vector<TallyInfo> table{
+      {"boundary_out", &StepTally::boundary_water_out, &Ledger::boundary_out},
+      {"evaporated", &StepTally::evaporated, &Ledger::evaporated},
+      {"clipped", &StepTally::clipped, &Ledger::clipped},
+      {"sediment_out", &StepTally::sediment_out, &Ledger::sediment_out},
+      {"transport_change", &StepTally::transport_change, &Ledger::transport_change},
+      {"water_exchanged", &StepTally::water_exchanged, &Ledger::water_exchanged},
+      {"eroded", &StepTally::eroded, &Ledger::eroded},
+      {"deposited", &StepTally::deposited, &Ledger::deposited},
+      {"sediment_exchanged", &StepTally::sediment_exchanged, &Ledger::sediment_exchanged},
+      {"thermal_moved", &StepTally::thermal_moved, &Ledger::thermal_moved},
+  };
+  return table;
+}
+
+const ProcessInfo& process_info(Process p) {
+  for (const auto& e : process_table())
+    if (e.id == p) return e;
+  throw Error(ExitCode::internal, "process without a table entry");
+}
+
+const char* process_name(Process p) {
+  return process_info(p).name;
+}
+
+const std::vector<std::string>& grid_inputs() {
+  static const std::vector<std::string> inputs{"kind",     "dx",        "dy",         "area",
+                                               "hardness", "manning_n", "rain_factor"};
+  return inputs;
+}
+
+std::vector<Process> step_sequence(const Params& params) {
+  std::vector<Process> seq;
+  for (const auto& e : process_table())
+    if (e.enabled(params)) seq.push_back(e.id);
+  return seq;
+}
+
+std::vector<std::pair<Process, SweepInfo>> step_sweeps(const Params& params) {
+  std::vector<std::pair<Process, SweepInfo>> out;
+  for (const auto& e : process_table())
+    if (e.enabled(params))
+      for (auto& s : e.sweeps(params)) out.emplace_back(e.id, std::move(s));
+  return out;
+}
+
+void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps) {
+  std::set<std::string> provided(grid_inputs().begin(), grid_inputs().end());
+  for (const auto& f : field_table())
+    if (f.state) provided.insert(f.name);
+  for (const auto& [p, s] : sweeps) {
+    for (const auto& u : s.uses)
+      if (u.access != Access::write && !provided.count(u.field))
+        throw Error(ExitCode::internal,
+                    fmt::format("process table: sweep '{}' of process '{}' reads '{}', which no "
+                                "grid input, state field or earlier sweep of the step provides",
+                                s.name, process_name(p), u.field));
+    for (const auto& u : s.uses) provided.insert(u.field);
+    for (const char* f : s.leaves) provided.insert(f);
+  }
+}
+
+bool bed_changes(const Params& params) {
+  for (const auto& [p, s] : step_sweeps(params))
+    if (s.domain == Domain::cells)
+      for (const auto& u : s.uses)
+        if (std::string(u.field) == "bed" &&
+            (u.access == Access::write || u.access == Access::update))
+          return true;
+  return false;
+}
+
+SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes) {
+  SweepBytes b;
+  if (sweep.domain != Domain::cells) return b;
+  for (const auto& u : sweep.uses) {
+    const int size = std::string(u.field) == "kind" ? 1 : real_bytes;
+    if (u.access != Access::write) {
+      b.read += size;
+      b.reads += (b.reads.empty() ? "" : " ") + std::string(u.field);
+    }
+    if (u.access == Access::write || u.access == Access::update) {
+      b.write += size;
+      b.writes += (b.writes.empty() ? "" : " ") + std::string(u.field);
+    }
+  }
+  return b;
+}
+
+SweepBytes process_bytes(Process p, const Params& params, int real_bytes) {
+  SweepBytes total;
+  for (const auto& s : process_info(p).sweeps(params)) {
+    const SweepBytes b = sweep_bytes(s, real_bytes);
+    total.read += b.read;
+    total.write += b.write;
+    if (!b.reads.empty()) total.reads += (total.reads.empty() ? "" : " | ") + b.reads;
+    if (!b.writes.empty()) total.writes += (total.writes.empty() ? "" : " | ") + b.writes;
+  }
+  return total;
+}
+
+const SweepInfo& stats_sweep() {
+  // CpuBackend::stats and stats.cl (cell_state_ok, stats.h): volumes, maxima, the first bad
+  // cell, over the active cells
+  static const SweepInfo sweep{"stats",
+                               Domain::cells,
+                               {{"kind", R},
+                                {"bed", R},
+                                {"bed_residual", R},
+                                {"water_depth", R},
+                                {"sediment", R},
+                                {"velocity_x", R},
+                                {"velocity_y", R}},
+                               {"field_stats", "stats_rows"}};
+  return sweep;
+}
+
+}  // namespace erodem

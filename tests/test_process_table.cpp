@@ -1,0 +1,171 @@
+// erodem — the process table (core/include/erodem/process.hpp): the step sequence, the tallies,
+// the check of the sweeps' fields, the byte model, the bed-change set, the state and output
+// fields, all derived from it, against what the code did when each was written by hand
+// (2026-11-25).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "erodem/error.hpp"
+#include "erodem/fields.hpp"
+#include "erodem/ledger.hpp"
+#include "erodem/process.hpp"
+
+namespace erodem::test {
+namespace {
+
+std::vector<std::string> names(const std::vector<Process>& seq) {
+  std::vector<std::string> out;
+  for (Process p : seq) out.emplace_back(process_name(p));
+  return out;
+}
+
+TEST(ProcessTable, SequenceFollowsTheSwitches) {
+  // Simulation::sequence() as it was written by hand: boundary, flow, sources (after the
+  // flow, model.md section 2), water; erosion and transport when erosion is on; thermal when
+  // it is on; evaporation always (it updates the wetness).
+  Params p;
+  using V = std::vector<std::string>;
+  EXPECT_EQ(names(step_sequence(p)), (V{"boundary", "flow", "sources", "water", "evaporation"}));
+  p.erosion.enabled = true;
+  EXPECT_EQ(names(step_sequence(p)),
+            (V{"boundary", "flow", "sources", "water", "erosion", "transport", "evaporation"}));
+  p.thermal.enabled = true;
+  EXPECT_EQ(names(step_sequence(p)), (V{"boundary", "flow", "sources", "water", "erosion",
+                                        "transport", "thermal", "evaporation"}));
+  p.erosion.enabled = false;
+  EXPECT_EQ(names(step_sequence(p)),
+            (V{"boundary", "flow", "sources", "water", "thermal", "evaporation"}));
+}
+
+TEST(ProcessTable, EveryTallyIsALedgerEntryBookedByOneProcess) {
+  std::size_t booked = 0;
+  for (const auto& t : tally_table()) {
+    // a ledger entry of the same name and member (the HDF5 restart/ledger_<name>, Python keys)
+    const auto& entries = ledger_entries();
+    const auto e = std::find_if(entries.begin(), entries.end(), [&](const LedgerEntry& l) {
+      return std::string(l.name) == t.name;
+    });
+    ASSERT_NE(e, entries.end()) << t.name;
+    EXPECT_TRUE(e->member == t.ledger) << t.name;
+    int by = 0;
+    for (const auto& p : process_table())
+      by += static_cast<int>(std::count_if(p.tallies.begin(), p.tallies.end(), [&](const char* n) {
+        return std::string(n) == t.name;
+      }));
+    EXPECT_EQ(by, 1) << t.name << " is booked by " << by << " processes";
+    booked += by;
+  }
+  std::size_t listed = 0;
+  for (const auto& p : process_table()) listed += p.tallies.size();
+  EXPECT_EQ(booked, listed) << "a process lists a tally that tally_table() lacks";
+  std::printf("[process table] %zu tallies, each booked by one process\n", tally_table().size());
+}
+
+TEST(ProcessTable, CheckRejectsAReadOfAFieldNothingProvides) {
+  Params p;
+  p.erosion.enabled = p.thermal.enabled = true;
+  for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian})
+    for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial}) {
+      p.transport.scheme = transport;
+      p.flow.scheme = flow;
+      EXPECT_NO_THROW(check_sweeps(step_sweeps(p)));
+    }
+  // Thermal collapse with its two sweeps swapped: the apply sweep reads the share before any
+  // sweep writes it.
+  auto sweeps = step_sweeps(p);
+  const auto share = std::find_if(sweeps.begin(), sweeps.end(), [](const auto& s) {
+    return std::string(s.second.name) == "thermal_share";
+  });
+  ASSERT_NE(share, sweeps.end());
+  std::iter_swap(share, share + 1);
+  try {
+    check_sweeps(sweeps);
+    ADD_FAILURE() << "thermal_apply before thermal_share was accepted";
+  } catch (const Error& e) {
+    std::printf("[process table] %s\n", e.what());
+    EXPECT_EQ(e.code(), ExitCode::internal);
+    EXPECT_NE(std::string(e.what()).find("'thermal_apply'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'thermal_share'"), std::string::npos) << e.what();
+  }
+  // Conservative transport without the water update before it: nothing leaves "depth_flow".
+  p.transport.scheme = TransportScheme::conservative;
+  std::vector<std::pair<Process, SweepInfo>> no_water;
+  for (auto& s : step_sweeps(p))
+    if (s.first != Process::water) no_water.push_back(s);
+  EXPECT_THROW(check_sweeps(no_water), Error);
+}
+
+// The byte model, per process, of the bench scenario's schemes and rates. Where it differs from
+// the model written by hand in cmd_bench.cpp (2026-11-23; full local-inertial step 213 B/cell),
+// the code had changed under that model: the water update reads the bed since the velocities
+// are taken over the faces' flow depths (+4), erosion and slope collapse read and write the
+// bed residual since the bed pair (+8, +8), and so do the statistics (+4): 237 B/cell.
+TEST(ProcessTable, ByteModelFromTheSweeps) {
+  Params p;
+  p.erosion.enabled = p.thermal.enabled = true;
+  p.rain.rate = 1e-6;
+  p.evaporation.rate = 1e-7;
+  auto bytes = [&](Process pr) { return process_bytes(pr, p, 4).total(); };
+  EXPECT_EQ(bytes(Process::boundary), 0);
+  EXPECT_EQ(bytes(Process::sources), 13);      // kind depth rain_factor | depth
+  EXPECT_EQ(bytes(Process::flow), 45);         // kind bed depth manning flux*4 | flux*4
+  EXPECT_EQ(bytes(Process::water), 37);        // kind bed depth flux*4 | depth velocity_x, _y
+  EXPECT_EQ(bytes(Process::erosion), 41);      // kind bed bed_residual sediment depth u v hardness
+  EXPECT_EQ(bytes(Process::transport), 29);    // kind sediment depth_flow flux*4 | sediment
+  EXPECT_EQ(bytes(Process::thermal), 30);      // kind bed | share; kind bed residual share | ...
+  EXPECT_EQ(bytes(Process::evaporation), 17);  // kind depth wetness | depth wetness
+  EXPECT_EQ(sweep_bytes(stats_sweep(), 4).total(), 25);
+  int full = sweep_bytes(stats_sweep(), 4).total();
+  for (Process pr : step_sequence(p)) full += bytes(pr);
+  EXPECT_EQ(full, 237);
+  std::printf(
+      "[process table] full local-inertial step %d B/cell (hand model of 2026-11-23: 213)\n", full);
+  p.flow.scheme = FlowScheme::pipes;
+  p.transport.scheme = TransportScheme::semi_lagrangian;
+  EXPECT_EQ(bytes(Process::flow), 41);
+  EXPECT_EQ(bytes(Process::transport), 17);
+  p.evaporation.rate = 0;
+  EXPECT_EQ(bytes(Process::evaporation), 13);  // the depth is only read
+  p.rain.rate = 0;
+  EXPECT_EQ(bytes(Process::sources), 0);
+  // float64: every field but the kind twice as wide
+  p.flow.scheme = FlowScheme::local_inertial;
+  EXPECT_EQ(process_bytes(Process::flow, p, 8).total(), 1 + 7 * 8 + 4 * 8);
+  const SweepBytes f = process_bytes(Process::flow, p, 4);
+  EXPECT_EQ(f.reads, "kind bed water_depth manning_n flux_left flux_right flux_top flux_bottom");
+  EXPECT_EQ(f.writes, "flux_left flux_right flux_top flux_bottom");
+}
+
+TEST(ProcessTable, BedChangesWithErosionOrThermal) {
+  Params p;
+  EXPECT_FALSE(bed_changes(p));
+  p.erosion.enabled = true;
+  EXPECT_TRUE(bed_changes(p));
+  p.erosion.enabled = false;
+  p.thermal.enabled = true;
+  EXPECT_TRUE(bed_changes(p));
+}
+
+TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
+  // state_fields() and output.fields' choices as written by hand before the table
+  // (simulation.cpp and schema.cpp of 2026-11-25), as sets: the order is the table's now.
+  std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
+  for (FieldId id : state_fields()) state.insert(field_info(id).name);
+  EXPECT_EQ(state, (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment",
+                                          "velocity_x", "velocity_y", "flux_left", "flux_right",
+                                          "flux_top", "flux_bottom", "wetness", "bed_residual"}));
+  EXPECT_EQ(output, (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x",
+                                           "velocity_y", "erosion", "wetness", "hardness",
+                                           "flux_left", "flux_right", "flux_top", "flux_bottom"}));
+  // a field restored from files that lack it starts at 0: only the bed residual, added later
+  for (const auto& f : field_table())
+    EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual) << f.name;
+}
+
+}  // namespace
+}  // namespace erodem::test
