@@ -32,6 +32,7 @@ import os
 import shutil
 import subprocess
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -529,7 +530,7 @@ def plot_case(case: str, recs: list[dict], profiles, path: Path) -> None:
         ax.set_xscale("log")
         ax.set_xlabel("|measured| / |bound| (bound at 1)")
         ax.set_title("measured against bound", fontsize=9)
-    fig.suptitle(CASES.get(case, (case,))[0], fontsize=10)
+    fig.suptitle(textwrap.fill(CASES.get(case, (case,))[0], 90 if panels > 1 else 55), fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
