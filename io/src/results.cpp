@@ -716,13 +716,18 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
 }
 
 ResultWriter::~ResultWriter() {
+  close();
+}
+
+void ResultWriter::close() {
   if (!impl_) return;
   QuietH5 quiet;
   try {
     impl_->flush_pending();
-  } catch (...) {  // a destructor reports nothing; the file keeps what it had
+  } catch (...) {  // closing reports nothing; the file keeps what it had
   }
   impl_->close();
+  impl_.reset();
 }
 
 void ResultWriter::snapshot(const Simulation& sim) {

@@ -16,6 +16,7 @@ import math
 import os
 import shlex
 import sys
+import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -389,8 +390,10 @@ class Simulation:
         backend: str = "auto",
         *,
         config: Union[Mapping[str, Any], str, os.PathLike, None] = None,
+        restart: Union[str, os.PathLike, Tuple[Any, Any], None] = None,
         **params: Any,
     ):
+        restart_arg = _restart_arg(restart)
         if dem is not None and not isinstance(dem, DEM):
             dem = read_dem(dem)
         config_path = ""
@@ -412,9 +415,18 @@ class Simulation:
         self._backend_name = backend
         self._config = config
         self._params = dict(params)
+        cmd = "python: " + " ".join(shlex.quote(a) for a in (sys.argv or ["python"]))
         self._sim = _erodem.Simulation(
-            config_path, settings, dem._terrain if dem is not None else None, backend
+            config_path,
+            settings,
+            dem._terrain if dem is not None else None,
+            backend,
+            restart_arg,
+            bool(restart_arg) and config is None,
+            cmd,
         )
+        for message in self._sim.warnings:
+            warnings.warn(message, RuntimeWarning, stacklevel=2)
 
     # ---- stepping ----
 
@@ -444,7 +456,7 @@ class Simulation:
         n = int(n)
         if n < 0:
             raise ValueError("step: 'n' must be >= 0, got %d" % n)
-        self._sim.advance(n, False, math.inf, None, self.chunk_seconds, False)
+        self._sim.advance(n, False, math.inf, self.chunk_seconds, False)
 
     def run(
         self,
@@ -504,7 +516,6 @@ class Simulation:
         t_end = None
         if duration is not None:
             t_end = self.time + _duration_seconds(duration)
-        writer = None
         if output is not None:
             out_settings: Dict[str, Any] = {"output.path": os.fspath(output)}
             if every is not None:
@@ -513,8 +524,9 @@ class Simulation:
                     out_settings["output.interval"] = 0.0
                 else:
                     out_settings["output.interval"] = every
-            cmd = "python: " + " ".join(shlex.quote(a) for a in (sys.argv or ["python"]))
-            writer = _erodem.ResultWriter(self._sim, _settings(out_settings), overwrite, cmd)
+            # The first snapshot (the state now); then every step is recorded as
+            # `erodem run` records it (the same C++ run driver, io::RunSession).
+            self._sim.open_output(_settings(out_settings), overwrite)
         elif every is not None:
             raise ValueError("run: 'every' needs 'output'")
 
@@ -539,30 +551,29 @@ class Simulation:
                     if left <= 0:
                         break
                     steps = left - self._sim.advance(
-                        left, False, math.inf, writer, self.chunk_seconds, True
+                        left, False, math.inf, self.chunk_seconds, True
                     )
                 elif t_end is not None:
                     if self.time >= t_end:
                         break
-                    self._sim.advance(big, False, t_end, writer, self.chunk_seconds, True)
+                    self._sim.advance(big, False, t_end, self.chunk_seconds, True)
                 else:
                     if self._sim.finished:
                         break
-                    self._sim.advance(big, True, math.inf, writer, self.chunk_seconds, True)
+                    self._sim.advance(big, True, math.inf, self.chunk_seconds, True)
                 if bar is not None:
                     bar.update(self.time - t0 if bar.unit == "s" else self.steps_done - n0)
-            if writer is not None:
-                writer.finish(self._sim)
+            if self._sim.output_open:
+                self._sim.finish_output()  # last snapshot, .xmf, rename into place
         except KeyboardInterrupt:
-            if writer is not None and writer.open:
-                writer.snapshot(self._sim)
-                writer.close()
+            if self._sim.output_open:
+                self._sim.abandon_output()  # a snapshot of this step; stays .partial
             raise
         finally:
             if bar is not None:
                 bar.close()
-            if writer is not None and writer.open:
-                writer.close()  # an error: the partial file stays
+            if self._sim.output_open:
+                self._sim.close_output()  # an error: the partial file stays
         return self.ledger
 
     # ---- state ----
@@ -661,6 +672,13 @@ class Simulation:
         return self._sim.finished
 
     @property
+    def restart_from(self) -> str:
+        """``"FILE:TIME"`` of the stored state this simulation continued from (``restart``),
+        recorded as ``restart_from`` in the result files it writes; ``""`` when it started
+        at t = 0."""
+        return self._sim.restart_from
+
+    @property
     def backend(self) -> str:
         """``"cpu"`` or ``"opencl"``."""
         return self._sim.backend
@@ -691,6 +709,35 @@ class Simulation:
             self.steps_done,
             self.time,
         )
+
+
+def _restart_arg(restart: Union[str, os.PathLike, Tuple[Any, Any], None]) -> str:
+    """``restart`` as the C++ run driver takes it: ``"FILE"`` or ``"FILE:TIME"``."""
+    if restart is None:
+        return ""
+    if isinstance(restart, (str, os.PathLike)):
+        arg = os.fspath(restart)
+    elif isinstance(restart, (tuple, list)) and len(restart) == 2:
+        path, t = restart
+        if not isinstance(path, (str, os.PathLike)):
+            raise ValueError("restart: expected (path, time), got a path of type %s"
+                             % type(path).__name__)
+        arg = os.fspath(path)
+        if t is not None:
+            if isinstance(t, (int, float, np.integer, np.floating)) and not isinstance(t, bool):
+                arg += ":" + repr(float(t))  # the shortest text of the same double
+            elif isinstance(t, str):
+                arg += ":" + repr(_erodem.duration_seconds("restart", t))
+            else:
+                raise ValueError("restart: time %r: expected seconds or a string with a unit"
+                                 % (t,))
+    else:
+        raise ValueError(
+            "restart: expected \"run.h5\", \"run.h5:TIME\" or (path, time), got %r" % (restart,)
+        )
+    if not arg:
+        raise ValueError("restart: empty path")
+    return arg
 
 
 def _duration_seconds(value: Union[float, str]) -> float:

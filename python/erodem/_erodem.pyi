@@ -65,21 +65,49 @@ class Simulation:
     """The C++ simulation behind erodem.Simulation."""
 
     def __init__(
-        self, config_path: str, settings: Settings, terrain: Optional[Terrain], backend: str
-    ) -> None: ...
+        self,
+        config_path: str,
+        settings: Settings,
+        terrain: Optional[Terrain],
+        backend: str,
+        restart: str,
+        config_from_restart: bool,
+        command_line: str,
+    ) -> None:
+        """An io::RunSession (the run driver of ``erodem run``) without a result file;
+        ``restart`` ("FILE[:TIME]" or "") continues a stored run, with its stored config as
+        the base when ``config_from_restart``."""
     def advance(
         self,
         max_steps: int,
         to_end: bool,
         until_time: float,
-        writer: Optional[ResultWriter],
         chunk_seconds: float,
         once: bool,
     ) -> int:
         """Runs up to ``max_steps`` steps (stopping at the configured end when ``to_end``, and
-        once the time reaches ``until_time`` s) with the GIL released, in chunks of ``chunk_seconds`` wall time; checks signals
-        between chunks (KeyboardInterrupt); with ``once`` returns after one chunk. Returns
+        once the time reaches ``until_time`` s) with the GIL released, in chunks of
+        ``chunk_seconds`` wall time; checks signals between chunks (KeyboardInterrupt); with
+        ``once`` returns after one chunk. An open result file records every step. Returns
         the steps run."""
+    def open_output(self, settings: Settings, overwrite: bool) -> None:
+        """Opens a result file (output.* ``settings``) with a first snapshot of the state now."""
+    def finish_output(self) -> None:
+        """The last snapshot, the .xmf sidecar, the rename into place."""
+    def abandon_output(self) -> None:
+        """A snapshot of this step (unless it has one); the file stays at its partial name."""
+    def close_output(self) -> None:
+        """Closes the file as it is, at its partial name."""
+    @property
+    def output_open(self) -> bool: ...
+    @property
+    def output_path(self) -> str: ...
+    @property
+    def output_partial(self) -> str: ...
+    @property
+    def restart_from(self) -> str: ...
+    @property
+    def warnings(self) -> List[str]: ...
     def field(self, name: str) -> np.ndarray:
         """A view (CPU) or read-only copy (OpenCL, erosion) of field ``name``."""
     def set_field(self, name: str, values: npt.ArrayLike) -> None: ...
@@ -117,19 +145,3 @@ class Simulation:
     def shape(self) -> Tuple[int, int]: ...
     @property
     def area(self) -> List[float]: ...
-
-class ResultWriter:
-    """A result file being written for a Simulation; takes the first snapshot when made."""
-
-    def __init__(
-        self, sim: Simulation, settings: Settings, overwrite: bool, command_line: str
-    ) -> None: ...
-    def snapshot(self, sim: Simulation) -> None: ...
-    def finish(self, sim: Simulation) -> None: ...
-    def close(self) -> None: ...
-    @property
-    def path(self) -> str: ...
-    @property
-    def partial(self) -> str: ...
-    @property
-    def open(self) -> bool: ...

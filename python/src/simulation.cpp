@@ -1,5 +1,6 @@
 // erodem — Python bindings: Simulation (step, advance with the GIL released, fields as numpy
-// views, ledger) and ResultWriter (result files written exactly as `erodem run` writes them).
+// views, ledger, result files, restart), thin over io::RunSession, the run driver of
+// `erodem run`: the same code writes both result files.
 #include "erodem/simulation.hpp"
 
 #include <fmt/format.h>
@@ -8,17 +9,15 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <memory>
-#include <optional>
+#include <utility>
 
 #include "bindings.hpp"
-#include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/config.hpp"
 #include "erodem/io/results.hpp"
-#include "erodem/io/setup.hpp"
+#include "erodem/io/run_session.hpp"
 #include "erodem/schema.hpp"
 #include "terrain.hpp"
 
@@ -28,49 +27,63 @@ namespace erodem::python {
 
 namespace {
 
-/// Whether `p` reads any parameter raster (those are loaded on the DEM's grid by
-/// io::load_terrain, so a DEM read without them cannot be reused as it is).
-bool has_parameter_rasters(const Params& p) {
-  return p.initial.water_depth.is_raster() || p.flow.manning_n.is_raster() ||
-         p.erosion.hardness.is_raster() || !p.rain.raster.empty();
-}
-
-class PyWriter;
-
-/// A simulation driven from Python. Not thread-safe: one call at a time (a second thread
-/// calling advance() while one runs gets RuntimeError).
+/// A simulation driven from Python: an io::RunSession. Not thread-safe: one call at a time
+/// (a second thread calling advance() while one runs gets RuntimeError).
 class PySimulation {
  public:
-  /// `config_path` ("" for none) is read first, then `settings` are applied; with `terrain`
-  /// its dem.* settings replace the config's, and its terrain is used as it is (unless
-  /// parameter rasters must be read on its grid). Built with the GIL released.
+  /// The config is `config_path` ("" for none) or, with `config_from_restart`, the stored
+  /// run's (`restart`'s config_toml); then `settings` are applied; with `terrain` its dem.*
+  /// settings replace the config's, and its terrain is used as it is (unless parameter
+  /// rasters must be read on its grid). `restart` ("FILE.h5[:TIME]", or "") continues a
+  /// stored run. Built with the GIL released.
   PySimulation(const std::string& config_path, const Settings& settings, const PyTerrain* terrain,
-               const std::string& backend) {
-    Params p = config_path.empty() ? Params() : load_config(config_path);
+               const std::string& backend, const std::string& restart, bool config_from_restart,
+               const std::string& command_line) {
+    Params p = !config_path.empty()  ? load_config(config_path)
+               : config_from_restart ? io::stored_params(restart)
+                                     : Params();
     apply_settings(p, settings);
     if (terrain) p.dem = terrain->dem;
-    validate(p, config_path.empty() ? "parameters" : config_path);
+    validate(p, !config_path.empty()  ? config_path
+                : config_from_restart ? io::split_restart(restart).first + " (config_toml)"
+                                      : "parameters");
+    io::SessionOptions options;
+    options.backend = backend;
+    options.command_line = command_line;
+    options.restart = restart;
+    options.restart_label = "restart";
+    options.write = false;  // a file is opened by run(output=...)
+    options.terrain = terrain ? &terrain->terrain : nullptr;
     py::gil_scoped_release release;
-    if (terrain && !has_parameter_rasters(p)) {
-      Terrain t = terrain->terrain;
-      auto be = make_backend(backend, t, p);
-      sim_ = std::make_unique<Simulation>(std::move(t), p, std::move(be));
-    } else {
-      sim_ = std::make_unique<Simulation>(io::make_simulation(p, backend));
-    }
+    session_ = std::make_unique<io::RunSession>(std::move(p), std::move(options));
   }
 
-  Simulation& sim() { return *sim_; }
-  const Simulation& sim() const { return *sim_; }
+  io::RunSession& session() { return *session_; }
+  const io::RunSession& session() const { return *session_; }
+  Simulation& sim() { return session_->sim(); }
+  const Simulation& sim() const { return session_->sim(); }
 
   /// Runs up to `max_steps` steps, stopping at the configured end when `to_end` and once the
   /// time reaches `until_time` (s), with the GIL released in chunks of about `chunk_seconds`
-  /// of wall time. Between chunks it checks for signals: a pending Ctrl-C raises
-  /// KeyboardInterrupt there, between two whole steps. `writer` (optional) records every
-  /// step as `erodem run` does. With `once`, returns after the first chunk. Returns the steps
-  /// run.
-  long advance(long max_steps, bool to_end, double until_time, PyWriter* writer,
-               double chunk_seconds, bool once);
+  /// of wall time (RunSession::advance). Between chunks it checks for signals: a pending
+  /// Ctrl-C raises KeyboardInterrupt there, between two whole steps. An open result file
+  /// records every step as `erodem run` does. With `once`, returns after the first chunk.
+  /// Returns the steps run.
+  long advance(long max_steps, bool to_end, double until_time, double chunk_seconds, bool once);
+
+  /// Opens a result file with the simulation's output settings changed by `settings`
+  /// (output.* keys only) and takes its first snapshot (the current state).
+  void open_output(const Settings& settings, bool overwrite) {
+    Params p = sim().params();
+    for (const auto& [key, text] : settings) {
+      if (key.rfind("output.", 0) != 0)
+        throw Error(ExitCode::config, "run: '" + key + "' is not an output.* setting");
+    }
+    apply_settings(p, settings);
+    validate(p, "run");
+    py::gil_scoped_release release;
+    session_->open_output(p, overwrite);
+  }
 
   /// The largest max_depth over the steps run through advance() (m).
   double peak_depth() const { return peak_depth_; }
@@ -79,8 +92,8 @@ class PySimulation {
   /// else a read-only copy (OpenCL, derived fields). `self` becomes the view's base.
   py::array field(const py::object& self, const std::string& name) {
     const FieldId id = field_info(name).id;
-    const Grid& g = sim_->grid();
-    const HostView v = sim_->backend().host_view(id);
+    const Grid& g = sim().grid();
+    const HostView v = sim().backend().host_view(id);
     const std::vector<py::ssize_t> shape{g.ny, g.nx};
     if (v.data) {
       const py::dtype dt = v.element_size == 4 ? py::dtype::of<float>() : py::dtype::of<double>();
@@ -89,9 +102,9 @@ class PySimulation {
           static_cast<py::ssize_t>(v.element_size)};
       return py::array(dt, shape, strides, v.data, self);
     }
-    const std::vector<double> values = sim_->field(id);
+    const std::vector<double> values = sim().field(id);
     py::array out;
-    if (sim_->params().numerics.precision == Precision::float32) {
+    if (sim().params().numerics.precision == Precision::float32) {
       py::array_t<float> a(shape);
       std::transform(values.begin(), values.end(), a.mutable_data(),
                      [](double x) { return static_cast<float>(x); });
@@ -109,7 +122,7 @@ class PySimulation {
   void set_field(const std::string& name,
                  const py::array_t<double, py::array::c_style | py::array::forcecast>& a) {
     const FieldInfo& info = field_info(name);
-    const Grid& g = sim_->grid();
+    const Grid& g = sim().grid();
     if (a.ndim() != 2 || a.shape(0) != g.ny || a.shape(1) != g.nx)
       throw Error(ExitCode::config,
                   fmt::format("field '{}': expected an array of shape ({}, {}), got {}", name, g.ny,
@@ -118,15 +131,15 @@ class PySimulation {
       throw Error(ExitCode::config,
                   "field 'erosion' is derived (initial_bed - bed); set bed or initial_bed");
     std::vector<double> v(a.data(), a.data() + a.size());
-    sim_->backend().set_field(info.id, v);
+    sim().backend().set_field(info.id, v);
   }
 
   /// (eroded, deposited) volume (m^3): the sums over active cells of max(erosion, 0) * area
   /// and max(-erosion, 0) * area, with erosion = initial bed - bed.
   std::pair<double, double> erosion_volumes() const {
-    const std::vector<double> e = sim_->field(FieldId::erosion);
-    const Grid& g = sim_->grid();
-    const Terrain& t = sim_->terrain();
+    const std::vector<double> e = sim().field(FieldId::erosion);
+    const Grid& g = sim().grid();
+    const Terrain& t = sim().terrain();
     double eroded = 0.0, deposited = 0.0;
     for (int r = 0; r < g.ny; ++r) {
       for (int c = 0; c < g.nx; ++c) {
@@ -148,104 +161,38 @@ class PySimulation {
     return s + (a.ndim() == 1 ? ",)" : ")");
   }
 
-  std::unique_ptr<Simulation> sim_;
+  std::unique_ptr<io::RunSession> session_;
   std::atomic<bool> busy_{false};
   double peak_depth_ = 0.0;
 };
 
-/// A result file being written for a PySimulation: io::ResultWriter with the simulation's
-/// output settings, changed by `settings` (output.* keys). Takes the first snapshot (the
-/// current state) when created, as `erodem run` does at t = 0.
-class PyWriter {
- public:
-  PyWriter(PySimulation& s, const Settings& settings, bool overwrite,
-           const std::string& command_line) {
-    Params p = s.sim().params();
-    for (const auto& [key, text] : settings) {
-      if (key.rfind("output.", 0) != 0)
-        throw Error(ExitCode::config, "run: '" + key + "' is not an output.* setting");
-    }
-    apply_settings(p, settings);
-    validate(p, "run");
-    io::Provenance prov = io::Provenance::of(s.sim(), command_line);
-    prov.config_toml = dump_toml(p);
-    py::gil_scoped_release release;
-    writer_ = std::make_unique<io::ResultWriter>(p.output.path, s.sim().grid(), p, prov, overwrite);
-    writer_->snapshot(s.sim());
-  }
-
-  io::ResultWriter& writer() {
-    if (!writer_) throw Error(ExitCode::usage, "the result file is closed already");
-    return *writer_;
-  }
-  /// Appends a snapshot of the current state (unless this step has one).
-  void snapshot(PySimulation& s) {
-    py::gil_scoped_release release;
-    if (writer().last_snapshot_step() != s.sim().steps_done()) writer().snapshot(s.sim());
-  }
-  /// The last snapshot, the .xmf sidecar, and the rename into place.
-  void finish(PySimulation& s) {
-    py::gil_scoped_release release;
-    writer().finish(s.sim());
-    writer_.reset();
-  }
-  /// Closes the file without renaming it: it stays at `partial`.
-  void close() { writer_.reset(); }
-  std::string path() const { return path_or_empty(&io::ResultWriter::path); }
-  std::string partial() const { return path_or_empty(&io::ResultWriter::partial); }
-  bool open() const { return static_cast<bool>(writer_); }
-
- private:
-  std::string path_or_empty(const std::string& (io::ResultWriter::*get)() const) const {
-    return writer_ ? (writer_.get()->*get)() : std::string();
-  }
-  std::unique_ptr<io::ResultWriter> writer_;
-};
-
-long PySimulation::advance(long max_steps, bool to_end, double until_time, PyWriter* writer,
-                           double chunk_seconds, bool once) {
+long PySimulation::advance(long max_steps, bool to_end, double until_time, double chunk_seconds,
+                           bool once) {
   if (busy_.exchange(true))
     throw Error(ExitCode::usage, "the simulation is already running in another thread");
   struct Clear {
     std::atomic<bool>& flag;
     ~Clear() { flag = false; }
   } clear{busy_};
-  io::ResultWriter* w = writer ? &writer->writer() : nullptr;
-  using Clock = std::chrono::steady_clock;
-  const auto chunk = std::chrono::duration<double>(std::max(chunk_seconds, 0.0));
-  long done = 0;
-  const auto more = [&] {
-    return done < max_steps && !(to_end && sim_->finished()) && sim_->time() < until_time;
+  const long first = sim().steps_done();
+  const auto on_step = [this](const Simulation& s) {
+    peak_depth_ = std::max(peak_depth_, s.diagnostics().max_depth);
   };
-  while (more()) {
+  for (;;) {
+    io::Limits limits;
+    limits.max_steps = max_steps - (sim().steps_done() - first);
+    limits.to_end = to_end;
+    limits.until_time = until_time;
+    limits.wall_seconds = std::max(chunk_seconds, 0.0);
+    io::Stop stop;
     {
       py::gil_scoped_release release;
-      const auto start = Clock::now();
-      try {
-        do {
-          sim_->step();
-          ++done;
-          peak_depth_ = std::max(peak_depth_, sim_->diagnostics().max_depth);
-          if (w) w->step_done(*sim_);
-        } while (more() && Clock::now() - start < chunk);
-      } catch (const Error& e) {
-        if (!w || e.code() != ExitCode::unstable) throw;
-        // As `erodem run`: keep the failing step (diagnostics and state) in the partial file.
-        try {
-          w->record_step(*sim_);
-          w->snapshot(*sim_);
-        } catch (const Error&) {  // the partial file keeps the earlier snapshots
-        }
-        throw Error(e.code(), fmt::format("{}; the results up to step {} (t = {:.6g} s) are in "
-                                          "{}; {} was not created",
-                                          e.what(), sim_->steps_done(), sim_->time(), w->partial(),
-                                          w->path()));
-      }
+      stop = session_->advance(limits, {}, on_step);
     }
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (once) break;
+    if (once || stop != io::Stop::wall) break;
   }
-  return done;
+  return sim().steps_done() - first;
 }
 
 py::dict ledger_dict(const Ledger& l) {
@@ -270,10 +217,40 @@ py::dict diagnostics_dict(const Diagnostics& g) {
 
 void add_simulation_bindings(py::module_& m) {
   py::class_<PySimulation>(m, "Simulation", "The C++ simulation behind erodem.Simulation.")
-      .def(py::init<const std::string&, const Settings&, const PyTerrain*, const std::string&>(),
-           py::arg("config_path"), py::arg("settings"), py::arg("terrain"), py::arg("backend"))
+      .def(py::init<const std::string&, const Settings&, const PyTerrain*, const std::string&,
+                    const std::string&, bool, const std::string&>(),
+           py::arg("config_path"), py::arg("settings"), py::arg("terrain"), py::arg("backend"),
+           py::arg("restart"), py::arg("config_from_restart"), py::arg("command_line"))
       .def("advance", &PySimulation::advance, py::arg("max_steps"), py::arg("to_end"),
-           py::arg("until_time"), py::arg("writer"), py::arg("chunk_seconds"), py::arg("once"))
+           py::arg("until_time"), py::arg("chunk_seconds"), py::arg("once"))
+      .def("open_output", &PySimulation::open_output, py::arg("settings"), py::arg("overwrite"))
+      .def("finish_output",
+           [](PySimulation& s) {
+             py::gil_scoped_release release;
+             s.session().finish();
+           })
+      .def("abandon_output",
+           [](PySimulation& s) {
+             py::gil_scoped_release release;
+             s.session().abandon();
+           })
+      .def("close_output", [](PySimulation& s) { s.session().close_output(); })
+      .def_property_readonly("output_open",
+                             [](const PySimulation& s) { return s.session().writing(); })
+      .def_property_readonly("output_path",
+                             [](const PySimulation& s) {
+                               const auto* w = s.session().writer();
+                               return w ? w->path() : std::string();
+                             })
+      .def_property_readonly("output_partial",
+                             [](const PySimulation& s) {
+                               const auto* w = s.session().writer();
+                               return w ? w->partial() : std::string();
+                             })
+      .def_property_readonly("restart_from",
+                             [](const PySimulation& s) { return s.session().restart_from(); })
+      .def_property_readonly("warnings",
+                             [](const PySimulation& s) { return s.session().warnings(); })
       .def(
           "field",
           [](const py::object& self, const std::string& name) {
@@ -311,16 +288,6 @@ void add_simulation_bindings(py::module_& m) {
                                return py::make_tuple(s.sim().grid().ny, s.sim().grid().nx);
                              })
       .def_property_readonly("area", [](const PySimulation& s) { return s.sim().grid().area; });
-
-  py::class_<PyWriter>(m, "ResultWriter", "A result file being written for a Simulation.")
-      .def(py::init<PySimulation&, const Settings&, bool, const std::string&>(), py::arg("sim"),
-           py::arg("settings"), py::arg("overwrite"), py::arg("command_line"))
-      .def("snapshot", &PyWriter::snapshot, py::arg("sim"))
-      .def("finish", &PyWriter::finish, py::arg("sim"))
-      .def("close", &PyWriter::close)
-      .def_property_readonly("path", &PyWriter::path)
-      .def_property_readonly("partial", &PyWriter::partial)
-      .def_property_readonly("open", &PyWriter::open);
 }
 
 }  // namespace erodem::python

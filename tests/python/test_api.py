@@ -8,6 +8,7 @@ import sys
 import textwrap
 import threading
 import time
+import warnings
 
 import h5py
 import numpy as np
@@ -249,6 +250,122 @@ def test_results_match_cli_bit_for_bit(erodem, cli, tujunga, tmp_path, backend, 
     for f in ("bed", "water_depth", "sediment"):
         assert np.array_equal(sim3.field(f), sim.field(f))
     assert sim3.ledger == sim.ledger
+
+
+# ---- restart ----------------------------------------------------------------------------
+
+
+def assert_continues(full_path, restarted_path, k):
+    """The file of a run restarted from snapshot ``k`` of ``full_path`` holds exactly the
+    rest of it: the snapshots from ``k`` on (fields and restart state) and the diagnostics
+    rows of every step after the restart, bit for bit."""
+    with h5py.File(full_path, "r") as a, h5py.File(restarted_path, "r") as b:
+        assert np.array_equal(a["time"][k:], b["time"][:]), (a["time"][:], b["time"][:])
+        n = 0
+        for f in ("bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion"):
+            assert np.array_equal(a[f][k:], b[f][:], equal_nan=True), "field %s differs" % f
+            n += b[f].size
+        for name in a["restart"]:
+            assert np.array_equal(a["restart"][name][k:], b["restart"][name][:]), name
+            n += b["restart"][name].size
+        first = int(a["restart/steps"][k])
+        rows = len(b["diagnostics/time"])
+        assert rows == len(a["diagnostics/time"]) - first
+        for name in a["diagnostics"]:
+            assert np.array_equal(a["diagnostics"][name][first:], b["diagnostics"][name][:],
+                                  equal_nan=True), "diagnostics/%s differs" % name
+        origin = b.attrs["restart_from"]
+        origin = origin.decode() if isinstance(origin, bytes) else str(origin)
+        assert origin.startswith(str(full_path) + ":"), origin
+        print("restart from snapshot %d (step %d, t = %.6g s): %d stored values and %d "
+              "diagnostics rows identical" % (k, first, a["time"][k], n, rows))
+
+
+def test_restart_from_a_snapshot_equals_the_uninterrupted_run(erodem, tujunga, tmp_path):
+    cfg_path = tmp_path / "cfg.toml"
+    cfg_path.write_text(toml_text(small_config(tujunga)))
+    full_path = tmp_path / "full.h5"
+    full = erodem.Simulation(config=cfg_path, backend="cpu")
+    full.run(output=full_path)  # 200 steps, snapshots every 50
+    with h5py.File(full_path, "r") as f:
+        times, steps = f["time"][:], f["restart/steps"][:]
+    assert list(steps) == [0, 50, 100, 150, 200]
+    for k in (1, 2):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # same config and backend: no warning
+            sim = erodem.Simulation(config=cfg_path, backend="cpu",
+                                    restart=(full_path, float(times[k])))
+        assert sim.steps_done == steps[k] and sim.time == times[k]
+        assert sim.restart_from.startswith(str(full_path) + ":")
+        out = tmp_path / ("restarted_%d.h5" % k)
+        sim.run(output=out)
+        assert sim.steps_done == full.steps_done and sim.time == full.time
+        assert sim.ledger == full.ledger  # every ledger entry, bit for bit
+        for f in ("bed", "water_depth", "sediment", "velocity_x", "velocity_y"):
+            assert np.array_equal(sim.field(f), full.field(f)), f
+        assert_continues(full_path, out, k)
+    # The "FILE:TIME" form, with no config: the stored run's config, stepped in pieces.
+    sim = erodem.Simulation(restart="%s:%r" % (full_path, float(times[2])), backend="cpu")
+    differ = [(x, y) for x, y in zip(sim.config_toml.splitlines(), full.config_toml.splitlines())
+              if x != y]
+    assert differ == [('path = "%s"' % full_path, 'path = "run.h5"')]  # output.path only
+    sim.step(13)
+    sim.run()
+    assert sim.ledger == full.ledger
+    assert np.array_equal(sim.bed, full.bed)
+    # The last snapshot is the default; a longer time.duration runs on from the end.
+    more = erodem.Simulation(restart=full_path, backend="cpu", time__steps=230)
+    assert more.steps_done == 200
+    more.run()
+    assert more.steps_done == 230
+    # A changed parameter is allowed, with a warning naming it.
+    with pytest.warns(RuntimeWarning, match="erosion.dissolving_rate"):
+        erodem.Simulation(restart=full_path, backend="cpu", erosion__dissolving_rate=0.2)
+
+
+def test_python_restart_matches_cli_restart(erodem, cli, tujunga, tmp_path):
+    cfg_path = tmp_path / "cfg.toml"
+    cfg_path.write_text(toml_text(small_config(tujunga)))
+    full_path = tmp_path / "full.h5"
+    run_cli(cli, "run", str(cfg_path), "--backend", "cpu", "--output", str(full_path))
+    with h5py.File(full_path, "r") as f:
+        t = float(f["time"][3])
+    run_cli(cli, "run", str(cfg_path), "--backend", "cpu", "--output", str(tmp_path / "cli.h5"),
+            "--restart", "%s:%r" % (full_path, t))
+    sim = erodem.Simulation(config=cfg_path, backend="cpu", restart="%s:%r" % (full_path, t))
+    sim.run(output=tmp_path / "py.h5")
+    assert_same_results(tmp_path / "cli.h5", tmp_path / "py.h5")
+    assert_continues(full_path, tmp_path / "py.h5", 3)
+
+
+def test_bad_restart_raises_naming_the_file_or_time(erodem, tujunga, tmp_path):
+    cfg = small_config(tujunga, steps=20)
+    cfg["output"]["every"] = 10
+    erodem.Simulation(config=cfg, backend="cpu").run(output=tmp_path / "a.h5")
+    plain = dict(cfg, output={"every": 10, "restart_state": False})
+    erodem.Simulation(config=plain, backend="cpu").run(output=tmp_path / "plain.h5")
+    a = str(tmp_path / "a.h5")
+    cases = [
+        ("a missing file", dict(restart=tmp_path / "nothere.h5"), FileNotFoundError, 66,
+         "nothere.h5"),
+        ("a time not stored", dict(restart=a + ":0.55"), ValueError, 2,
+         r"restart .*a\.h5:0\.55: no snapshot at that time; the file holds t = 0, "),
+        ("a time not stored, tuple form", dict(restart=(a, "3 h")), ValueError, 2,
+         r"a\.h5:10800: no snapshot at that time"),
+        ("no restart state", dict(restart=str(tmp_path / "plain.h5")), ValueError, 65,
+         r"plain\.h5.*no restart state"),
+        ("another grid", dict(restart=a, dem__window=[300, 200, 32, 32]), ValueError, 65,
+         r"restart .*a\.h5: the stored run is on a 64 x 64 grid, this config gives 32 x 32"),
+        ("a bad time", dict(restart=(a, "soon")), ValueError, 78, "restart"),
+        ("a bad type", dict(restart=42), ValueError, None, "restart: expected"),
+        ("a bad tuple", dict(restart=(a, [1.0])), ValueError, None, "restart: time"),
+    ]
+    for what, kw, exc, code, pattern in cases:
+        with pytest.raises(exc, match=pattern) as e:
+            erodem.Simulation(config=cfg, backend="cpu", **kw)
+        print("  [%s] %s: %s" % (what, type(e.value).__name__, e.value))
+        if code is not None:
+            assert e.value.exit_code == code, what
 
 
 def test_open_run_and_run_options(erodem, tujunga, tmp_path):

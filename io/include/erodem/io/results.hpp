@@ -86,6 +86,11 @@ class ResultWriter {
   /// Writes what is buffered, closes the file, writes the .xmf sidecar and renames both
   /// into place. Without `overwrite`, a file created at `path` meanwhile is an error.
   void finish();
+  /// Writes what is buffered and closes the file without renaming it: it stays at
+  /// partial(), a readable result file (as the destructor leaves it). No-op once closed.
+  void close();
+  /// Whether the file is open (not finished or closed yet).
+  bool is_open() const { return static_cast<bool>(impl_); }
 
   const std::string& path() const { return path_; }
   /// Where the file is until finish().
