@@ -2,22 +2,14 @@
 // between two run outputs at their matching snapshot times; exit 1 when a field differs by
 // more than the tolerance.
 //
-// A run output is a result file (`run.h5`, read with io::ResultReader), the set of GeoTIFFs
-// that `erodem run` wrote before the HDF5 writer (`out.h5` -> out_bed.tif, ...), or a single
-// GeoTIFF. A GeoTIFF holds one state: it is compared with the last snapshot of a result file.
-#include <cpl_conv.h>
-#include <cpl_error.h>
+// The two sides, their fields at the matching times and the difference of one field at one
+// time come from io/compare.hpp; this file holds the options, the choice of the fields to
+// compare, the worst values over the times, and the text and JSON reports.
 #include <fmt/format.h>
-#include <fmt/ranges.h>
-#include <gdal.h>
-#include <ogr_srs_api.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <limits>
-#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -26,14 +18,12 @@
 #include "commands.hpp"
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
-#include "erodem/io/results.hpp"
+#include "erodem/io/compare.hpp"
 #include "json.hpp"
 
 namespace erodem::cli {
 
 namespace {
-
-namespace fs = std::filesystem;
 
 struct CompareOptions {
   std::string a, b;
@@ -50,235 +40,6 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
-bool is_geotiff_name(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".tif" || ext == ".tiff";
-}
-
-/// The GeoTIFF of field `name` of a run whose output is `path` (as cmd_run.cpp names it).
-std::string field_file(const std::string& path, const std::string& name) {
-  fs::path p(path);
-  p.replace_extension();
-  return p.string() + "_" + name + ".tif";
-}
-
-/// One side of the comparison: a result file, or field name -> GeoTIFF. A single GeoTIFF
-/// has one entry, named after the field its file name ends with ("out_water_depth.tif"),
-/// else "".
-struct Output {
-  std::string path;
-  bool single = false;
-  std::shared_ptr<io::ResultReader> h5;  ///< set for a result file
-  std::map<std::string, std::string> files;
-
-  bool has(const std::string& field) const {
-    if (h5) {
-      const auto f = h5->fields();
-      return std::find(f.begin(), f.end(), field) != f.end();
-    }
-    return files.count(field) != 0;
-  }
-  std::vector<std::string> fields() const {
-    if (h5) return h5->fields();
-    std::vector<std::string> out;
-    for (const auto& f : field_table())
-      if (files.count(f.name)) out.push_back(f.name);
-    return out;
-  }
-  std::string missing(const std::string& field) const {
-    return h5 ? fmt::format("{}: field '{}' missing: the file holds {}", path, field,
-                            fmt::join(h5->fields(), ", "))
-              : fmt::format("{}: field '{}' missing: no file {}", path, field,
-                            field_file(path, field));
-  }
-};
-
-Output resolve(const std::string& path) {
-  Output o;
-  o.path = path;
-  std::error_code ec;
-  if (is_geotiff_name(path)) {
-    if (!fs::exists(path, ec)) throw Error(ExitCode::no_input, path + ": no such file");
-    o.single = true;
-    const std::string stem = fs::path(path).stem().string();
-    std::string name;
-    for (const auto& f : field_table()) {
-      const std::string suffix = std::string("_") + f.name;
-      if (stem.size() > suffix.size() &&
-          stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0 &&
-          std::string(f.name).size() > name.size())
-        name = f.name;
-    }
-    o.files[name] = path;
-    return o;
-  }
-  if (fs::exists(path, ec)) {
-    o.h5 = std::make_shared<io::ResultReader>(path);  // not a result file -> Error(data)
-    return o;
-  }
-  for (const auto& f : field_table()) {
-    const std::string file = field_file(path, f.name);
-    if (fs::exists(file, ec)) o.files[f.name] = file;
-  }
-  if (o.files.empty())
-    throw Error(ExitCode::no_input, fmt::format("{}: no such file (nor GeoTIFF fields {})", path,
-                                                field_file(path, "<field>")));
-  return o;
-}
-
-/// Band 1 of a raster, nodata and non-finite values as NaN, with its georeferencing.
-struct Raster {
-  std::string path;
-  int nx = 0, ny = 0;
-  bool has_transform = false;
-  double transform[6] = {0, 1, 0, 0, 0, 1};
-  std::string crs_wkt;
-  std::vector<double> values;
-};
-
-/// Closes a GDAL dataset on every path.
-struct DatasetCloser {
-  void operator()(void* ds) const {
-    if (ds) GDALClose(ds);
-  }
-};
-
-Raster read_raster(const std::string& path) {
-  static const bool registered = [] {
-    GDALAllRegister();
-    return true;
-  }();
-  (void)registered;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(ExitCode::no_input, path + ": no such file");
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  CPLErrorReset();
-  std::unique_ptr<void, DatasetCloser> ds(
-      GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-  const std::string gdal_msg = CPLGetLastErrorMsg();
-  CPLPopErrorHandler();
-  if (!ds)
-    throw Error(ExitCode::data, fmt::format("{}: not a raster GDAL can read{}", path,
-                                            gdal_msg.empty() ? "" : " (" + gdal_msg + ")"));
-  Raster r;
-  r.path = path;
-  r.nx = GDALGetRasterXSize(ds.get());
-  r.ny = GDALGetRasterYSize(ds.get());
-  if (GDALGetRasterCount(ds.get()) < 1) throw Error(ExitCode::data, path + ": has no band");
-  r.has_transform = GDALGetGeoTransform(ds.get(), r.transform) == CE_None;
-  if (const char* wkt = GDALGetProjectionRef(ds.get())) r.crs_wkt = wkt;
-  GDALRasterBandH band = GDALGetRasterBand(ds.get(), 1);
-  r.values.resize(static_cast<std::size_t>(r.nx) * static_cast<std::size_t>(r.ny));
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  const CPLErr err =
-      GDALRasterIO(band, GF_Read, 0, 0, r.nx, r.ny, r.values.data(), r.nx, r.ny, GDT_Float64, 0, 0);
-  const std::string read_msg = CPLGetLastErrorMsg();
-  CPLPopErrorHandler();
-  if (err != CE_None)
-    throw Error(ExitCode::io, fmt::format("{}: reading failed: {}", path, read_msg));
-  int has_nodata = 0;
-  const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
-  const double scale = GDALGetRasterScale(band, nullptr);
-  const double offset = GDALGetRasterOffset(band, nullptr);
-  for (auto& v : r.values) {
-    if ((has_nodata && (v == nodata || (std::isnan(nodata) && std::isnan(v)))) || !std::isfinite(v))
-      v = std::nan("");
-    else
-      v = v * scale + offset;
-  }
-  return r;
-}
-
-/// Field `field` of a result file at snapshot `index`, as a Raster.
-Raster read_snapshot(const io::ResultReader& r, const std::string& field, std::size_t index) {
-  Raster out;
-  out.path = fmt::format("{} ({} at t = {:g} s)", r.path(), field, r.times()[index]);
-  const Grid& g = r.grid();
-  out.nx = g.nx;
-  out.ny = g.ny;
-  out.has_transform = g.georef.has_transform;
-  std::copy(g.georef.transform.begin(), g.georef.transform.end(), out.transform);
-  out.crs_wkt = g.georef.crs_wkt;
-  const auto v = r.read_index(field, index);
-  out.values.assign(v.begin(), v.end());
-  for (auto& x : out.values)
-    if (!std::isfinite(x)) x = std::nan("");
-  return out;
-}
-
-/// Whether two CRS are the same; true when either is unknown (nothing to compare).
-bool same_crs(const std::string& a, const std::string& b) {
-  if (a == b || a.empty() || b.empty()) return true;
-  OGRSpatialReferenceH sa = OSRNewSpatialReference(a.c_str());
-  OGRSpatialReferenceH sb = OSRNewSpatialReference(b.c_str());
-  const bool same = sa && sb && OSRIsSame(sa, sb);
-  if (sa) OSRDestroySpatialReference(sa);
-  if (sb) OSRDestroySpatialReference(sb);
-  return same;
-}
-
-/// Both rasters on one grid: size, geotransform (within 1e-6 of a cell) and CRS; else
-/// Error(data) naming both files and what differs.
-void check_same_grid(const Raster& a, const Raster& b) {
-  if (a.nx != b.nx || a.ny != b.ny)
-    throw Error(ExitCode::data, fmt::format("grid mismatch: {} is {} x {} cells, {} is {} x {}",
-                                            a.path, a.nx, a.ny, b.path, b.nx, b.ny));
-  if (a.has_transform != b.has_transform)
-    throw Error(ExitCode::data, fmt::format("grid mismatch: {} has {} geotransform, {} has {}",
-                                            a.path, a.has_transform ? "a" : "no", b.path,
-                                            b.has_transform ? "one" : "none"));
-  if (a.has_transform) {
-    const double cell = std::max(std::fabs(a.transform[1]), std::fabs(a.transform[5]));
-    for (int k = 0; k < 6; ++k)
-      if (!(std::fabs(a.transform[k] - b.transform[k]) <= 1e-6 * cell))
-        throw Error(ExitCode::data,
-                    fmt::format("geotransform mismatch: {} has ({}), {} has ({})", a.path,
-                                fmt::join(a.transform, a.transform + 6, ", "), b.path,
-                                fmt::join(b.transform, b.transform + 6, ", ")));
-  }
-  if (!same_crs(a.crs_wkt, b.crs_wkt))
-    throw Error(ExitCode::data,
-                fmt::format("CRS mismatch: {} and {} are in different CRS{}", a.path, b.path,
-                            a.crs_wkt.empty() || b.crs_wkt.empty() ? " (one has none)" : ""));
-}
-
-/// One field compared at one time.
-struct Difference {
-  std::size_t cells = 0;           ///< cells valid in both
-  std::size_t valid_mismatch = 0;  ///< cells valid (not NaN) in one and nodata in the other
-  double rel_l2 = 0.0;             ///< ||a - b|| / ||b||; 0 when both are 0, inf when only b is
-  double max_abs = 0.0;
-  int max_col = -1, max_row = -1;  ///< -1: no difference
-};
-
-Difference difference(const Raster& a, const Raster& b) {
-  Difference r;
-  double diff2 = 0.0, ref2 = 0.0;
-  for (std::size_t i = 0; i < a.values.size(); ++i) {
-    const double va = a.values[i], vb = b.values[i];
-    const bool na = std::isnan(va), nb = std::isnan(vb);
-    if (na || nb) {
-      if (na != nb) ++r.valid_mismatch;
-      continue;
-    }
-    ++r.cells;
-    const double d = va - vb;
-    diff2 += d * d;
-    ref2 += vb * vb;
-    if (std::fabs(d) > r.max_abs) {
-      r.max_abs = std::fabs(d);
-      r.max_col = static_cast<int>(i % static_cast<std::size_t>(a.nx));
-      r.max_row = static_cast<int>(i / static_cast<std::size_t>(a.nx));
-    }
-  }
-  r.rel_l2 = ref2 > 0     ? std::sqrt(diff2 / ref2)
-             : diff2 == 0 ? 0.0
-                          : std::numeric_limits<double>::infinity();
-  return r;
-}
-
 /// One field over all matching times: the worst relative L2 and the largest difference.
 struct FieldResult {
   std::string field;
@@ -292,49 +53,6 @@ struct FieldResult {
   int max_col = -1, max_row = -1;
   bool ok = true;
 };
-
-/// A snapshot of each side to compare; index -1 is a GeoTIFF's one state.
-struct TimePair {
-  double time = std::nan("");  ///< s; NaN when neither side is a result file
-  long ia = -1, ib = -1;
-};
-
-/// Result file against result file: every snapshot time both hold (to 1e-9 relative);
-/// none -> Error(data). A result file against GeoTIFFs: its last snapshot.
-std::vector<TimePair> matching_times(const Output& a, const Output& b) {
-  if (a.h5 && b.h5) {
-    const auto &ta = a.h5->times(), &tb = b.h5->times();
-    std::vector<TimePair> out;
-    for (std::size_t i = 0; i < ta.size(); ++i)
-      for (std::size_t j = 0; j < tb.size(); ++j)
-        if (std::fabs(ta[i] - tb[j]) <= 1e-9 * std::max(1.0, std::fabs(ta[i]))) {
-          out.push_back({ta[i], static_cast<long>(i), static_cast<long>(j)});
-          break;
-        }
-    if (out.empty())
-      throw Error(ExitCode::data,
-                  fmt::format("no snapshot time in common: {} has t = {} s, {} has t = {} s",
-                              a.path, fmt::join(ta, ", "), b.path, fmt::join(tb, ", ")));
-    return out;
-  }
-  TimePair p;
-  if (a.h5 && !a.h5->times().empty()) {
-    p.ia = static_cast<long>(a.h5->times().size()) - 1;
-    p.time = a.h5->times().back();
-  }
-  if (b.h5 && !b.h5->times().empty()) {
-    p.ib = static_cast<long>(b.h5->times().size()) - 1;
-    p.time = b.h5->times().back();
-  }
-  if ((a.h5 && p.ia < 0) || (b.h5 && p.ib < 0))
-    throw Error(ExitCode::data, (a.h5 && p.ia < 0 ? a.path : b.path) + ": holds no snapshot");
-  return {p};
-}
-
-Raster load(const Output& o, const std::string& field, long index) {
-  if (o.h5) return read_snapshot(*o.h5, field, static_cast<std::size_t>(index));
-  return read_raster(o.files.count(field) ? o.files.at(field) : o.files.begin()->second);
-}
 
 std::string json_time(double t) {
   return json_number(t);
@@ -350,7 +68,7 @@ int compare(const CompareOptions& o) {
       throw Error(ExitCode::usage, std::string("--fields: ") + e.what());
     }
   }
-  const Output a = resolve(o.a), b = resolve(o.b);
+  const io::CompareInput a = io::open_compare_input(o.a), b = io::open_compare_input(o.b);
   // The fields to compare, each named as A and B hold it ("" for an unnamed GeoTIFF).
   struct Pair {
     std::string label, in_a, in_b;
@@ -363,8 +81,8 @@ int compare(const CompareOptions& o) {
                                                                : "band 1";
     pairs.push_back({name, a.files.begin()->first, b.files.begin()->first});
   } else if (a.single || b.single) {
-    const Output& one = a.single ? a : b;
-    const Output& other = a.single ? b : a;
+    const io::CompareInput& one = a.single ? a : b;
+    const io::CompareInput& other = a.single ? b : a;
     const std::string name = !wanted.empty() ? wanted.front() : one.files.begin()->first;
     if (name.empty())
       throw Error(
@@ -382,7 +100,7 @@ int compare(const CompareOptions& o) {
         if (std::find(names.begin(), names.end(), f) == names.end()) names.push_back(f);
     }
     for (const auto& name : names) {
-      for (const Output* side : {&a, &b})
+      for (const io::CompareInput* side : {&a, &b})
         if (!side->has(name))
           throw Error(ExitCode::no_input,
                       side->missing(name) +
@@ -390,7 +108,7 @@ int compare(const CompareOptions& o) {
       pairs.push_back({name, name, name});
     }
   }
-  const auto times = matching_times(a, b);
+  const auto times = io::matching_times(a, b);
   if (a.h5 && b.h5 &&
       (times.size() != a.h5->times().size() || times.size() != b.h5->times().size()))
     std::fprintf(stderr,
@@ -403,11 +121,12 @@ int compare(const CompareOptions& o) {
     FieldResult r;
     r.field = pair.label;
     for (const auto& t : times) {
-      const Raster ra = load(a, pair.in_a, t.ia), rb = load(b, pair.in_b, t.ib);
-      check_same_grid(ra, rb);
+      const io::RasterBand ra = io::load_compare_field(a, pair.in_a, t.ia),
+                           rb = io::load_compare_field(b, pair.in_b, t.ib);
+      io::check_same_grid(ra, rb);
       nx = ra.nx;
       ny = ra.ny;
-      const Difference d = difference(ra, rb);
+      const io::FieldDifference d = io::field_difference(ra.values, rb.values, ra.nx);
       ++r.times;
       r.cells = d.cells;
       r.valid_mismatch = std::max(r.valid_mismatch, d.valid_mismatch);

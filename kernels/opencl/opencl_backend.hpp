@@ -1,7 +1,8 @@
 // erodem — the OpenCL backend (private to erodem::kernels): RAII handles of the OpenCL C API,
 // the program assembled from the embedded sources, the per-device runtime shared by backends,
 // and the backend class. The per-cell formulas are those of kernels/common/*.h; the kernels
-// of kernels/opencl/*.cl only index cells and call them, mirroring the CPU loops.
+// of kernels/opencl/*.cl only index cells and call them, mirroring the CPU loops. Defined in
+// errors.cpp, program.cpp, runtime.cpp, memory.cpp, launch.cpp and opencl_backend.cpp.
 #pragma once
 
 #ifndef CL_TARGET_OPENCL_VERSION
@@ -103,6 +104,10 @@ struct Runtime {
   bool whole_rows = false;
   std::string options;  ///< the build options
 };
+
+/// Builds the program on the runtime's device; throws Error(internal) with the annotated
+/// build log on failure. ERODEM_OPENCL_DUMP=dir writes the source and options there.
+void build_program(Runtime& rt);
 
 /// The cell kernels' largest work-group of at most `limit` work-items (and of 1024, the
 /// local arrays of reduce.cl) that divides a padded row of W cells: W itself up to there.

@@ -1,6 +1,6 @@
 // erodem — the one validated parameter schema shared by TOML files, `--set key=value`
 // and Python keywords. Every key, default, accepted range and doc line is written once,
-// in the descriptor table of schema.cpp; everything here is derived from that table.
+// in the descriptor table of schema_table.cpp; everything here is derived from that table.
 #pragma once
 
 #include <toml++/toml.h>

@@ -1,0 +1,146 @@
+// erodem — the descriptor kinds of the parameter schema that are written once for one key
+// (schema_kinds.hpp): dem.resample, flow.pipe_length and the [[inflow]] tables.
+#include "schema_kinds.hpp"
+
+namespace erodem::schema_detail {
+
+Descriptor resample_descriptor(const char* key, const char* doc) {
+  auto access = [](auto& p) -> auto& {
+    return p.dem;
+  };
+  Descriptor d = base(key, access, "length or integer", Dimension::length,
+                      "a cell size >= 0 (m, or a string like \"320 m\"), or an integer "
+                      "factor >= 0; 0 = none",
+                      doc);
+  d.reset = [](Params& p) {
+    p.dem.resample = Params{}.dem.resample;
+    p.dem.resample_factor = Params{}.dem.resample_factor;
+  };
+  d.assign = [](Params& p, const toml::node& n, const Where& w) {
+    if (n.is_integer()) {
+      p.dem.resample_factor = static_cast<int>(read_integer(n, closed(0, 1e6), w));
+      p.dem.resample = 0.0;
+    } else {
+      p.dem.resample = read_double(n, Dimension::length, at_least(0), w);
+      p.dem.resample_factor = 0;
+    }
+  };
+  d.check = [](const Params& p, const Where& w) {
+    check_double(p.dem.resample, Dimension::length, at_least(0), w);
+    if (p.dem.resample_factor < 0) throw w.fail("the resample factor must be >= 0");
+    if (p.dem.resample > 0 && p.dem.resample_factor > 0) {
+      throw w.fail("give a resample cell size or an integer factor, not both");
+    }
+  };
+  d.format = [](const Params& p) {
+    return p.dem.resample_factor > 0 || p.dem.resample == 0.0
+               ? std::to_string(p.dem.resample_factor)
+               : format_number(p.dem.resample);
+  };
+  return d;
+}
+
+Descriptor pipe_length_descriptor(const char* key, const char* doc) {
+  auto access = [](auto& p) -> auto& {
+    return p.flow.pipe_length;
+  };
+  Descriptor d = base(key, access, "length or \"cell\"", Dimension::length,
+                      "\"cell\" (the cell size), or a length >= 0 (0 = the cell size)", doc);
+  d.assign = [](Params& p, const toml::node& n, const Where& w) {
+    if (n.value_exact<std::string>() == std::optional<std::string>("cell")) {
+      p.flow.pipe_length = 0.0;
+    } else {
+      p.flow.pipe_length = read_double(n, Dimension::length, at_least(0), w);
+    }
+  };
+  d.check = [](const Params& p, const Where& w) {
+    check_double(p.flow.pipe_length, Dimension::length, at_least(0), w);
+  };
+  d.format = [](const Params& p) {
+    return p.flow.pipe_length == 0.0 ? quoted_string("cell") : format_number(p.flow.pipe_length);
+  };
+  return d;
+}
+
+// ---- inflow -----------------------------------------------------------------------------
+
+const Range kDischargeRange = at_least(0);
+
+void check_inflow(const InflowSpec& in, const Where& w) {
+  if (in.vertices.empty()) throw w.fail("needs a point = [x, y] or a line = [[x, y], ...]");
+  check_points(in.vertices, w.sub(in.vertices.size() == 1 ? ".point" : ".line"));
+  if (in.hydrograph.empty()) throw w.sub(".hydrograph").fail("needs at least one [t, Q] pair");
+  check_series(in.hydrograph, Dimension::discharge, kDischargeRange, w.sub(".hydrograph"));
+}
+
+/// One inflow table: point = [x, y] or line = [[x, y], ...], and hydrograph = [[t, Q], ...].
+InflowSpec read_inflow(const toml::node& n, const Where& w) {
+  const toml::table* t = n.as_table();
+  if (!t) throw w.fail("expected a table with point or line, and hydrograph; got " + node_text(n));
+  InflowSpec in;
+  bool has_point = false;
+  bool has_line = false;
+  for (auto&& [k, v] : *t) {
+    const std::string name(k.str());
+    const Where wk = w.sub("." + name);
+    if (name == "point") {
+      const auto xy = read_pair(v, Dimension::dimensionless, any_finite(), Dimension::dimensionless,
+                                "an [x, y] point", wk);
+      in.vertices = {xy};
+      has_point = true;
+    } else if (name == "line") {
+      in.vertices = read_points(v, wk);
+      if (in.vertices.size() < 2) throw wk.fail("a line needs two or more [x, y] vertices");
+      has_line = true;
+    } else if (name == "hydrograph") {
+      in.hydrograph = read_series(v, Dimension::discharge, kDischargeRange, wk);
+    } else {
+      throw wk.fail("unknown inflow key; accepted: point, line, hydrograph");
+    }
+  }
+  if (has_point && has_line) throw w.fail("give a point or a line, not both");
+  check_inflow(in, w);
+  return in;
+}
+
+Descriptor inflow_descriptor(const char* key, const char* doc) {
+  auto access = [](auto& p) -> auto& {
+    return p.inflow;
+  };
+  Descriptor d = base(key, access, "inflow list", Dimension::discharge,
+                      "[[inflow]] tables: point = [x, y] or line = [[x, y], ...], "
+                      "hydrograph = [[t, Q], ...] with Q >= 0 (m^3/s)",
+                      doc);
+  d.assign = [](Params& p, const toml::node& n, const Where& w) {
+    const toml::array& a = read_array(n, "an array of inflow tables ([[inflow]])", w);
+    std::vector<InflowSpec> list;
+    for (size_t i = 0; i < a.size(); ++i) {
+      list.push_back(read_inflow(*a.get(i), w.sub("[" + std::to_string(i) + "]")));
+    }
+    p.inflow = std::move(list);
+  };
+  d.check = [](const Params& p, const Where& w) {
+    for (size_t i = 0; i < p.inflow.size(); ++i) {
+      check_inflow(p.inflow[i], w.sub("[" + std::to_string(i) + "]"));
+    }
+  };
+  d.format = [](const Params&) -> std::optional<std::string> { return std::nullopt; };
+  return d;
+}
+
+std::string format_inflow_tables(const std::vector<InflowSpec>& list, const std::string& doc) {
+  std::string out = "\n# " + doc + "\n";
+  if (list.empty()) return out + "# (no [[inflow]] tables)\n";
+  for (const InflowSpec& in : list) {
+    out += "[[inflow]]\n";
+    if (in.vertices.size() == 1) {
+      out += "point = " + format_pair(in.vertices[0][0], in.vertices[0][1]) + "\n";
+    } else {
+      out += "line = " + format_points(in.vertices) + "\n";
+    }
+    out += "hydrograph = " + format_series(in.hydrograph) + "\n";
+  }
+  return out;
+}
+
+}  // namespace erodem::schema_detail

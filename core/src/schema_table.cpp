@@ -1,0 +1,161 @@
+// erodem — the table of the parameter schema: every key of Params with its kind, dimension,
+// range and doc line, grouped by section. The only place where keys, ranges, units and docs
+// are written; parsing, `--set`, validation, dumping and --help follow from it (schema.cpp).
+#include "schema_kinds.hpp"
+
+namespace erodem::schema_detail {
+
+// ---- the table --------------------------------------------------------------------------
+
+/// The dotted key and an accessor for a Params member, e.g. FIELD(time.dt).
+#define ERODEM_FIELD(member)      \
+#member, [](auto& p) -> auto& { \
+    return p.member;              \
+  }
+
+const std::vector<Descriptor>& descriptor_table() {
+  using D = Dimension;
+  static const Choices<BoundaryKind> boundary{{"closed", BoundaryKind::closed},
+                                              {"open", BoundaryKind::open},
+                                              {"fixed_level", BoundaryKind::fixed_level}};
+  static const std::vector<Descriptor> table{
+      text(ERODEM_FIELD(dem.path), "DEM file (GDAL raster); relative to the config file"),
+      choice(ERODEM_FIELD(dem.synthetic),
+             Choices<std::string>{{"", ""},
+                                  {"fbm", "fbm"},
+                                  {"ridged", "ridged"},
+                                  {"diamond_square", "diamond_square"},
+                                  {"hill", "hill"},
+                                  {"lake", "lake"},
+                                  {"valley", "valley"},
+                                  {"ridge", "ridge"}},
+             "synthetic terrain generator instead of a DEM file (\"\" = none)"),
+      integer(ERODEM_FIELD(dem.size), closed(2, 32768),
+              "synthetic terrain: grid size (cells per side)"),
+      integer(ERODEM_FIELD(dem.seed), closed(-2147483648.0, 2147483647.0),
+              "synthetic terrain: random seed"),
+      number(ERODEM_FIELD(dem.relief), D::length, above(0),
+             "synthetic terrain: elevation range (m)"),
+      window(ERODEM_FIELD(dem.window), "pixel window [col, row, width, height] of the DEM"),
+      resample_descriptor("dem.resample",
+                          "coarser cell size by averaging (m), or an integer factor; 0 = none"),
+      number(ERODEM_FIELD(dem.z_scale), D::dimensionless, above(0),
+             "multiplier of the stored elevations (1)"),
+      number(ERODEM_FIELD(dem.cell_size), D::length, at_least(0),
+             "cell size (m) for files without georeferencing and synthetic terrain; 0 = from "
+             "the file"),
+      text(ERODEM_FIELD(dem.crs), "CRS (e.g. \"EPSG:32610\") for files without georeferencing"),
+      optional_number(ERODEM_FIELD(dem.nodata_value), D::dimensionless, any_finite(),
+                      "stored value to treat as nodata, in the file's units before z_scale "
+                      "(e.g. 0 for a heightmap whose sea is 0; with boundary.nodata = \"sea\" "
+                      "such cells hold the sea level)"),
+
+      optional_number(ERODEM_FIELD(initial.water_level), D::length, any_finite(),
+                      "fill every active cell up to this water surface elevation (m)"),
+      scalar_or_raster(ERODEM_FIELD(initial.water_depth), D::length, at_least(0),
+                       "initial water depth (m), uniform or a raster path"),
+
+      integer(ERODEM_FIELD(time.steps), at_least(1),
+              "number of steps (used when time.duration is 0)"),
+      number(ERODEM_FIELD(time.duration), D::time, at_least(0),
+             "simulated time (s); 0 = use time.steps"),
+      number(ERODEM_FIELD(time.dt), D::time, above(0), "fixed time step (s)"),
+      boolean(ERODEM_FIELD(time.adaptive), "CFL-adaptive time step"),
+      number(ERODEM_FIELD(time.cfl), D::dimensionless, left_open(0, 1),
+             "Courant number alpha of the adaptive step (1)"),
+      number(ERODEM_FIELD(time.dt_max), D::time, above(0), "upper bound of the adaptive step (s)"),
+
+      choice(ERODEM_FIELD(flow.scheme),
+             Choices<FlowScheme>{{"pipes", FlowScheme::pipes},
+                                 {"local_inertial", FlowScheme::local_inertial}},
+             "flow scheme: pipes (Mei 2007) or local_inertial (Bates 2010)"),
+      scalar_or_raster(ERODEM_FIELD(flow.manning_n), D::manning, at_least(0),
+                       "Manning roughness n (s m^-1/3), uniform or a raster path"),
+      number(ERODEM_FIELD(flow.theta), D::dimensionless, closed(0, 1),
+             "local_inertial: de Almeida weighting theta (1)"),
+      number(ERODEM_FIELD(flow.pipe_area), D::area, above(0), "pipes: pipe cross-section A (m^2)"),
+      pipe_length_descriptor("flow.pipe_length",
+                             "pipes: pipe length l (m), or \"cell\" for the cell size"),
+      number(ERODEM_FIELD(flow.gravity), D::acceleration, above(0),
+             "gravitational acceleration g (m/s^2)"),
+
+      number(ERODEM_FIELD(rain.rate), D::speed, at_least(0),
+             "uniform rain rate (m/s), used when rain.series is empty"),
+      series(ERODEM_FIELD(rain.series), D::speed, at_least(0),
+             "rain rate series [[time (s), rate (m/s)], ...], linear in between, held at the end "
+             "values outside"),
+      text(ERODEM_FIELD(rain.raster), "raster path of a spatial rain multiplier (1); \"\" = none"),
+
+      inflow_descriptor("inflow",
+                        "point or line inflows with a hydrograph [[time (s), discharge (m^3/s)]]"),
+
+      boolean(ERODEM_FIELD(erosion.enabled), "hydraulic erosion and deposition"),
+      number(ERODEM_FIELD(erosion.sediment_capacity), D::time, at_least(0),
+             "sediment capacity K_c (s): capacity per unit speed and tilt"),
+      number(ERODEM_FIELD(erosion.dissolving_rate), D::inverse_time, at_least(0),
+             "dissolving (erosion) rate K_s (1/s)"),
+      number(ERODEM_FIELD(erosion.deposition_rate), D::inverse_time, at_least(0),
+             "deposition rate K_d (1/s)"),
+      number(ERODEM_FIELD(erosion.min_tilt), D::dimensionless, closed(0, 1),
+             "minimum tilt sin_min in the capacity (1)"),
+      scalar_or_raster(ERODEM_FIELD(erosion.hardness), D::dimensionless, closed(0, 1),
+                       "hardness R in [0, 1] (1), uniform or a raster path"),
+      number(ERODEM_FIELD(erosion.min_depth), D::length, at_least(0),
+             "depth below which the capacity ramps to 0 (m); 0 = off"),
+      optional_number(ERODEM_FIELD(erosion.bedrock_level), D::length, any_finite(),
+                      "no erosion below this bed elevation (m)"),
+
+      choice(ERODEM_FIELD(transport.scheme),
+             Choices<TransportScheme>{{"conservative", TransportScheme::conservative},
+                                      {"semi_lagrangian", TransportScheme::semi_lagrangian}},
+             "sediment transport: conservative (flux form) or semi_lagrangian (Mei 2007)"),
+
+      boolean(ERODEM_FIELD(thermal.enabled), "thermal erosion (slope collapse)"),
+      number(ERODEM_FIELD(thermal.talus_angle), D::angle, open(0, 90), "talus angle (degrees)"),
+      number(ERODEM_FIELD(thermal.rate), D::inverse_time, at_least(0), "thermal rate K_t (1/s)"),
+
+      number(ERODEM_FIELD(evaporation.rate), D::inverse_time, at_least(0),
+             "evaporation rate K_e (1/s)"),
+
+      choice(ERODEM_FIELD(boundary.north), boundary, "north edge: closed, open or fixed_level"),
+      choice(ERODEM_FIELD(boundary.south), boundary, "south edge: closed, open or fixed_level"),
+      choice(ERODEM_FIELD(boundary.east), boundary, "east edge: closed, open or fixed_level"),
+      choice(ERODEM_FIELD(boundary.west), boundary, "west edge: closed, open or fixed_level"),
+      number(ERODEM_FIELD(boundary.sea_level), D::length, any_finite(),
+             "water level of fixed_level edges and sea nodata cells (m)"),
+      choice(ERODEM_FIELD(boundary.nodata),
+             Choices<NodataKind>{{"wall", NodataKind::wall}, {"sea", NodataKind::sea}},
+             "nodata cells: wall, or sea at boundary.sea_level"),
+
+      text(ERODEM_FIELD(output.path), "result file (.h5)"),
+      integer(ERODEM_FIELD(output.every), at_least(1),
+              "steps between snapshots (used when output.interval is 0)"),
+      number(ERODEM_FIELD(output.interval), D::time, at_least(0),
+             "simulated time between snapshots (s); 0 = use output.every"),
+      name_list(ERODEM_FIELD(output.fields),
+                {"bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness",
+                 "hardness", "flux_left", "flux_right", "flux_top", "flux_bottom"},
+                "fields written in each snapshot"),
+      points(ERODEM_FIELD(output.gauges),
+             "gauge points [[x, y], ...] in the DEM's CRS: depth, level and speed every step"),
+      boolean(ERODEM_FIELD(output.restart_state),
+              "store the full state at each snapshot, so a run can restart from it"),
+
+      choice(ERODEM_FIELD(numerics.precision),
+             Choices<Precision>{{"float32", Precision::float32}, {"float64", Precision::float64}},
+             "floating-point precision of the CPU reference: float32 or float64"),
+      number(
+          ERODEM_FIELD(numerics.dry_depth), D::length, at_least(0),
+          "local_inertial: faces shallower than this carry no flow (m); below 1e-16 m none does"),
+      number(ERODEM_FIELD(numerics.velocity_min_depth), D::length, at_least(0),
+             "velocity is 0 below this mean depth d_min (m)"),
+      number(ERODEM_FIELD(numerics.wetness_time), D::time, above(0),
+             "time constant of the wetness running mean (s)"),
+      integer(ERODEM_FIELD(numerics.threads), closed(0, 65536), "CPU threads (0 = all cores)"),
+  };
+  return table;
+}
+
+#undef ERODEM_FIELD
+
+}  // namespace erodem::schema_detail

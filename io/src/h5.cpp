@@ -1,0 +1,141 @@
+// erodem — HDF5 helpers of the result files (h5.hpp): error messages, attributes, datasets
+// and appended rows.
+#include "h5.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "erodem/error.hpp"
+
+namespace erodem::io {
+
+std::string h5_reason() {
+  std::string msg;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_DOWNWARD,
+      [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
+        if (n == 0 && e->desc != nullptr) *static_cast<std::string*>(out) = e->desc;
+        return 0;
+      },
+      &msg);
+  return msg.empty() ? "" : ": " + msg;
+}
+
+[[noreturn]] void write_failed(const std::string& path, const std::string& what) {
+  throw Error(ExitCode::io, path + ": writing " + what + " failed" + h5_reason());
+}
+
+H5Id checked(hid_t id, const std::string& path, const std::string& what) {
+  if (id < 0) write_failed(path, what);
+  return H5Id(id);
+}
+void checked(herr_t status, const std::string& path, const std::string& what) {
+  if (status < 0) write_failed(path, what);
+}
+
+void put_text(hid_t obj, const char* name, const std::string& value, const std::string& path) {
+  const std::size_t size = std::max<std::size_t>(value.size(), 2);
+  std::string buf = value;
+  buf.resize(size, '\0');
+  const bool ascii = std::all_of(value.begin(), value.end(),
+                                 [](char c) { return static_cast<unsigned char>(c) < 0x80; });
+  H5Id type = checked(H5Tcopy(H5T_C_S1), path, "a string type");
+  H5Tset_size(type, size);
+  H5Tset_strpad(type, H5T_STR_NULLTERM);
+  H5Tset_cset(type, ascii ? H5T_CSET_ASCII : H5T_CSET_UTF8);
+  H5Id space = checked(H5Screate(H5S_SCALAR), path, "a dataspace");
+  H5Id attr = checked(H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT), path,
+                      std::string("attribute ") + name);
+  checked(H5Awrite(attr, type, buf.data()), path, std::string("attribute ") + name);
+}
+
+void put_numbers(hid_t obj, const char* name, hid_t file_type, hid_t mem_type, const void* data,
+                 hsize_t n, const std::string& path) {
+  H5Id space = checked(n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), path,
+                       "a dataspace");
+  H5Id attr = checked(H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT), path,
+                      std::string("attribute ") + name);
+  checked(H5Awrite(attr, mem_type, data), path, std::string("attribute ") + name);
+}
+
+bool get_text(hid_t obj, const char* name, std::string& out) {
+  if (H5Aexists(obj, name) <= 0) return false;
+  H5Id attr(H5Aopen(obj, name, H5P_DEFAULT));
+  if (!attr.valid()) return false;
+  H5Id type(H5Aget_type(attr));
+  if (H5Tget_class(type) != H5T_STRING) return false;
+  H5Id space(H5Aget_space(attr));
+  if (H5Sget_simple_extent_npoints(space) != 1) return false;
+  if (H5Tis_variable_str(type) > 0) {
+    H5Id mem(H5Tcopy(H5T_C_S1));
+    H5Tset_size(mem, H5T_VARIABLE);
+    H5Tset_cset(mem, H5Tget_cset(type));
+    char* s = nullptr;
+    if (H5Aread(attr, mem, &s) < 0) return false;
+    out = s != nullptr ? s : "";
+    H5free_memory(s);
+    return true;
+  }
+  const std::size_t size = H5Tget_size(type);
+  std::string buf(size, '\0');
+  if (H5Aread(attr, type, buf.data()) < 0) return false;
+  buf.resize(std::strlen(buf.c_str()));
+  out = buf;
+  return true;
+}
+
+H5Id create_dataset(hid_t loc, const std::string& name, hid_t type,
+                    const std::vector<hsize_t>& dims, const std::vector<hsize_t>& maxdims,
+                    const std::vector<hsize_t>& chunk, bool compress, const void* fill,
+                    const std::string& path) {
+  H5Id space = checked(
+      dims.empty() ? H5Screate(H5S_SCALAR)
+                   : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), maxdims.data()),
+      path, "dataspace of " + name);
+  H5Id dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), path, "properties of " + name);
+  H5Pset_attr_creation_order(dcpl, kCreationOrder);
+  H5Pset_obj_track_times(dcpl, 0);
+  if (!chunk.empty()) {
+    checked(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), path,
+            "chunks of " + name);
+    if (compress) {
+      checked(H5Pset_shuffle(dcpl), path, "shuffle filter of " + name);
+      checked(H5Pset_deflate(dcpl, 4), path, "deflate filter of " + name);
+    }
+  }
+  if (fill != nullptr) checked(H5Pset_fill_value(dcpl, type, fill), path, "fill of " + name);
+  return checked(H5Dcreate2(loc, name.c_str(), type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
+                 "dataset " + name);
+}
+
+void append_rows(hid_t ds, hid_t mem_type, hsize_t rows, const void* data, const std::string& path,
+                 const std::string& name) {
+  if (rows == 0) return;
+  H5Id space = checked(H5Dget_space(ds), path, name);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  std::vector<hsize_t> start(dims.size(), 0), count = dims;
+  start[0] = dims[0];
+  count[0] = rows;
+  dims[0] += rows;
+  checked(H5Dset_extent(ds, dims.data()), path, "(extending) " + name);
+  H5Id file_space = checked(H5Dget_space(ds), path, name);
+  checked(
+      H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+      path, name);
+  H5Id mem_space = checked(H5Screate_simple(rank, count.data(), nullptr), path, name);
+  checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+}
+
+bool exists(hid_t loc, const std::string& path) {
+  std::size_t pos = 0;
+  while (true) {
+    pos = path.find('/', pos + 1);
+    const std::string part = path.substr(0, pos);
+    if (H5Lexists(loc, part.c_str(), H5P_DEFAULT) <= 0) return false;
+    if (pos == std::string::npos) return true;
+  }
+}
+
+}  // namespace erodem::io

@@ -1,0 +1,122 @@
+// erodem — how the OpenCL backend launches its kernels: kernels by name, launch geometry
+// (interior rows, row ranges, edge cells, reductions), accumulator values, and the ledger's
+// tallies deferred on the device until one read per step.
+#include "opencl/launch.hpp"
+
+#include <fmt/format.h>
+
+#include <cstring>
+
+#include "opencl/opencl_backend.hpp"
+
+namespace erodem::opencl {
+
+cl_kernel OpenClBackend::kernel(const char* name) {
+  for (auto& [n, k] : kernels_)
+    if (n == name) return k.get();
+  cl_int err = CL_SUCCESS;
+  Kernel k(clCreateKernel(rt_->program.get(), name, &err));
+  check(err, fmt::format("clCreateKernel({})", name).c_str());
+  kernels_.emplace_back(name, std::move(k));
+  return kernels_.back().second.get();
+}
+
+void OpenClBackend::launch_interior(cl_kernel k) {
+  launch_rows(k, 1, H_ - 1);
+}
+
+void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1) {
+  if (y1 <= y0) return;
+  const std::size_t offset[2] = {0, static_cast<std::size_t>(y0)};
+  const std::size_t global[2] = {groups_x_ * local_x_, static_cast<std::size_t>(y1 - y0)};
+  const std::size_t local[2] = {local_x_, 1};
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel");
+}
+
+void OpenClBackend::launch_edge_tallies(int slot, Real dt) {
+  if (edge_count_ == 0) return;
+  cl_kernel k = kernel("edge_tallies");
+  set_args(k, cl_int{W_}, kind_, edge_cells_, static_cast<cl_int>(edge_count_), flux_[0], flux_[1],
+           flux_[2], flux_[3], sediment_, depth_next_, dt, cl_int{slot}, tally_partials_,
+           static_cast<cl_int>(tally_stride_));
+  const std::size_t global = edge_groups_ * edge_local_, local = edge_local_;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(edge_tallies)");
+}
+
+void OpenClBackend::launch_reduction(cl_kernel k, std::size_t groups) {
+  const std::size_t global = groups * reduce_local_, local = reduce_local_;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel");
+}
+
+std::vector<double> OpenClBackend::acc_values(const std::vector<unsigned char>& raw,
+                                              std::size_t count) const {
+  std::vector<double> out(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (acc_size_ == sizeof(double)) {
+      std::memcpy(&out[k], raw.data() + k * sizeof(double), sizeof(double));
+    } else {
+      float f;
+      std::memcpy(&f, raw.data() + k * sizeof(float), sizeof(float));
+      out[k] = f;
+    }
+  }
+  return out;
+}
+
+void OpenClBackend::defer(StepTally& tally, unsigned bits) {
+  // A tally for another StepTally, or one whose slot is still pending: deliver first.
+  if (pending_ && (pending_tally_ != &tally || (pending_ & bits))) flush_tallies();
+  pending_tally_ = &tally;
+  pending_ |= bits;
+}
+
+void OpenClBackend::enqueue_tally_reduction() {
+  if (!(pending_ & kTallyBits)) return;
+  cl_kernel k = kernel("reduce_tallies");
+  set_args(k, static_cast<cl_int>(tally_stride_), tally_partials_, tally_sums_);
+  launch_reduction(k, kTallySlots);
+}
+
+void OpenClBackend::deliver_tallies() {
+  if (!pending_ || !pending_tally_) {
+    pending_ = 0;
+    return;
+  }
+  StepTally& t = *pending_tally_;
+  if (pending_ & kTallyBits) {
+    const auto v = acc_values(tally_raw_, kTallySlots);
+    if (pending_ & kExchangeBit)
+      t.boundary_water_out += static_cast<double>(pending_water_dt_) * v[0];
+    if (pending_ & kClippedBit) t.clipped += v[1];
+    if (pending_ & kSedimentBit) t.sediment_out += v[2];
+    if (pending_ & kEvaporatedBit) t.evaporated += v[3];
+    if (pending_ & kWaterGivenBit) t.water_exchanged += v[4];
+    if (pending_ & kErodedBit) t.eroded += v[5];
+    if (pending_ & kDepositedBit) t.deposited += v[6];
+    if (pending_ & kSedimentGivenBit) t.sediment_exchanged += v[7];
+    if (pending_ & kThermalBit) t.thermal_moved += v[8];
+  }
+  if (pending_ & kChangeBit) {
+    double change = 0.0;
+    for (double v : acc_values(change_raw_, reduce_groups_)) change += v;
+    t.transport_change += change;
+  }
+  pending_ = 0;
+  pending_tally_ = nullptr;
+}
+
+void OpenClBackend::flush_tallies() {
+  if (!pending_) return;
+  enqueue_tally_reduction();
+  tally_raw_.resize(kTallySlots * acc_size_);
+  change_raw_.resize(reduce_groups_ * acc_size_);
+  if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
+  if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  check(clFinish(queue_.get()), "clFinish");
+  deliver_tallies();
+}
+
+}  // namespace erodem::opencl

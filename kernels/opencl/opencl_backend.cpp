@@ -1,0 +1,445 @@
+// erodem — the OpenCL backend: the kernels of kernels/opencl/*.cl (each calling the per-cell
+// functions of kernels/common/*.h) run over the padded raster, with the same buffers, swaps
+// and process order as the CPU reference (kernels/cpu). This file: the backend's state set up
+// on the device, the dispatch of the processes and their run_* functions, and stats();
+// errors, devices, program, runtime, memory and launch.cpp hold the rest. Built when
+// ERODEM_OPENCL is on (stubs.cpp otherwise).
+#include "opencl/opencl_backend.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "common/compat.h"
+#include "erodem/error.hpp"
+#include "erodem/initial_state.hpp"
+#include "opencl/launch.hpp"
+
+namespace erodem {
+namespace opencl {
+
+namespace {
+
+/// A size from the environment (the tuning variable ERODEM_OPENCL_WG), else `fallback`. Where
+/// the kernels are built for rounded launches, the cell kernels' work-group is ERODEM_OPENCL_WG
+/// rounded down to a power of two, by default 64 on CPU devices and 128 on others, one row high;
+/// CPU devices launch whole rows (a divisor of the row) unless ERODEM_OPENCL_WG is set.
+std::size_t env_size(const char* name, std::size_t fallback) {
+  if (const char* env = std::getenv(name); env && *env) {
+    const long v = std::strtol(env, nullptr, 10);
+    if (v >= 1) return static_cast<std::size_t>(v);
+  }
+  return fallback;
+}
+
+}  // namespace
+
+OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
+                             const std::string& selector)
+    : params_(params),
+      nx_(terrain.grid.nx),
+      ny_(terrain.grid.ny),
+      W_(terrain.grid.nx + 2),
+      H_(terrain.grid.ny + 2) {
+  if (params.numerics.precision == Precision::float64)
+    throw Error(ExitCode::config,
+                "numerics.precision: the opencl backend runs float32 (the float64 reference "
+                "runs on the cpu backend: --backend cpu)");
+  const auto& g = terrain.grid;
+  g.validate();
+  n_ = static_cast<std::size_t>(W_) * H_;
+  if (n_ > static_cast<std::size_t>(std::numeric_limits<cl_int>::max()))
+    throw Error(ExitCode::data, fmt::format("backend 'opencl': a grid of {} x {} is too large "
+                                            "(at most 2^31 padded cells)",
+                                            nx_, ny_));
+  const PaddedState state = build_padded_state(terrain, params);
+
+  rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
+  cl_int err = CL_SUCCESS;
+  queue_ = Queue(clCreateCommandQueue(rt_->context.get(), rt_->device, 0, &err));
+  check(err, "clCreateCommandQueue");
+  acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
+
+  // ---- the host state: the same padded state the CPU reference starts from ----
+  auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
+  const std::vector<Real> dx = to_real(state.dx), dy = to_real(state.dy),
+                          area = to_real(state.area);
+  area_host_.assign(area.begin(), area.end());
+  const std::vector<cl_uchar> kind(state.kind.begin(), state.kind.end());
+  const std::vector<Real> bed_r = to_real(state.bed), depth_r = to_real(state.depth),
+                          zeros(n_, Real(0));
+
+  // ---- the device state ----
+  kind_ = upload(kind);
+  dx_ = upload(dx);
+  dy_ = upload(dy);
+  area_ = upload(area);
+  bed_ = upload(bed_r);
+  bed_next_ = upload(bed_r);
+  bed0_ = upload(bed_r);
+  bed_residual_ = upload(std::vector<Real>(bed_r.size(), Real(0)));
+  depth_ = upload(depth_r);
+  depth_next_ = upload(depth_r);
+  sediment_ = upload(zeros);
+  sediment_next_ = upload(zeros);
+  for (int k = 0; k < 4; ++k) {
+    flux_[k] = upload(zeros);
+    flux_next_[k] = upload(zeros);
+  }
+  face_x_ = upload(zeros);
+  face_y_ = upload(zeros);
+  velocity_x_ = upload(zeros);
+  velocity_y_ = upload(zeros);
+  thermal_share_ = upload(zeros);
+  wetness_ = upload(depth_r);
+  manning_ = upload(to_real(state.manning));
+  hardness_ = upload(to_real(state.hardness));
+  rain_factor_ = upload(to_real(state.rain_factor));
+
+  // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
+  // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
+  std::size_t limit = std::min(kReduceMax, rt_->max_work_group);
+  for (const char* name : {"reduce_tallies", "reduce_change", "stats_rows"}) {
+    std::size_t wg = 0;
+    check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
+                                   &wg, nullptr),
+          "clGetKernelWorkGroupInfo");
+    limit = std::min(limit, wg);
+  }
+  reduce_local_ = 1;
+  while (reduce_local_ * 2 <= limit) reduce_local_ *= 2;
+  reduce_groups_ =
+      std::clamp<std::size_t>((n_ + reduce_local_ - 1) / reduce_local_, 1, kReduceGroupsMax);
+  partial_b_ = make_buffer(reduce_groups_ * acc_size_);
+
+  // Cell kernels: work-groups of (local_x_, 1) that every cell kernel accepts: a divisor
+  // of the row by one row (whole rows), else powers of two; a fixed number of groups for this
+  // grid (the tallies' partials, summed in a fixed order). Where a kernel accepts less than the
+  // device's maximum, the whole-row divisor may be small: still correct, slower.
+  const bool cpu = rt_->info.type == "CPU";
+  std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
+  for (const char* name :
+       {"sources_rain", "flow_pipes", "flow_pipes_interior", "flow_local_inertial_faces",
+        "flow_local_inertial_faces_x_interior", "flow_local_inertial_faces_y_interior",
+        "flow_local_inertial_split", "flow_local_inertial_split_interior", "water_update",
+        "erosion", "transport_conservative", "transport_semi_lagrangian", "thermal_share",
+        "thermal_apply", "evaporation", "field_stats", "edge_tallies"}) {
+    std::size_t wg = 0;
+    check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
+                                   &wg, nullptr),
+          "clGetKernelWorkGroupInfo");
+    cell_limit = std::min(cell_limit, wg);
+  }
+  auto pow2_at_most = [](std::size_t v) {
+    std::size_t p = 1;
+    while (p * 2 <= v) p *= 2;
+    return p;
+  };
+  if (rt_->whole_rows) {
+    // the program was built for it: a local size that divides the row (any divisor keeps
+    // the kernels correct; the largest is the fastest)
+    local_x_ = whole_row_group(static_cast<std::size_t>(W_), cell_limit);
+  } else {
+    local_x_ = pow2_at_most(std::min(cell_limit, env_size("ERODEM_OPENCL_WG", cpu ? 64 : 128)));
+  }
+  groups_x_ = (static_cast<std::size_t>(W_) + local_x_ - 1) / local_x_;
+  interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
+  partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
+  partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
+  row_sums_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 6 * acc_size_);  // stats_rows
+  row_cells_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 3 * sizeof(cl_long));
+  // The active cells beside a ghost, row-major: the only ones with a water exchange or a
+  // sediment outflow through the domain's faces (edges.cl). The kinds never change.
+  std::vector<cl_int> edges;
+  for (int y = 1; y < H_ - 1; ++y)
+    for (int x = 1; x < W_ - 1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
+      if (kind[i] != ERODEM_CELL_ACTIVE) continue;
+      if (kind[i - 1] != ERODEM_CELL_ACTIVE || kind[i + 1] != ERODEM_CELL_ACTIVE ||
+          kind[i - W_] != ERODEM_CELL_ACTIVE || kind[i + W_] != ERODEM_CELL_ACTIVE)
+        edges.push_back(static_cast<cl_int>(i));
+    }
+  edge_count_ = edges.size();
+  edge_cells_ = upload(edges);
+  edge_local_ = pow2_at_most(std::min<std::size_t>(cell_limit, 64));
+  edge_groups_ = std::max<std::size_t>(1, (edge_count_ + edge_local_ - 1) / edge_local_);
+  // Every slot holds tally_stride_ partials; what no kernel writes stays 0.
+  tally_stride_ = std::max(interior_groups_, edge_groups_);
+  const std::vector<unsigned char> no_partials(kTallySlots * tally_stride_ * acc_size_, 0);
+  tally_partials_ = upload(no_partials);
+  tally_sums_ = make_buffer(kTallySlots * acc_size_);
+  run_boundary();
+}
+
+std::string OpenClBackend::device() const {
+  return rt_->info.platform + " / " + rt_->info.device;
+}
+
+void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
+  const Real dt = static_cast<Real>(in.dt);
+  switch (p) {
+    case Process::boundary:
+      run_boundary();
+      break;
+    case Process::sources:
+      run_sources(in);
+      break;
+    case Process::flow:
+      run_flow(dt);
+      break;
+    case Process::water:
+      run_water(dt, tally);
+      break;
+    case Process::erosion:
+      run_erosion(dt, tally);
+      break;
+    case Process::transport:
+      run_transport(dt, tally);
+      break;
+    case Process::thermal:
+      run_thermal(dt, tally);
+      break;
+    case Process::evaporation:
+      run_evaporation(dt, tally);
+      break;
+  }
+}
+
+void OpenClBackend::run_boundary() {
+  cl_kernel k = kernel("boundary_fill");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_,
+           static_cast<Real>(params_.boundary.sea_level));
+  const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(boundary_fill)");
+}
+
+void OpenClBackend::run_sources(const StepInputs& in) {
+  const Real dt = static_cast<Real>(in.dt);
+  const Real rate = static_cast<Real>(in.rain_rate);
+  if (rate != Real(0)) {
+    cl_kernel k = kernel("sources_rain");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, rain_factor_, dt, rate);
+    launch_interior(k);
+  }
+  if (in.points.empty()) return;
+  std::vector<cl_int> cells;
+  std::vector<Real> amounts;
+  for (const auto& p : in.points) {
+    const int x = static_cast<int>(p.cell % nx_) + 1, y = static_cast<int>(p.cell / nx_) + 1;
+    cells.push_back(x + y * W_);
+    amounts.push_back(static_cast<Real>(p.volume / area_host_[y]));
+  }
+  // The previous upload (if any) may still read the host vectors.
+  if (points_written_) {
+    cl_event e = points_written_.get();
+    check(clWaitForEvents(1, &e), "clWaitForEvents");
+    points_written_.reset();
+  }
+  point_cells_host_ = std::move(cells);
+  point_amounts_host_ = std::move(amounts);
+  const auto& cells_h = point_cells_host_;
+  const auto& amounts_h = point_amounts_host_;
+  if (cells_h.size() > point_capacity_) {
+    point_capacity_ = std::max<std::size_t>(cells_h.size(), 2 * point_capacity_);
+    point_cells_ = make_buffer(point_capacity_ * sizeof(cl_int));
+    point_amounts_ = make_buffer(point_capacity_ * sizeof(Real));
+  }
+  // Non-blocking uploads (the queue is in order): the step does not wait for the device.
+  check(clEnqueueWriteBuffer(queue_.get(), point_cells_.get(), CL_FALSE, 0,
+                             cells_h.size() * sizeof(cl_int), cells_h.data(), 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer");
+  cl_event written = nullptr;
+  check(
+      clEnqueueWriteBuffer(queue_.get(), point_amounts_.get(), CL_FALSE, 0,
+                           amounts_h.size() * sizeof(Real), amounts_h.data(), 0, nullptr, &written),
+      "clEnqueueWriteBuffer");
+  points_written_ = Event(written);
+  cl_kernel k = kernel("sources_points");
+  set_args(k, depth_, point_cells_, point_amounts_, static_cast<cl_int>(cells_h.size()));
+  const std::size_t one = 1;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &one, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(sources_points)");
+}
+
+void OpenClBackend::run_flow(Real dt) {
+  const auto& f = params_.flow;
+  const Real g = static_cast<Real>(f.gravity);
+  if (f.scheme == FlowScheme::pipes) {
+    // The interior rows by a kernel without clamping, the first and last row by the general one.
+    for (const char* name : {"flow_pipes_interior", "flow_pipes"})
+      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, dx_, dy_, area_, flux_[0],
+               flux_[1], flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2],
+               flux_next_[3], dt, g, static_cast<Real>(f.pipe_area),
+               static_cast<Real>(f.pipe_length));
+    launch_interior(kernel("flow_pipes_interior"));
+    launch_rows(kernel("flow_pipes"), 0, 1);
+    launch_rows(kernel("flow_pipes"), H_ - 1, H_);
+  } else {
+    // Each face once (face pass), then split into the cells' outflows (cell pass); the
+    // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
+    // edge rows by the general ones. H >= 3.
+    const Real theta = static_cast<Real>(f.theta),
+               dry = static_cast<Real>(params_.numerics.dry_depth);
+    for (const char* name : {"flow_local_inertial_faces_x_interior",
+                             "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
+      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
+               flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, g, theta, dry);
+    launch_rows(kernel("flow_local_inertial_faces_x_interior"), 1, H_ - 2);
+    launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
+    launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
+    launch_rows(kernel("flow_local_inertial_faces"), H_ - 2, H_);
+    for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
+      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_,
+               flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], dt);
+    launch_rows(kernel("flow_local_inertial_split_interior"), 1, H_ - 1);
+    launch_rows(kernel("flow_local_inertial_split"), 0, 1);
+    launch_rows(kernel("flow_local_inertial_split"), H_ - 1, H_);
+  }
+  std::swap(flux_, flux_next_);
+}
+
+void OpenClBackend::run_water(Real dt, StepTally& tally) {
+  cl_kernel k = kernel("water_update");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
+           flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
+           static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
+           static_cast<cl_int>(tally_stride_));
+  defer(tally, kExchangeBit | kClippedBit | kWaterGivenBit);
+  pending_water_dt_ = dt;
+  launch_interior(k);
+  launch_edge_tallies(kTallyExchange, dt);
+  // depth_next_ keeps the depth the water update started from (after this step's sources):
+  // conservative transport needs it.
+  std::swap(depth_, depth_next_);
+}
+
+void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
+  const auto& e = params_.erosion;
+  const Real bedrock = e.bedrock_level ? static_cast<Real>(*e.bedrock_level)
+                                       : -std::numeric_limits<Real>::infinity();
+  cl_kernel k = kernel("erosion");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_, depth_,
+           velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt,
+           static_cast<Real>(e.sediment_capacity), static_cast<Real>(e.dissolving_rate),
+           static_cast<Real>(e.deposition_rate), static_cast<Real>(e.min_tilt),
+           static_cast<Real>(e.min_depth), bedrock, tally_partials_,
+           static_cast<cl_int>(tally_stride_));
+  defer(tally, kErodedBit | kDepositedBit);
+  launch_interior(k);
+  std::swap(bed_, bed_next_);
+}
+
+void OpenClBackend::run_transport(Real dt, StepTally& tally) {
+  if (params_.transport.scheme == TransportScheme::conservative) {
+    cl_kernel k = kernel("transport_conservative");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
+             flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
+             static_cast<cl_int>(tally_stride_));
+    defer(tally, kSedimentBit | kSedimentGivenBit);
+    launch_interior(k);
+    launch_edge_tallies(kTallySediment, dt);  // reads sediment_ before the swap
+  } else {
+    cl_kernel k = kernel("transport_semi_lagrangian");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
+             dx_, dy_, dt);
+    launch_interior(k);
+    cl_kernel r = kernel("reduce_change");
+    set_args(r, cl_int{W_}, cl_int{H_}, kind_, sediment_next_, sediment_, area_, partial_b_);
+    defer(tally, kChangeBit);
+    launch_reduction(r, reduce_groups_);
+  }
+  std::swap(sediment_, sediment_next_);
+}
+
+void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
+  const double pi = 3.14159265358979323846;
+  const Real tan_talus = static_cast<Real>(std::tan(params_.thermal.talus_angle * pi / 180.0));
+  const Real rate = static_cast<Real>(params_.thermal.rate);
+  cl_kernel share = kernel("thermal_share");
+  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, dx_, dy_, area_, thermal_share_, dt, rate,
+           tan_talus);
+  launch_interior(share);
+  cl_kernel apply = kernel("thermal_apply");
+  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, thermal_share_, dx_, dy_,
+           area_, bed_next_, tan_talus, tally_partials_, static_cast<cl_int>(tally_stride_));
+  defer(tally, kThermalBit);
+  launch_interior(apply);
+  std::swap(bed_, bed_next_);
+}
+
+void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
+  const Real rate = static_cast<Real>(params_.evaporation.rate);
+  const Real tau = static_cast<Real>(params_.numerics.wetness_time);
+  cl_kernel k = kernel("evaporation");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, rate, tau,
+           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(tally_stride_));
+  defer(tally, kEvaporatedBit);
+  launch_interior(k);
+}
+
+void OpenClBackend::finish() {
+  flush_tallies();
+  check(clFinish(queue_.get()), "clFinish");
+}
+
+FieldStats OpenClBackend::stats() {
+  cl_kernel k = kernel("field_stats");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, depth_, sediment_, velocity_x_,
+           velocity_y_, area_, partial_a_, partial_cells_);
+  launch_interior(k);
+  const int rows = H_ - 2;
+  cl_kernel r = kernel("stats_rows");
+  set_args(r, cl_int{W_}, cl_int{rows}, static_cast<cl_int>(groups_x_), partial_a_, partial_cells_,
+           velocity_x_, velocity_y_, row_sums_, row_cells_);
+  launch_reduction(r, (static_cast<std::size_t>(rows) + reduce_local_ - 1) / reduce_local_);
+  // The step's tallies with the statistics: one wait per step (the queue is in order).
+  enqueue_tally_reduction();
+  tally_raw_.resize(kTallySlots * acc_size_);
+  change_raw_.resize(reduce_groups_ * acc_size_);
+  if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
+  if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  std::vector<cl_long> cells(static_cast<std::size_t>(rows) * 3);
+  read(row_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
+  stats_sums_raw_.resize(static_cast<std::size_t>(rows) * 6 * acc_size_);
+  read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
+  deliver_tallies();
+  const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * 6);
+  // Rows in order, with the rules of CpuBackend::stats: the max depth starts at 0 and a
+  // later row takes it when larger (or when none has been taken); the max speed ranks the
+  // rows by the squared speed; the first bad cell.
+  FieldStats st;
+  st.max_depth = 0.0;
+  st.max_speed = 0.0;
+  double best_v2 = -1;
+  for (std::size_t y = 0; y < static_cast<std::size_t>(rows); ++y) {
+    st.water_volume += sums[6 * y + 0];
+    st.material_volume += sums[6 * y + 1];
+    st.sediment_volume += sums[6 * y + 2];
+    const double max_d = sums[6 * y + 3], max_v2 = sums[6 * y + 4];
+    const std::int64_t arg_d = cells[3 * y + 0], arg_v = cells[3 * y + 1], bad = cells[3 * y + 2];
+    if (max_d > st.max_depth || (st.max_depth_cell < 0 && arg_d >= 0)) {
+      st.max_depth = std::max(0.0, max_d);
+      st.max_depth_cell = arg_d;
+    }
+    if (arg_v >= 0 && (st.max_speed_cell < 0 || max_v2 > best_v2)) {
+      best_v2 = max_v2;
+      st.max_speed_cell = arg_v;
+      st.max_speed = std::max(0.0, sums[6 * y + 5]);
+    }
+    if (st.bad_cell < 0 && bad >= 0) st.bad_cell = bad;
+  }
+  return st;
+}
+
+}  // namespace opencl
+
+std::unique_ptr<Backend> make_opencl_backend(const Terrain& terrain, const Params& params) {
+  const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
+  return std::make_unique<opencl::OpenClBackend>(terrain, params, env ? env : "");
+}
+
+}  // namespace erodem

@@ -1,0 +1,92 @@
+// erodem — the OpenCL runtime of a device: the device ERODEM_OPENCL_DEVICE selects (else the
+// first GPU, else the first device), its context, the launch kind (whole rows on CPU devices)
+// and the build options, with the program built once per process, device and launch kind.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <map>
+#include <mutex>
+
+#include "erodem/error.hpp"
+#include "opencl/devices.hpp"
+#include "opencl/opencl_backend.hpp"
+
+namespace erodem::opencl {
+
+std::size_t whole_row_group(std::size_t W, std::size_t limit) {
+  const std::size_t cap = std::min<std::size_t>(limit, 1024);  // ERODEM_CELL_GROUP_MAX
+  for (std::size_t d = std::min(W, cap); d > 1; --d)
+    if (W % d == 0) return d;
+  return 1;
+}
+
+std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width) {
+  static std::mutex mutex;
+  static std::map<std::pair<cl_device_id, bool>, std::shared_ptr<Runtime> > cache;
+  const auto devices = enumerate_devices();
+  if (devices.empty())
+    throw Error(ExitCode::usage,
+                "backend 'opencl': no OpenCL platform or device found (install an OpenCL "
+                "driver, e.g. pocl-opencl-icd or the GPU vendor's, or use --backend cpu)");
+  const DeviceEntry* chosen = nullptr;
+  if (!selector.empty()) {
+    for (const auto& d : devices)
+      if (opencl_selector_matches(d.info, selector)) {
+        chosen = &d;
+        break;
+      }
+    if (!chosen)
+      throw Error(ExitCode::usage,
+                  fmt::format("ERODEM_OPENCL_DEVICE='{}': no OpenCL device matches "
+                              "'<platform>:<device>'; devices: {}",
+                              selector, describe(devices)));
+  } else {
+    for (const auto& d : devices)
+      if (d.info.gpu()) {
+        chosen = &d;
+        break;
+      }
+    if (!chosen) chosen = &devices.front();
+  }
+
+  // Whole rows on CPU devices (PoCL vectorises across a row's work-items only where no
+  // per-work-item condition guards the loads), unless a tuning size is set.
+  const char* wg_env = std::getenv("ERODEM_OPENCL_WG");
+  const bool whole_rows = chosen->info.type == "CPU" && !(wg_env && *wg_env) &&
+                          whole_row_group(row_width, chosen->info.max_work_group) >=
+                              std::min<std::size_t>(32, row_width);
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{chosen->device, whole_rows}];
+  if (slot) return slot;
+  auto rt = std::make_shared<Runtime>();
+  rt->info = chosen->info;
+  rt->platform = chosen->platform;
+  rt->device = chosen->device;
+  rt->fp64 = chosen->info.fp64;
+  rt->whole_rows = whole_rows;
+  rt->max_work_group = device_value<std::size_t>(rt->device, CL_DEVICE_MAX_WORK_GROUP_SIZE);
+  rt->base_align = std::max<std::size_t>(
+      1, device_value<cl_uint>(rt->device, CL_DEVICE_MEM_BASE_ADDR_ALIGN) / 8);
+  rt->max_alloc =
+      static_cast<std::size_t>(device_value<cl_ulong>(rt->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE));
+  const cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
+                                         reinterpret_cast<cl_context_properties>(rt->platform), 0};
+  cl_int err = CL_SUCCESS;
+  cl_device_id device = rt->device;
+  rt->context = Context(clCreateContext(props, 1, &device, nullptr, nullptr, &err));
+  check(err, "clCreateContext");
+  // IEEE float32 as on the CPU: no fast-math options; correctly rounded divide and sqrt
+  // where the device offers them; the kernels switch FP_CONTRACT off.
+  rt->options = "-cl-std=CL1.2 -D real=float";
+  if (rt->fp64) rt->options += " -D ERODEM_HAVE_FP64=1";
+  if (rt->whole_rows) rt->options += " -D ERODEM_WHOLE_ROWS=1";
+  const auto fp = device_value<cl_device_fp_config>(rt->device, CL_DEVICE_SINGLE_FP_CONFIG);
+  if (fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
+    rt->options += " -cl-fp32-correctly-rounded-divide-sqrt";
+  build_program(*rt);
+  slot = rt;
+  return rt;
+}
+
+}  // namespace erodem::opencl
