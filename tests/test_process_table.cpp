@@ -167,5 +167,24 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
     EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual) << f.name;
 }
 
+TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
+  // the cell kernels whose work-group the OpenCL backend queried from its own list (before
+  // 2026-11-26), as a set; the program in step order (flow before sources since they run after
+  // it; before, the files were listed in the enum's order)
+  const auto k = opencl_cell_kernels();
+  EXPECT_EQ(std::set<std::string>(k.begin(), k.end()),
+            (std::set<std::string>{
+                "sources_rain", "flow_pipes", "flow_pipes_interior", "flow_local_inertial_faces",
+                "flow_local_inertial_faces_x_interior", "flow_local_inertial_faces_y_interior",
+                "flow_local_inertial_split", "flow_local_inertial_split_interior", "water_update",
+                "erosion", "transport_conservative", "transport_semi_lagrangian", "thermal_share",
+                "thermal_apply", "evaporation", "field_stats", "edge_tallies"}));
+  EXPECT_EQ(k.size(), 17u) << "a kernel listed twice";
+  EXPECT_EQ(opencl_program_order(),
+            (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl",
+                                      "water.cl", "erosion.cl", "transport.cl", "thermal.cl",
+                                      "evaporation.cl", "edges.cl", "stats.cl"}));
+}
+
 }  // namespace
 }  // namespace erodem::test

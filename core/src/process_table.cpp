@@ -127,7 +127,7 @@ std::vector<SweepInfo> transport_sweeps(const Params& p) {
   return {{"transport_semi_lagrangian",
            Domain::cells,
            {{"kind", N}, {"sediment", U}, {"velocity_x", R}, {"velocity_y", R}},
-           {"transport_semi_lagrangian", "reduce_change"}}};
+           {"transport_semi_lagrangian"}}};
 }
 
 std::vector<SweepInfo> thermal_sweeps(const Params&) {
@@ -156,30 +156,45 @@ std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
 
 const std::vector<ProcessInfo>& process_table() {
   static const std::vector<ProcessInfo> table{
-      {Process::boundary, "boundary", "boundary", always, boundary_sweeps, {}},
-      {Process::flow, "flow", "flow", always, flow_sweeps, {}},
-      {Process::sources, "sources", "rain", always, sources_sweeps, {}},
+      {Process::boundary, "boundary", "boundary", always, boundary_sweeps, {}, "boundary.cl"},
+      {Process::flow, "flow", "flow", always, flow_sweeps, {}, "flow.cl"},
+      {Process::sources, "sources", "rain", always, sources_sweeps, {}, "sources.cl"},
       {Process::water,
        "water",
        "",
        always,
        water_sweeps,
-       {"boundary_out", "clipped", "water_exchanged"}},
-      {Process::erosion, "erosion", "erosion", erosion_on, erosion_sweeps, {"eroded", "deposited"}},
+       {"boundary_out", "clipped", "water_exchanged"},
+       "water.cl"},
+      {Process::erosion,
+       "erosion",
+       "erosion",
+       erosion_on,
+       erosion_sweeps,
+       {"eroded", "deposited"},
+       "erosion.cl"},
       // erosion.enabled switches transport too: what erosion lifts must move
       {Process::transport,
        "transport",
        "transport",
        erosion_on,
        transport_sweeps,
-       {"sediment_out", "transport_change", "sediment_exchanged"}},
-      {Process::thermal, "thermal", "thermal", thermal_on, thermal_sweeps, {"thermal_moved"}},
+       {"sediment_out", "transport_change", "sediment_exchanged"},
+       "transport.cl"},
+      {Process::thermal,
+       "thermal",
+       "thermal",
+       thermal_on,
+       thermal_sweeps,
+       {"thermal_moved"},
+       "thermal.cl"},
       {Process::evaporation,
        "evaporation",
        "evaporation",
        always,
        evaporation_sweeps,
-       {"evaporated"}},
+       {"evaporated"},
+       "evaporation.cl"},
   };
   return table;
 }
@@ -299,8 +314,38 @@ const SweepInfo& stats_sweep() {
                                 {"sediment", R},
                                 {"velocity_x", R},
                                 {"velocity_y", R}},
-                               {"field_stats", "stats_rows"}};
+                               {"field_stats"}};
   return sweep;
+}
+
+std::vector<std::string> opencl_cell_kernels() {
+  std::vector<std::string> out;
+  auto add = [&](const SweepInfo& sweep) {
+    if (sweep.domain != Domain::cells) return;
+    for (const char* k : sweep.opencl_kernels)
+      if (std::find(out.begin(), out.end(), k) == out.end()) out.emplace_back(k);
+  };
+  // every process on, with each flow and transport scheme
+  Params p;
+  p.rain.rate = 1.0;
+  p.erosion.enabled = p.thermal.enabled = true;
+  p.evaporation.rate = 1.0;
+  for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial})
+    for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian}) {
+      p.flow.scheme = flow;
+      p.transport.scheme = transport;
+      for (const auto& [process, sweep] : step_sweeps(p)) add(sweep);
+    }
+  add(stats_sweep());
+  return out;
+}
+
+std::vector<std::string> opencl_program_order() {
+  std::vector<std::string> order{"reduce.cl"};
+  for (const auto& e : process_table()) order.emplace_back(e.opencl_source);
+  order.emplace_back("edges.cl");
+  order.emplace_back("stats.cl");
+  return order;
 }
 
 }  // namespace erodem

@@ -1,6 +1,7 @@
 // erodem — the table of the parameter schema: every key of Params with its kind, dimension,
 // range and doc line, grouped by section. The only place where keys, ranges, units and docs
 // are written; parsing, `--set`, validation, dumping and --help follow from it (schema.cpp).
+#include "erodem/fields.hpp"
 #include "schema_kinds.hpp"
 
 namespace erodem::schema_detail {
@@ -132,9 +133,7 @@ const std::vector<Descriptor>& descriptor_table() {
               "steps between snapshots (used when output.interval is 0)"),
       number(ERODEM_FIELD(output.interval), D::time, at_least(0),
              "simulated time between snapshots (s); 0 = use output.every"),
-      name_list(ERODEM_FIELD(output.fields),
-                {"bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness",
-                 "hardness", "flux_left", "flux_right", "flux_top", "flux_bottom"},
+      name_list(ERODEM_FIELD(output.fields), output_field_names(),  // fields.cpp's table
                 "fields written in each snapshot"),
       points(ERODEM_FIELD(output.gauges),
              "gauge points [[x, y], ...] in the DEM's CRS: depth, level and speed every step"),

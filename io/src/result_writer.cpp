@@ -22,6 +22,7 @@
 #include "erodem/fields.hpp"
 #include "erodem/io/paths.hpp"
 #include "erodem/io/results.hpp"
+#include "erodem/process.hpp"
 #include "erodem/schema.hpp"
 #include "h5.hpp"
 #include "xdmf.hpp"
@@ -235,7 +236,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   m.partial = partial_;
   m.grid = grid;
   m.output = params.output;
-  m.bed_changes = params.erosion.enabled || params.thermal.enabled;
+  m.bed_changes = bed_changes(params);  // a sweep of the step writes the bed (process.hpp)
   m.restart = params.output.restart_state;
   m.restart_f64 = params.numerics.precision == Precision::float64;
   for (const auto& name : m.output.fields) m.fields.emplace_back(field_info(name), H5Id());

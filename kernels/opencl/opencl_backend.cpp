@@ -16,6 +16,7 @@
 #include "common/compat.h"
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
+#include "erodem/process.hpp"
 #include "opencl/launch.hpp"
 
 namespace erodem {
@@ -121,15 +122,10 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // device's maximum, the whole-row divisor may be small: still correct, slower.
   const bool cpu = rt_->info.type == "CPU";
   std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
-  for (const char* name :
-       {"sources_rain", "flow_pipes", "flow_pipes_interior", "flow_local_inertial_faces",
-        "flow_local_inertial_faces_x_interior", "flow_local_inertial_faces_y_interior",
-        "flow_local_inertial_split", "flow_local_inertial_split_interior", "water_update",
-        "erosion", "transport_conservative", "transport_semi_lagrangian", "thermal_share",
-        "thermal_apply", "evaporation", "field_stats", "edge_tallies"}) {
+  for (const std::string& name : opencl_cell_kernels()) {  // from the process table
     std::size_t wg = 0;
-    check(clGetKernelWorkGroupInfo(kernel(name), rt_->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg),
-                                   &wg, nullptr),
+    check(clGetKernelWorkGroupInfo(kernel(name.c_str()), rt_->device, CL_KERNEL_WORK_GROUP_SIZE,
+                                   sizeof(wg), &wg, nullptr),
           "clGetKernelWorkGroupInfo");
     cell_limit = std::min(cell_limit, wg);
   }

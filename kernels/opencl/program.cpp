@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "erodem/error.hpp"
+#include "erodem/process.hpp"
 #include "opencl/embedded_sources.hpp"
 #include "opencl/opencl_backend.hpp"
 
@@ -64,9 +65,7 @@ void expand(const std::string& name, ProgramSource& out, std::set<std::string>& 
 ProgramSource assemble_program() {
   // What the reductions share, the process files in step order, then the reductions; every
   // other embedded .cl after.
-  std::vector<std::string> order = {"reduce.cl",      "boundary.cl", "sources.cl",   "flow.cl",
-                                    "water.cl",       "erosion.cl",  "transport.cl", "thermal.cl",
-                                    "evaporation.cl", "edges.cl",    "stats.cl"};
+  std::vector<std::string> order = opencl_program_order();  // from the process table
   for (std::size_t k = 0; k < kEmbeddedSourceCount; ++k) {
     const std::string name = kEmbeddedSources[k].name;
     if (name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0 &&

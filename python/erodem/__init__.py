@@ -38,23 +38,7 @@ __all__ = [
 __version__ = "0.1.0"
 
 #: Names of the fields a Simulation exposes (MODEL.md); all in SI units.
-FIELDS = (
-    "bed",
-    "water_depth",
-    "sediment",
-    "velocity_x",
-    "velocity_y",
-    "flux_left",
-    "flux_right",
-    "flux_top",
-    "flux_bottom",
-    "hardness",
-    "wetness",
-    "erosion",
-    "manning_n",
-    "initial_bed",
-    "bed_residual",
-)
+FIELDS = tuple(_erodem.field_names())
 
 Settings = List[Tuple[str, str]]
 

@@ -17,6 +17,9 @@ class UnstableError(RuntimeError):
 def parameter_keys() -> List[str]:
     """All dotted parameter keys, in schema order."""
 
+def field_names() -> List[str]:
+    """The names of every field, in the order of the C++ field table (fields.cpp)."""
+
 def parameter_info(key: str) -> Dict[str, str]:
     """key, type, unit, accepted, default, doc of one parameter; ValueError if unknown."""
 

@@ -5,6 +5,7 @@
 
 #include "bindings.hpp"
 #include "erodem/error.hpp"
+#include "erodem/fields.hpp"
 #include "erodem/io/config.hpp"
 #include "erodem/schema.hpp"
 #include "erodem/units.hpp"
@@ -78,6 +79,14 @@ void add_error_bindings(py::module_& m) {
 
 void add_schema_bindings(py::module_& m) {
   m.def("parameter_keys", &parameter_keys, "All dotted parameter keys, in schema order.");
+  m.def(
+      "field_names",
+      [] {
+        std::vector<std::string> names;
+        for (const auto& f : field_table()) names.emplace_back(f.name);
+        return names;
+      },
+      "The names of every field, in the order of the C++ field table (fields.cpp).");
   m.def(
       "parameter_info",
       [](const std::string& key) {

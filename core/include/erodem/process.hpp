@@ -45,6 +45,8 @@ struct SweepInfo {
   const char* name;  ///< e.g. "erosion"; the OpenCL kernels that run it are `opencl_kernels`
   Domain domain;
   std::vector<FieldUse> uses;
+  /// The OpenCL kernels that run it over the cells (for a cells sweep: the cell kernels whose
+  /// work-group limits the backend's launch geometry; reductions are the backend's own).
   std::vector<const char*> opencl_kernels;
   /// Intermediates it leaves for later sweeps of the step at no traffic of its own (the
   /// water update leaves "depth_flow", the depth it started from, in its second buffer).
@@ -69,6 +71,8 @@ struct ProcessInfo {
   std::vector<SweepInfo> (*sweeps)(const Params&);
   /// The Ledger members its tallies are booked into (entries of tally_table()).
   std::vector<const char*> tallies;
+  /// The file of kernels/opencl/ with its kernels.
+  const char* opencl_source;
 };
 
 /// Every process, in step order (the sources run after the flow: model.md section 2).
@@ -112,5 +116,13 @@ SweepBytes process_bytes(Process p, const Params& params, int real_bytes);
 /// The driver's reductions after every step (Simulation::step: the ledger's volumes, the
 /// maxima, the first bad cell), as a sweep.
 const SweepInfo& stats_sweep();
+
+/// Every OpenCL cell kernel of any configuration: the kernels of the cells sweeps of every
+/// process with either flow and either transport scheme, and of stats_sweep(), once each (the
+/// OpenCL backend's work-group size must suit all of them).
+std::vector<std::string> opencl_cell_kernels();
+/// The OpenCL program's files in order: reduce.cl (the reductions the kernels share), each
+/// process's opencl_source in step order, then edges.cl and stats.cl.
+std::vector<std::string> opencl_program_order();
 
 }  // namespace erodem

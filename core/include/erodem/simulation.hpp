@@ -58,7 +58,6 @@ struct RestartPoint {
   std::vector<std::vector<double>> fields;
 };
 
-
 class Simulation {
  public:
   /// Takes the host inputs, the validated parameters and the backend that holds the state
