@@ -4,6 +4,11 @@
 
 #include "compat.h"
 
+/* The run constants of the boundary ghosts (boundary_params, kernels/cell_params.cpp). */
+ERODEM_PARAMS(BoundaryParams, {
+  real sea_level; /* the level of fixed_level edges and of sea nodata cells (m) */
+})
+
 ERODEM_BEGIN_NAMESPACE
 
 /* Set bed and depth of halo cell (x, y) from the edge cell inside it:
@@ -12,7 +17,9 @@ ERODEM_BEGIN_NAMESPACE
  *  - fixed_level: water surface at sea_level (m) over a bed no higher than the edge's.
  * Walls and corners keep what they have: no water crosses their faces. */
 ERODEM_FN void boundary_fill_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
-                                  GLOBAL real* bed, GLOBAL real* depth, real sea_level) {
+                                  GLOBAL real* bed, GLOBAL real* depth,
+                                  ERODEM_P(BoundaryParams) p) {
+  const real sea_level = p.sea_level;
   const int i = x + y * W;
   const int k = kind[i];
   if (k != ERODEM_CELL_OPEN && k != ERODEM_CELL_FIXED) return;

@@ -54,6 +54,29 @@ typedef std::uint8_t erodem_kind_t;
   }
 #endif
 
+/* One parameter struct per process: the run constants of its cell functions, members of
+ * type `real` or `int` only, so that the host's Name<float> and the device's Name share one
+ * layout (kernels/cell_params.hpp checks the size). The host converts the parameters into it
+ * once (kernels/cell_params.cpp) and both backends pass it as it is: the CPU loops to the cell
+ * functions, the OpenCL host as one kernel argument, by value. ERODEM_PARAMS(Name, {members})
+ * declares it, at file scope (outside ERODEM_BEGIN_NAMESPACE); ERODEM_P(Name) names it in a
+ * cell function's signature. In C++ the structs live in erodem::cell_params, outside the
+ * per-instruction-set namespaces of the CPU builds (cpu/isa_prelude.hpp): they hold no code,
+ * and the one conversion (baseline code) fills the type every build uses. */
+#ifdef __OPENCL_C_VERSION__
+#define ERODEM_PARAMS(Name, ...) typedef struct __VA_ARGS__ Name;
+#define ERODEM_P(Name) Name
+#else
+#define ERODEM_PARAMS(Name, ...) \
+  namespace erodem {             \
+  namespace cell_params {        \
+  template <class real>          \
+  struct Name __VA_ARGS__;       \
+  }                              \
+  }
+#define ERODEM_P(Name) ::erodem::cell_params::Name<real>
+#endif
+
 /* Cube root with the same bits on the CPU and every OpenCL device (float32). The C library's
  * cbrtf and OpenCL's cbrt may differ by an ulp, and the thresholds of the flow schemes (dry
  * faces, clipping) turn one ulp into visible differences after many steps. This one uses

@@ -5,6 +5,17 @@
 #include "compat.h"
 #include "compensated.h"
 
+/* The run constants of the erosion process (erosion_params, kernels/cell_params.cpp, from
+ * Params::Erosion). */
+ERODEM_PARAMS(ErosionParams, {
+  real capacity_k;      /* K_c (s): capacity per unit speed and tilt */
+  real dissolving_rate; /* K_s (1/s) */
+  real deposition_rate; /* K_d (1/s) */
+  real min_tilt;        /* sin_min (1) */
+  real min_depth;       /* depth below which the capacity ramps to 0 (m); 0 = off */
+  real bedrock;         /* no erosion below this bed elevation (m); -inf without one */
+})
+
 ERODEM_BEGIN_NAMESPACE
 
 /* Sine of the local bed tilt from central differences of the bed over active neighbours
@@ -72,24 +83,24 @@ ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
                             GLOBAL const real* sediment, GLOBAL const real* depth,
                             GLOBAL const real* velocity_x, GLOBAL const real* velocity_y,
                             GLOBAL const real* hardness, GLOBAL const real* dx,
-                            GLOBAL const real* dy, real dt, real capacity_k, real dissolving_rate,
-                            real deposition_rate, real min_tilt, real min_depth, real bedrock,
+                            GLOBAL const real* dy, real dt, ERODEM_P(ErosionParams) p,
                             real* bed_residual_out, real* sediment_out, real* moved_out) {
   const int i = x + y * W;
   const real u = velocity_x[i];
   const real v = velocity_y[i];
   const real speed = sqrt(u * u + v * v);
   const real tilt = bed_tilt_sin(x, y, W, kind, bed, dx, dy);
-  const real capacity = transport_capacity(capacity_k, tilt, min_tilt, speed, depth[i], min_depth);
+  const real capacity =
+      transport_capacity(p.capacity_k, tilt, p.min_tilt, speed, depth[i], p.min_depth);
   const real s = sediment[i];
   const real b = bed[i];
   const real lo = bed_residual[i];
-  const real k_erode = dissolving_rate * hardness[i] * dt;
+  const real k_erode = p.dissolving_rate * hardness[i] * dt;
   const real erode = (k_erode < (real)1 ? k_erode : (real)1) * (capacity - s);
-  const real above = (b - bedrock) + lo; /* +inf without a bedrock level */
+  const real above = (b - p.bedrock) + lo; /* +inf without a bedrock level */
   const real above_rock = above > 0 ? above : (real)0;
   const real eroded = erode < above_rock ? erode : above_rock;
-  const real k_deposit = deposition_rate * dt;
+  const real k_deposit = p.deposition_rate * dt;
   const real deposited = -(k_deposit < (real)1 ? k_deposit : (real)1) * (s - capacity);
   const real moved = capacity > s ? eroded : deposited;
   real e_s, e_b;
@@ -99,6 +110,37 @@ ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   *moved_out = moved;
   /* (b + lo) - (moved - e_s) = h + (lo + e_b + e_s) */
   return two_sum(h, (lo + e_b) + e_s, bed_residual_out);
+}
+
+/* The erosion sweep's work for padded cell (x, y) of a row 1 <= y <= H - 2, the body of both
+ * backends' sweeps (the CPU loop of kernels/cpu/erosion.cpp, the work-item of
+ * kernels/opencl/erosion.cl): every cell computes (in the first and last column on
+ * neighbours across the row's ends, inside the buffer) and the active ones (1 <= x <= W - 2,
+ * kind active) keep the result: the new bed into bed_out, the new residual and sediment in
+ * place; the others keep theirs. Writes the volume eroded and the volume deposited (m^3; 0
+ * for other cells) through *eroded and *deposited. Every load is unconditional (the row's
+ * area too: under `active`, PoCL made it a gather and left the kernel scalar), so loops over
+ * x vectorise. */
+ERODEM_FN void erosion_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                  GLOBAL const real* bed, GLOBAL real* bed_out,
+                                  GLOBAL real* bed_residual, GLOBAL real* sediment,
+                                  GLOBAL const real* depth, GLOBAL const real* velocity_x,
+                                  GLOBAL const real* velocity_y, GLOBAL const real* hardness,
+                                  GLOBAL const real* dx, GLOBAL const real* dy,
+                                  GLOBAL const real* area, real dt, ERODEM_P(ErosionParams) p,
+                                  real* eroded, real* deposited) {
+  const int i = x + y * W;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  const real b = bed[i], lo = bed_residual[i], s = sediment[i], cell_area = area[y];
+  real lo_new, s_new, moved;
+  const real b_new = erosion_cell(x, y, W, kind, bed, bed_residual, sediment, depth, velocity_x,
+                                  velocity_y, hardness, dx, dy, dt, p, &lo_new, &s_new, &moved);
+  bed_out[i] = active ? b_new : b;
+  bed_residual[i] = active ? lo_new : lo;
+  sediment[i] = active ? s_new : s;
+  const real volume = moved * cell_area;
+  *eroded = active & (volume > 0) ? volume : (real)0;
+  *deposited = active & (volume < 0) ? -volume : (real)0;
 }
 
 ERODEM_END_NAMESPACE

@@ -12,6 +12,15 @@
 
 #include "compat.h"
 
+/* The run constants of the flow schemes (flow_params, kernels/cell_params.cpp). */
+ERODEM_PARAMS(FlowParams, {
+  real gravity;     /* g (m/s^2) */
+  real theta;       /* local inertial: de Almeida's weighting (1) */
+  real dry_depth;   /* local inertial: faces shallower carry no flow (m) */
+  real pipe_area;   /* pipes: the pipe cross-section A (m^2) */
+  real pipe_length; /* pipes: the pipe length l (m); 0 = the cell size */
+})
+
 ERODEM_BEGIN_NAMESPACE
 
 /* Kind of padded cell (x, y); anything outside the padded raster is a wall. */

@@ -5,6 +5,12 @@
 #include "compat.h"
 #include "compensated.h"
 
+/* The run constants of slope collapse (thermal_params, kernels/cell_params.cpp). */
+ERODEM_PARAMS(ThermalParams, {
+  real rate;      /* K_t (1/s) */
+  real tan_talus; /* tan of the talus angle (1) */
+})
+
 ERODEM_BEGIN_NAMESPACE
 
 /* Height (m) by which the bed drop from `from` to `to` over `dist` (m) exceeds the talus
@@ -21,7 +27,8 @@ ERODEM_FN real talus_excess(real from, real to, real dist, real tan_talus) {
 ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                   GLOBAL const real* bed, GLOBAL const real* dx,
                                   GLOBAL const real* dy, GLOBAL const real* area, real dt,
-                                  real rate, real tan_talus) {
+                                  ERODEM_P(ThermalParams) p) {
+  const real rate = p.rate, tan_talus = p.tan_talus;
   const int i = x + y * W;
   const real b = bed[i];
   const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
@@ -55,8 +62,10 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
 ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                   GLOBAL const real* bed, GLOBAL const real* bed_residual,
                                   GLOBAL const real* share, GLOBAL const real* dx,
-                                  GLOBAL const real* dy, GLOBAL const real* area, real tan_talus,
-                                  real* bed_residual_out, real* given_out) {
+                                  GLOBAL const real* dy, GLOBAL const real* area,
+                                  ERODEM_P(ThermalParams) p, real* bed_residual_out,
+                                  real* given_out) {
+  const real tan_talus = p.tan_talus;
   const int i = x + y * W;
   const real b = bed[i];
   const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
@@ -80,6 +89,38 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real gave = share[i] * given;
   *given_out = gave;
   return bed_add(b, bed_residual[i], (taken - gave) * ((real)1 / cell_area), bed_residual_out);
+}
+
+/* The two sweeps of slope collapse for padded cell (x, y) of a row 1 <= y <= H - 2, the
+ * bodies of both backends' loops (kernels/cpu/thermal.cpp, kernels/opencl/thermal.cl): every
+ * cell computes, the active ones (1 <= x <= W - 2, kind active) keep the result, branch-free.
+ * Pass 1 writes the share (0 for other cells); pass 2 writes the new bed into bed_out and the
+ * residual in place (others keep theirs) and the volume the cell gave (m^3; 0 for others)
+ * through *moved. */
+ERODEM_FN void thermal_share_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                        GLOBAL const real* bed, GLOBAL const real* dx,
+                                        GLOBAL const real* dy, GLOBAL const real* area,
+                                        GLOBAL real* share, real dt, ERODEM_P(ThermalParams) p) {
+  const int i = x + y * W;
+  const real s = thermal_share_cell(x, y, W, kind, bed, dx, dy, area, dt, p);
+  share[i] = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s : (real)0;
+}
+
+ERODEM_FN void thermal_apply_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                        GLOBAL const real* bed, GLOBAL real* bed_out,
+                                        GLOBAL real* bed_residual, GLOBAL const real* share,
+                                        GLOBAL const real* dx, GLOBAL const real* dy,
+                                        GLOBAL const real* area, ERODEM_P(ThermalParams) p,
+                                        real* moved) {
+  const int i = x + y * W;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  const real b_old = bed[i], lo_old = bed_residual[i]; /* unconditional loads */
+  real lo_new, gave;
+  const real b =
+      thermal_apply_cell(x, y, W, kind, bed, bed_residual, share, dx, dy, area, p, &lo_new, &gave);
+  bed_out[i] = active ? b : b_old;
+  bed_residual[i] = active ? lo_new : lo_old;
+  *moved = active ? gave : (real)0;
 }
 
 ERODEM_END_NAMESPACE

@@ -4,6 +4,11 @@
 
 #include "flow.h"
 
+/* The run constants of the water update (water_params, kernels/cell_params.cpp). */
+ERODEM_PARAMS(WaterParams, {
+  real velocity_min_depth; /* the velocity is 0 below this mean depth (m) */
+})
+
 ERODEM_BEGIN_NAMESPACE
 
 /* Depth-averaged velocity (m/s) of a cell along one axis: the mean of the velocities through
@@ -54,7 +59,7 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
                                  GLOBAL const real* f_bottom, GLOBAL const real* dx,
                                  GLOBAL const real* dy, GLOBAL const real* area,
                                  GLOBAL real* velocity_x, GLOBAL real* velocity_y, real dt,
-                                 real velocity_min_depth, real* exchange, real* clipped,
+                                 ERODEM_P(WaterParams) p, real* exchange, real* clipped,
                                  real* given) {
   const int i = x + y * W;
   const int active = kind[i] == ERODEM_CELL_ACTIVE;
@@ -96,9 +101,9 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   const real h_t = face_flow_depth(depth[i - W], d_old, b_t, b);
   const real h_b = erodem_max(db_b + depth[i + W], d_old) - (db_b > 0 ? db_b : (real)0);
   const real u = face_velocity(in_left - f_left[i], h_l, f_right[i] - in_right, h_r, dy[y], d_mean,
-                               velocity_min_depth);
+                               p.velocity_min_depth);
   const real v = face_velocity(in_bottom - f_bottom[i], h_b, f_top[i] - in_top, h_t, dx[y], d_mean,
-                               velocity_min_depth);
+                               p.velocity_min_depth);
   velocity_x[i] = active ? u : (real)0;
   velocity_y[i] = active ? v : (real)0;
 }

@@ -8,7 +8,7 @@ namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_boundary() {
-  const Real sea = static_cast<Real>(params_.boundary.sea_level);
+  const cell_params::BoundaryParams<Real> sea = cell_.boundary;
   for (int x = 1; x < W_ - 1; ++x) {
     cell::boundary_fill_cell(x, 0, W_, H_, kind_.data(), bed_.data(), depth_.data(), sea);
     cell::boundary_fill_cell(x, H_ - 1, W_, H_, kind_.data(), bed_.data(), depth_.data(), sea);

@@ -22,6 +22,7 @@ namespace ERODEM_CPU_NAMESPACE {
 template <class Real>
 CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
     : params_(params),
+      cell_(cell_params_of<Real>(params)),
       nx_(terrain.grid.nx),
       ny_(terrain.grid.ny),
       W_(terrain.grid.nx + 2),

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cell_params.hpp"
 #include "common/compat.h"
 #include "erodem/backend.hpp"
 #include "erodem/grid.hpp"
@@ -105,6 +106,7 @@ class CpuBackend final : public Backend {
   Field* field_storage(FieldId id);
 
   Params params_;
+  CellParams<Real> cell_;  // the processes' run constants (cell_params.hpp)
   int nx_, ny_, W_, H_;
   int threads_;
   std::vector<Kind> kind_;

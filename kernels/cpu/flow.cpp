@@ -138,8 +138,8 @@ void split_row(int y, int W, const int* __restrict k, const int* __restrict k_to
 
 template <class Real>
 void CpuBackend<Real>::run_flow(Real dt) {
-  const auto& f = params_.flow;
-  const Real g = static_cast<Real>(f.gravity);
+  const cell_params::FlowParams<Real> f = cell_.flow;
+  const Real g = f.gravity;
   const Kind* kind = kind_.data();
   const Real *b = bed_.data(), *d = depth_.data();
   const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
@@ -148,9 +148,9 @@ void CpuBackend<Real>::run_flow(Real dt) {
        *ob = flux_next_[3].data();
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const int W = W_, H = H_;
-  if (f.scheme == FlowScheme::pipes) {
-    const Real area_pipe = static_cast<Real>(f.pipe_area);
-    const Real length = static_cast<Real>(f.pipe_length);
+  if (params_.flow.scheme == FlowScheme::pipes) {
+    const Real area_pipe = f.pipe_area;
+    const Real length = f.pipe_length;
     // Rows 1 .. H - 2 without clamping (the loop vectorises), the first and last row clamped.
     for_rows(0, H, [=](int y) {
       // Locals, not closure members: stores to Real arrays could alias those.
@@ -172,8 +172,7 @@ void CpuBackend<Real>::run_flow(Real dt) {
     std::swap(flux_, flux_next_);
     return;
   }
-  const InertialParams<Real> p{dt, g, static_cast<Real>(f.theta),
-                               static_cast<Real>(params_.numerics.dry_depth)};
+  const InertialParams<Real> p{dt, g, f.theta, f.dry_depth};
   const Real* manning = manning_.data();
 #pragma omp parallel num_threads(threads_)
   {

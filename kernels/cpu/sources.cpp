@@ -38,30 +38,20 @@ void CpuBackend<Real>::run_sources(const StepInputs& in) {
 
 template <class Real>
 void CpuBackend<Real>::run_evaporation(Real dt, StepTally& tally) {
-  const Real rate = static_cast<Real>(params_.evaporation.rate);
-  const Real tau = static_cast<Real>(params_.numerics.wetness_time);
   const Kind* kind = kind_.data();
   const Real* area = area_.data();
   Real *depth = depth_.data(), *wetness = wetness_.data();
+  const cell_params::EvaporationParams<Real> params = cell_.evaporation;
   const int W = W_;
-  const bool evaporate = rate > Real(0);
   for_rows(1, H_ - 1, [=](int y) {
-    const Real step = dt, k = rate, t = tau, a = area[y];
+    // Locals, not closure members: stores to Real arrays could alias those.
+    const Real step = dt;
+    const cell_params::EvaporationParams<Real> p = params;
     const auto lost_row = row_scratch(W);
     Real* lost = lost_row.get();
     ERODEM_IVDEP
-    for (int x = 1; x < W - 1; ++x) {
-      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
-      const bool active = kind[i] == ERODEM_CELL_ACTIVE;
-      const Real d = depth[i];
-      Real taken = 0;
-      const Real dried = cell::evaporation_cell(d, step, k, a, &taken);
-      const Real d_new = active && evaporate ? dried : d;
-      depth[i] = d_new;
-      lost[x] = active && evaporate ? taken : Real(0);
-      const Real w = wetness[i];  // an unconditional load: if-convertible
-      wetness[i] = active ? cell::wetness_cell(w, d_new, step, t) : w;
-    }
+    for (int x = 1; x < W - 1; ++x)
+      cell::evaporation_sweep_cell(x, y, W, kind, depth, wetness, area, step, p, lost + x);
     row_sums_a_[y] = sum_row(lost, static_cast<std::size_t>(W));
   });
   tally.evaporated += sum_rows(row_sums_a_);

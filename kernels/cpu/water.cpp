@@ -10,16 +10,17 @@ namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
-  const Real d_min = static_cast<Real>(params_.numerics.velocity_min_depth);
   const Kind* kind = kind_.data();
   const Real *bed = bed_.data(), *depth = depth_.data(), *fl = flux_[0].data(),
              *fr = flux_[1].data(), *ft = flux_[2].data(), *fb = flux_[3].data();
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   Real *depth_out = depth_next_.data(), *u = velocity_x_.data(), *v = velocity_y_.data();
+  const cell_params::WaterParams<Real> params = cell_.water;
   const int W = W_;
   for_rows(1, H_ - 1, [=](int y) {
     // Locals, not closure members: stores to Real arrays could alias those.
-    const Real step = dt, min_depth = d_min;
+    const Real step = dt;
+    const cell_params::WaterParams<Real> p = params;
     const auto exchange = row_scratch(W), clipped = row_scratch(W), given = row_scratch(W);
     Real* ex = exchange.get();
     Real* cl = clipped.get();
@@ -27,7 +28,7 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
       cell::water_update_cell(x, y, W, kind, bed, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u,
-                              v, step, min_depth, ex + x, cl + x, gv + x);
+                              v, step, p, ex + x, cl + x, gv + x);
     row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
     row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
     row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));

@@ -13,12 +13,12 @@ __kernel void flow_pipes(int W, int H, __global const uchar* restrict kind,
                          __global const real* restrict f_right, __global const real* restrict f_top,
                          __global const real* restrict f_bottom, __global real* restrict out_left,
                          __global real* restrict out_right, __global real* restrict out_top,
-                         __global real* restrict out_bottom, real dt, real gravity, real pipe_area,
-                         real pipe_length) {
+                         __global real* restrict out_bottom, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   flow_pipes_cell(x, y, W, H, kind, bed, depth, dx, dy, area, f_left, f_right, f_top, f_bottom,
-                  out_left, out_right, out_top, out_bottom, dt, gravity, pipe_area, pipe_length);
+                  out_left, out_right, out_top, out_bottom, dt, p.gravity, p.pipe_area,
+                  p.pipe_length);
 }
 
 /* The pipes scheme on rows 1 .. H - 2 (global offset 1): no clamping, no branches. */
@@ -29,15 +29,14 @@ __kernel void flow_pipes_interior(
     __global const real* restrict f_left, __global const real* restrict f_right,
     __global const real* restrict f_top, __global const real* restrict f_bottom,
     __global real* restrict out_left, __global real* restrict out_right,
-    __global real* restrict out_top, __global real* restrict out_bottom, real dt, real gravity,
-    real pipe_area, real pipe_length) {
+    __global real* restrict out_top, __global real* restrict out_bottom, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   real lx, lt, lb;
-  pipe_lengths(y, y - 1, y + 1, dx, dy, pipe_length, &lx, &lt, &lb);
+  pipe_lengths(y, y - 1, y + 1, dx, dy, p.pipe_length, &lx, &lt, &lb);
   flow_pipes_cell_interior(x, y, W, kind, bed, depth, lx, lt, lb, area[y], f_left, f_right, f_top,
-                           f_bottom, out_left, out_right, out_top, out_bottom, dt, gravity,
-                           pipe_area);
+                           f_bottom, out_left, out_right, out_top, out_bottom, dt, p.gravity,
+                           p.pipe_area);
 }
 
 /* Local inertial, face pass: one work-item per padded cell computes the face east of it
@@ -51,15 +50,14 @@ __kernel void flow_local_inertial_faces(
     __global const real* restrict dx, __global const real* restrict dy,
     __global const real* restrict f_left, __global const real* restrict f_right,
     __global const real* restrict f_top, __global const real* restrict f_bottom,
-    __global real* restrict face_x, __global real* restrict face_y, real dt, real gravity,
-    real theta, real dry_depth) {
+    __global real* restrict face_x, __global real* restrict face_y, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   const int i = x + y * W;
   const real qx = local_inertial_face_x(x, y, W, H, kind, bed, depth, manning, dx, dy, f_left,
-                                        f_right, dt, gravity, theta, dry_depth);
+                                        f_right, dt, p.gravity, p.theta, p.dry_depth);
   const real qy = local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, dx, dy, f_top,
-                                        f_bottom, dt, gravity, theta, dry_depth);
+                                        f_bottom, dt, p.gravity, p.theta, p.dry_depth);
   face_x[i] = x < W - 1 ? qx : (real)0;
   face_y[i] = y < H - 1 ? qy : (real)0;
 }
@@ -75,12 +73,11 @@ __kernel void flow_local_inertial_faces_x_interior(
     __global const real* restrict dx, __global const real* restrict dy,
     __global const real* restrict f_left, __global const real* restrict f_right,
     __global const real* restrict f_top, __global const real* restrict f_bottom,
-    __global real* restrict face_x, __global real* restrict face_y, real dt, real gravity,
-    real theta, real dry_depth) {
+    __global real* restrict face_x, __global real* restrict face_y, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const real qx = local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_left,
-                                                 f_right, dt, gravity, theta, dry_depth);
+                                                 f_right, dt, p.gravity, p.theta, p.dry_depth);
   face_x[x + y * W] = x < W - 1 ? qx : (real)0;
 }
 
@@ -90,12 +87,12 @@ __kernel void flow_local_inertial_faces_y_interior(
     __global const real* restrict dx, __global const real* restrict dy,
     __global const real* restrict f_left, __global const real* restrict f_right,
     __global const real* restrict f_top, __global const real* restrict f_bottom,
-    __global real* restrict face_x, __global real* restrict face_y, real dt, real gravity,
-    real theta, real dry_depth) {
+    __global real* restrict face_x, __global real* restrict face_y, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
-  face_y[x + y * W] = local_inertial_face_y_interior(
-      x, y, W, kind, bed, depth, manning, dx, dy, f_top, f_bottom, dt, gravity, theta, dry_depth);
+  face_y[x + y * W] =
+      local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_top, f_bottom,
+                                     dt, p.gravity, p.theta, p.dry_depth);
 }
 
 /* Local inertial, cell pass: the four faces around each padded cell split into its

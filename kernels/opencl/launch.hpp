@@ -17,7 +17,11 @@ inline void set_arg(cl_kernel k, cl_uint index, const Buffer& b) {
 }
 template <class T>
 inline void set_arg(cl_kernel k, cl_uint index, const T& v) {
-  static_assert(std::is_arithmetic_v<T>, "kernel arguments: buffers or numbers");
+  // numbers, or a process's parameter struct (kernels/cell_params.hpp: real members only, the
+  // device's layout), passed by value
+  static_assert(
+      std::is_arithmetic_v<T> || (std::is_trivially_copyable_v<T> && std::is_standard_layout_v<T>),
+      "kernel arguments: buffers, numbers or parameter structs");
   check(clSetKernelArg(k, index, sizeof(T), &v), "clSetKernelArg");
 }
 template <class... Args>

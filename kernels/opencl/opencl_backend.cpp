@@ -41,6 +41,7 @@ std::size_t env_size(const char* name, std::size_t fallback) {
 OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                              const std::string& selector)
     : params_(params),
+      cell_(cell_params_of<float>(params)),
       nx_(terrain.grid.nx),
       ny_(terrain.grid.ny),
       W_(terrain.grid.nx + 2),
@@ -206,8 +207,7 @@ void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
 
 void OpenClBackend::run_boundary() {
   cl_kernel k = kernel("boundary_fill");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_,
-           static_cast<Real>(params_.boundary.sea_level));
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, cell_.boundary);
   const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel(boundary_fill)");
@@ -262,15 +262,12 @@ void OpenClBackend::run_sources(const StepInputs& in) {
 }
 
 void OpenClBackend::run_flow(Real dt) {
-  const auto& f = params_.flow;
-  const Real g = static_cast<Real>(f.gravity);
-  if (f.scheme == FlowScheme::pipes) {
+  if (params_.flow.scheme == FlowScheme::pipes) {
     // The interior rows by a kernel without clamping, the first and last row by the general one.
     for (const char* name : {"flow_pipes_interior", "flow_pipes"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, dx_, dy_, area_, flux_[0],
                flux_[1], flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2],
-               flux_next_[3], dt, g, static_cast<Real>(f.pipe_area),
-               static_cast<Real>(f.pipe_length));
+               flux_next_[3], dt, cell_.flow);
     launch_interior(kernel("flow_pipes_interior"));
     launch_rows(kernel("flow_pipes"), 0, 1);
     launch_rows(kernel("flow_pipes"), H_ - 1, H_);
@@ -278,12 +275,10 @@ void OpenClBackend::run_flow(Real dt) {
     // Each face once (face pass), then split into the cells' outflows (cell pass); the
     // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
     // edge rows by the general ones. H >= 3.
-    const Real theta = static_cast<Real>(f.theta),
-               dry = static_cast<Real>(params_.numerics.dry_depth);
     for (const char* name : {"flow_local_inertial_faces_x_interior",
                              "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
-               flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, g, theta, dry);
+               flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, cell_.flow);
     launch_rows(kernel("flow_local_inertial_faces_x_interior"), 1, H_ - 2);
     launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
     launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
@@ -301,9 +296,8 @@ void OpenClBackend::run_flow(Real dt) {
 void OpenClBackend::run_water(Real dt, StepTally& tally) {
   cl_kernel k = kernel("water_update");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
-           flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt,
-           static_cast<Real>(params_.numerics.velocity_min_depth), tally_partials_,
-           static_cast<cl_int>(tally_stride_));
+           flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water,
+           tally_partials_, static_cast<cl_int>(tally_stride_));
   defer(tally, kExchangeBit | kClippedBit | kWaterGivenBit);
   pending_water_dt_ = dt;
   launch_interior(k);
@@ -314,15 +308,9 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
-  const auto& e = params_.erosion;
-  const Real bedrock = e.bedrock_level ? static_cast<Real>(*e.bedrock_level)
-                                       : -std::numeric_limits<Real>::infinity();
   cl_kernel k = kernel("erosion");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_, depth_,
-           velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt,
-           static_cast<Real>(e.sediment_capacity), static_cast<Real>(e.dissolving_rate),
-           static_cast<Real>(e.deposition_rate), static_cast<Real>(e.min_tilt),
-           static_cast<Real>(e.min_depth), bedrock, tally_partials_,
+           velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt, cell_.erosion, tally_partials_,
            static_cast<cl_int>(tally_stride_));
   defer(tally, kErodedBit | kDepositedBit);
   launch_interior(k);
@@ -352,27 +340,22 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
-  const double pi = 3.14159265358979323846;
-  const Real tan_talus = static_cast<Real>(std::tan(params_.thermal.talus_angle * pi / 180.0));
-  const Real rate = static_cast<Real>(params_.thermal.rate);
   cl_kernel share = kernel("thermal_share");
-  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, dx_, dy_, area_, thermal_share_, dt, rate,
-           tan_talus);
+  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, dx_, dy_, area_, thermal_share_, dt,
+           cell_.thermal);
   launch_interior(share);
   cl_kernel apply = kernel("thermal_apply");
   set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, thermal_share_, dx_, dy_,
-           area_, bed_next_, tan_talus, tally_partials_, static_cast<cl_int>(tally_stride_));
+           area_, bed_next_, cell_.thermal, tally_partials_, static_cast<cl_int>(tally_stride_));
   defer(tally, kThermalBit);
   launch_interior(apply);
   std::swap(bed_, bed_next_);
 }
 
 void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
-  const Real rate = static_cast<Real>(params_.evaporation.rate);
-  const Real tau = static_cast<Real>(params_.numerics.wetness_time);
   cl_kernel k = kernel("evaporation");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, rate, tau,
-           cl_int{rate > Real(0) ? 1 : 0}, tally_partials_, static_cast<cl_int>(tally_stride_));
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, cell_.evaporation,
+           tally_partials_, static_cast<cl_int>(tally_stride_));
   defer(tally, kEvaporatedBit);
   launch_interior(k);
 }

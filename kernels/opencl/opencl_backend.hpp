@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "cell_params.hpp"
 #include "erodem/backend.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/grid.hpp"
@@ -187,6 +188,7 @@ class OpenClBackend final : public Backend {
   Buffer* field_buffer(FieldId id);
 
   Params params_;
+  CellParams<float> cell_;  // the processes' run constants (cell_params.hpp)
   std::shared_ptr<Runtime> rt_;
   Queue queue_;
   std::vector<std::pair<std::string, Kernel>> kernels_;

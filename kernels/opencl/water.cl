@@ -18,15 +18,13 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
                            __global const real* restrict f_bottom, __global const real* restrict dx,
                            __global const real* restrict dy, __global const real* restrict area,
                            __global real* restrict velocity_x, __global real* restrict velocity_y,
-                           real dt, real velocity_min_depth, __global acc_t* restrict partials,
-                           int stride) {
+                           real dt, WaterParams p, __global acc_t* restrict partials, int stride) {
   __local real s_clipped[ERODEM_CELL_GROUP_MAX], s_given[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real exchange, clipped = 0, given = 0; /* exchange: edge_tallies (unused here) */
   if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, bed, depth, depth_out, f_left, f_right, f_top, f_bottom, dx,
-                      dy, area, velocity_x, velocity_y, dt, velocity_min_depth, &exchange, &clipped,
-                      &given);
+                      dy, area, velocity_x, velocity_y, dt, p, &exchange, &clipped, &given);
   const int g = cell_group_index();
   cell_group_sum2(s_clipped, s_given, clipped, given, partials + ERODEM_TALLY_CLIPPED * stride + g,
                   partials + ERODEM_TALLY_WATER_GIVEN * stride + g);
