@@ -21,12 +21,7 @@ void CpuBackend<Real>::run_sources(const StepInputs& in) {
     for_rows(1, H_ - 1, [=](int y) {
       const Real step = dt, r = rate;
       ERODEM_IVDEP
-      for (int x = 1; x < W - 1; ++x) {
-        const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
-        const Real d = depth[i];
-        const Real wet = cell::rain_cell(d, step, r, factor[i]);
-        depth[i] = kind[i] == ERODEM_CELL_ACTIVE ? wet : d;
-      }
+      for (int x = 1; x < W - 1; ++x) cell::rain_sweep_cell(x, y, W, kind, depth, factor, step, r);
     });
   }
   for (const auto& p : in.points) {

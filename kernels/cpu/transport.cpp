@@ -24,17 +24,9 @@ void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
       const auto out_row = row_scratch(W), given_row = row_scratch(W);
       Real *out = out_row.get(), *given = given_row.get();
       ERODEM_IVDEP
-      for (int x = 1; x < W - 1; ++x) {
-        const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
-        const bool active = kind[i] == ERODEM_CELL_ACTIVE;
-        Real gone, gave;
-        const Real s_new = cell::transport_conservative_cell(
-            x, y, W, kind, sediment, depth_flow, fl, fr, ft, fb, area, step, &gone, &gave);
-        const Real s_old = sediment[i];  // an unconditional load: if-convertible
-        sediment_out[i] = active ? s_new : s_old;
-        out[x] = active ? gone : Real(0);
-        given[x] = active ? gave : Real(0);
-      }
+      for (int x = 1; x < W - 1; ++x)
+        cell::transport_conservative_sweep_cell(x, y, W, kind, sediment, sediment_out, depth_flow,
+                                                fl, fr, ft, fb, area, step, out + x, given + x);
       row_sums_a_[y] = sum_row(out, static_cast<std::size_t>(W));
       row_sums_b_[y] = sum_row(given, static_cast<std::size_t>(W));
     });

@@ -10,9 +10,7 @@ __kernel void sources_rain(int W, int H, __global const uchar* restrict kind,
                            real dt, real rate) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
-  const int i = x + y * W;
-  const real d = depth[i];
-  depth[i] = kind[i] == ERODEM_CELL_ACTIVE ? rain_cell(d, dt, rate, rain_factor[i]) : d;
+  rain_sweep_cell(x, y, W, kind, depth, rain_factor, dt, rate);
 }
 
 /* Point and line inflows, one work-item adding them in order (a cell may appear twice):

@@ -16,16 +16,10 @@ __kernel void transport_conservative(
   __local real s_sum[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real given = 0;
-  if (!ERODEM_PAST_ROW(x, W)) {
-    const int i = x + y * W;
-    const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-    real carried, gave; /* carried: edge_tallies (unused here) */
-    const real s_new =
-        transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left, f_right, f_top,
-                                    f_bottom, area, dt, &carried, &gave);
-    sediment_out[i] = active ? s_new : sediment[i];
-    given = active ? gave : (real)0;
-  }
+  real carried; /* edge_tallies sums it over the cells beside ghosts (unused here) */
+  if (!ERODEM_PAST_ROW(x, W))
+    transport_conservative_sweep_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left,
+                                      f_right, f_top, f_bottom, area, dt, &carried, &given);
   cell_group_sum(s_sum, given,
                  partials + ERODEM_TALLY_SEDIMENT_GIVEN * stride + cell_group_index());
 }
