@@ -28,7 +28,8 @@ std::string quoted_string(const std::string& s) {
         out += "\\r";
         break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
+        // TOML basic strings hold no raw control character: U+0000..U+001F nor U+007F.
+        if (static_cast<unsigned char>(c) < 0x20 || c == '\x7f') {
           char buf[8];
           std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
           out += buf;

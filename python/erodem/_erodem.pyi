@@ -23,6 +23,10 @@ def field_names() -> List[str]:
 def parameter_info(key: str) -> Dict[str, str]:
     """key, type, unit, accepted, default, doc of one parameter; ValueError if unknown."""
 
+def quoted_string(s: str) -> str:
+    """``s`` as a TOML basic string: in double quotes, with ``"``, ``\\`` and control
+    characters escaped, as the C++ schema writes strings (``--dump-config``)."""
+
 def duration_seconds(key: str, text: str) -> float:
     """A duration ("10 min", "600") in seconds; ValueError naming ``key`` otherwise."""
 

@@ -36,7 +36,7 @@ def _members(
 ) -> List[Dict[str, Any]]:
     """The parameter sets of a sweep: the Cartesian product of ``grid`` (in key order, the
     last key varying fastest), or the dicts of ``params``, with keys made dotted."""
-    from . import _flatten
+    from ._params import _flatten
 
     if (grid is None) == (params is None):
         raise ValueError("sweep: give exactly one of 'grid' (dict of lists) or 'params' (list)")
@@ -189,7 +189,8 @@ def sweep(
     """
     import pandas as pd
 
-    from . import DEM, _flatten, read_dem
+    from ._params import _flatten
+    from .dem import DEM, read_dem
 
     if not isinstance(dem, DEM):
         dem = read_dem(dem)

@@ -103,6 +103,10 @@ void add_schema_bindings(py::module_& m) {
       py::arg("key"),
       "What the schema knows about one parameter: key, type, SI unit, accepted range, default "
       "(TOML text) and doc line. Unknown key -> ValueError.");
+  m.def("quoted_string", &quoted_string, py::arg("s"),
+        "`s` as a TOML basic string: in double quotes, with \", \\ and control characters "
+        "escaped (\\n, \\t, \\r, \\uXXXX), as the schema writes strings "
+        "(--dump-config).");
   m.def(
       "duration_seconds",
       [](const std::string& key, const std::string& text) {

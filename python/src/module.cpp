@@ -2,7 +2,8 @@
 // C++ API: parameters go through the one schema (apply_setting / load_config / validate),
 // terrain through io::load_terrain, runs through Simulation and io::ResultWriter exactly as
 // `erodem run` drives them. The public Python API is the package `erodem` on top of it
-// (python/erodem/__init__.py); docs/python.md describes both.
+// (python/erodem/: _params.py, dem.py, simulation.py, results.py and sweep.py, re-exported
+// by __init__.py); docs/python.md describes both.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

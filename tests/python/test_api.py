@@ -48,7 +48,7 @@ def small_config(dem_path, steps=200, **extra):
 
 def toml_text(cfg):
     """A nested dict as a TOML document (through erodem's own value formatting)."""
-    from erodem import _toml_text
+    from erodem._params import _toml_text
 
     lines = []
     for sec, table in cfg.items():
@@ -162,6 +162,13 @@ def test_parameter_forms_agree(erodem, tujunga):
     print(info)
     assert info["unit"] == "m/s"
     assert "erosion.sediment_capacity" in erodem.parameter_keys()
+    # Strings reach the schema as they are (quoted by the C++ schema's own quoted_string):
+    # quotes, backslashes, control characters (DEL included) and non-ASCII.
+    from erodem._params import _settings
+
+    odd = 'run "a" \\ \t\r\n\x01\x7f Zürich 日本 😀.h5'
+    toml = erodem._erodem.resolve_config("", _settings({"dem.path": tujunga, "output.path": odd}))
+    assert "path = " + erodem._erodem.quoted_string(odd) in toml.splitlines()
 
 
 # ---- numpy views ------------------------------------------------------------------------
