@@ -1,20 +1,24 @@
 // erodem — the backend contract (backend.hpp): a step is begin_step, run per process and
 // end_step, which returns the step's tallies, the statistics and the probe samples. On every
 // target: end_step's tallies and statistics equal those of the old path (run(p, in, tally)
-// per process, then stats()), bit for bit; the probes and sample() equal whole-field reads
-// bit for bit.
+// per process, then stats()), bit for bit; the probes, sample() and the gauges of a result
+// file equal whole-field reads bit for bit.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include "erodem/io/results.hpp"
+#include "erodem/io/run_session.hpp"
 #include "erodem/io/setup.hpp"
 #include "erodem/process.hpp"
 #include "erodem/schema.hpp"
 #include "target_test.hpp"
+#include "temp_dir.hpp"
 
 namespace erodem::test {
 namespace {
@@ -221,6 +225,79 @@ TEST_P(BackendContract, ProbesAndSampleEqualFieldReads) {
       EXPECT_THROW(be.set_probes({bad}, {FieldId::bed}), Error);
     }
   }
+}
+
+// The gauges of a result file equal whole-field reads bit for bit: a run with four gauges
+// through io::RunSession (which registers them as the simulation's probes, gathered by
+// end_step), after every step the expected row from field(): depth, bed + depth and
+// hypot(vx, vy) at the gauge cells; and the same run written by a ResultWriter whose gauges
+// are not the simulation's probes (record_step samples them).
+TEST_P(BackendContract, GaugesEqualWholeFieldReads) {
+  TempDir dir;
+  Params p = valley_storm(target(), FlowScheme::local_inertial, TransportScheme::conservative);
+  p.time.steps = 40;
+  p.output.every = 1000;
+  p.output.fields = {"water_depth"};
+  p.output.restart_state = false;
+  p.output.gauges = {{15.0, 15.0}, {155.0, 155.0}, {305.0, 305.0}, {155.0, 255.0}};
+  p.output.path = dir.file("probed.h5");
+  io::SessionOptions options;
+  options.backend = target().backend;
+  options.command_line = "test_backend_contract";
+  io::RunSession session(p, options);
+  const auto cells = session.writer()->gauge_cells();
+  ASSERT_EQ(cells.size(), 4u);
+  std::vector<double> want;  // [step][gauge][depth, level, speed]
+  long probed = 0;
+  session.advance({}, {}, [&](const Simulation& sim) {
+    if (sim.probes() && sim.probe_cells() == cells) ++probed;
+    const auto d = sim.field(FieldId::water_depth), b = sim.field(FieldId::bed),
+               vx = sim.field(FieldId::velocity_x), vy = sim.field(FieldId::velocity_y);
+    for (const std::int64_t cell : cells) {
+      const auto i = static_cast<std::size_t>(cell);
+      want.insert(want.end(), {d[i], b[i] + d[i], std::hypot(vx[i], vy[i])});
+    }
+  });
+  session.finish();
+  EXPECT_EQ(probed, 40) << "the steps whose gauges came from the probes";
+
+  // The same run, its gauges sampled by record_step (not registered as probes).
+  p.output.path = dir.file("sampled.h5");
+  Simulation sim = io::make_simulation(p, target().backend);
+  {
+    io::ResultWriter writer(p.output.path, sim, "test_backend_contract", false);
+    writer.snapshot(sim);
+    while (!sim.finished()) {
+      sim.step();
+      writer.step_done(sim);
+    }
+    EXPECT_TRUE(sim.probe_cells().empty());
+    writer.finish(sim);
+  }
+
+  long compared = 0, differing = 0;
+  for (const char* name : {"probed.h5", "sampled.h5"}) {
+    const auto g = io::ResultReader(dir.file(name)).gauges();
+    ASSERT_EQ(g.time.size(), 40u) << name;
+    for (std::size_t step = 0; step < g.time.size(); ++step)
+      for (std::size_t j = 0; j < cells.size(); ++j) {
+        const double* w = &want[(step * cells.size() + j) * 3];
+        const double got[3] = {g.water_depth[step][j], g.water_level[step][j], g.speed[step][j]};
+        for (int k = 0; k < 3; ++k) {
+          ++compared;
+          if (!same_bits(got[k], w[k])) {
+            ++differing;
+            ADD_FAILURE() << name << " step " << step + 1 << " gauge " << j << " series " << k
+                          << ": " << got[k] << ", field reads " << w[k];
+          }
+        }
+      }
+  }
+  std::printf(
+      "[backend contract] %s: %ld gauge values (4 gauges, 40 steps, depth, level, speed; "
+      "probed and sampled) against whole-field reads: %ld differ (bound 0); %ld of 40 steps "
+      "took the gauges from the step's probes\n",
+      target().label().c_str(), compared, differing, probed);
 }
 
 // A step outside begin_step .. end_step is a programming error, named as such.
