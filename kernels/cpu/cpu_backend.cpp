@@ -79,7 +79,17 @@ double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) {
 }
 
 template <class Real>
-void CpuBackend<Real>::run(Process p, const StepInputs& in, StepTally& tally) {
+void CpuBackend<Real>::begin_step(const StepInputs& in) {
+  step_inputs_ = in;
+  step_tally_ = StepTally{};
+  in_step_ = true;
+}
+
+template <class Real>
+void CpuBackend<Real>::run(Process p) {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
+  const StepInputs& in = step_inputs_;
+  StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
   switch (p) {
     case Process::boundary:
@@ -107,19 +117,6 @@ void CpuBackend<Real>::run(Process p, const StepInputs& in, StepTally& tally) {
       run_evaporation(dt, tally);
       break;
   }
-}
-
-template <class Real>
-void CpuBackend<Real>::begin_step(const StepInputs& in) {
-  step_inputs_ = in;
-  step_tally_ = StepTally{};
-  in_step_ = true;
-}
-
-template <class Real>
-void CpuBackend<Real>::run(Process p) {
-  if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
-  run(p, step_inputs_, step_tally_);
 }
 
 template <class Real>

@@ -47,7 +47,6 @@ class CpuBackend final : public Backend {
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
   StepResult end_step() override;
-  void run(Process p, const StepInputs& in, StepTally& tally) override;
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,
                   const std::vector<FieldId>& fields) override;

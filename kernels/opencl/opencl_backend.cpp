@@ -185,19 +185,8 @@ void OpenClBackend::begin_step(const StepInputs& in) {
 
 void OpenClBackend::run(Process p) {
   if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
-  run(p, step_inputs_, step_tally_);
-}
-
-StepResult OpenClBackend::end_step() {
-  if (!in_step_) throw Error(ExitCode::internal, "backend: end_step() outside a step");
-  in_step_ = false;
-  StepResult r;
-  r.stats = collect(&r.probes);  // delivers the step's tallies to step_tally_
-  r.tally = step_tally_;
-  return r;
-}
-
-void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
+  const StepInputs& in = step_inputs_;
+  StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
   switch (p) {
     case Process::boundary:
@@ -225,6 +214,15 @@ void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
       run_evaporation(dt, tally);
       break;
   }
+}
+
+StepResult OpenClBackend::end_step() {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: end_step() outside a step");
+  in_step_ = false;
+  StepResult r;
+  r.stats = collect(&r.probes);  // delivers the step's tallies to step_tally_
+  r.tally = step_tally_;
+  return r;
 }
 
 void OpenClBackend::run_boundary() {
@@ -401,7 +399,7 @@ void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::finish() {
-  flush_tallies();
+  // (the step's tallies stay on the device: end_step reads them with the statistics)
   check(clFinish(queue_.get()), "clFinish");
 }
 

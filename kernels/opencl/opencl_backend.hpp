@@ -132,7 +132,6 @@ class OpenClBackend final : public Backend {
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
   StepResult end_step() override;
-  void run(Process p, const StepInputs& in, StepTally& tally) override;
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,
                   const std::vector<FieldId>& fields) override;
@@ -178,10 +177,10 @@ class OpenClBackend final : public Backend {
   /// `count` accumulator values (double or float on the device, as read) as doubles.
   std::vector<double> acc_values(const std::vector<unsigned char>& raw, std::size_t count) const;
 
-  // The ledger's tallies stay on the device until stats() or finish() (or a run() that would
-  // overwrite them): one read per step instead of one blocking reduction per process. They
-  // are then added to the StepTally the processes were run with, which the caller keeps
-  // alive until then (the driver's step does).
+  // The ledger's tallies stay on the device until end_step() (or a stats() within the step,
+  // or a run() that would overwrite them): one read per step instead of one blocking
+  // reduction per process. They are then added to the step's tally (step_tally_, the `tally`
+  // the run_* functions get), which end_step() returns.
   /// Marks the tallies of `bits` as pending for `tally` (delivering earlier ones first).
   void defer(StepTally& tally, unsigned bits);
   /// Enqueues the reduction of the pending tally slots (no read).

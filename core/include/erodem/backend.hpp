@@ -109,8 +109,6 @@ class Backend {
   /// samples, with one wait for the device (OpenCL: one batch of reads). Outside a step:
   /// Error(ExitCode::internal).
   virtual StepResult end_step() = 0;
-  /// Migration adapter (removed once the callers use begin_step/run/end_step).
-  virtual void run(Process p, const StepInputs& in, StepTally& tally) = 0;
   /// Reductions over the current state, outside the steps: at the start, after set_field()
   /// or a restore (a step's come with end_step()).
   virtual FieldStats stats() = 0;
