@@ -92,8 +92,7 @@ constexpr int kRepetitions = 3;
 /// Times `backend` on `terrain`; a round of `probe` runs before each timed repetition.
 std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::string& backend,
                            int threads, long steps, BandwidthProbe& probe) {
-  auto be = make_backend(backend, terrain, p);
-  Simulation sim(terrain, p, std::move(be));
+  Simulation sim(terrain, p, make_backend(backend, terrain, p));
   const auto seq = sim.sequence();
   const double cells = static_cast<double>(terrain.grid.cells());
   sim.step(3);  // warm-up: kernel builds, caches, page faults
@@ -102,26 +101,26 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
   auto since = [](Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   };
-  // Per repetition and process: seconds per step. Slot seq.size() is the stats() reduction,
-  // the last one the full step.
+  // Per repetition and process: seconds per step. Slot seq.size() is end_step (the
+  // statistics, the tallies' reduction and the step's one read), the last one the full step.
   const std::size_t n_stats = seq.size(), n_full = seq.size() + 1;
   std::vector<std::vector<double>> per_step(seq.size() + 2);
   const double dt = sim.next_dt();
   for (int rep = 0; rep < kRepetitions; ++rep) {
     probe.round();
-    // Each process alone, waited for; then the reduction the driver runs after each step.
+    // Each process alone, waited for; then end_step, as the driver runs it after each step.
     std::vector<double> total(seq.size() + 1, 0.0);
+    Backend& b = sim.backend();
     for (long s = 0; s < steps; ++s) {
-      const StepInputs in = sim.inputs_for(dt);
-      StepTally tally;
+      b.begin_step(sim.inputs_for(dt));
       for (std::size_t k = 0; k < seq.size(); ++k) {
         const auto t0 = Clock::now();
-        sim.backend().run(seq[k], in, tally);
-        sim.backend().finish();
+        b.run(seq[k]);
+        b.finish();
         total[k] += since(t0);
       }
       const auto t0 = Clock::now();
-      const FieldStats st = sim.backend().stats();
+      const FieldStats st = b.end_step().stats;
       total[n_stats] += since(t0);
       if (st.bad_cell >= 0)
         throw Error(ExitCode::unstable, "bench: the benchmark state went unstable");

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "erodem/backends.hpp"
+#include "erodem/process.hpp"
 #include "erodem/simulation.hpp"
 #include "reference_solutions.hpp"
 
@@ -200,18 +201,21 @@ inline void set_uniform_flow(Simulation& sim, double h, double u) {
 
 /// Runs only `processes` of the simulation's backend, `steps` times with steps of `dt` s
 /// (Simulation::step always runs flow and water; Backend::run runs one process): every field
-/// the processes do not write stays as set. Returns the volumes that crossed the boundary.
-/// The simulation's time and ledger are left as they were.
+/// the processes do not write stays as set. Returns the volumes that crossed the boundary,
+/// summed over the steps. The simulation's time and ledger are left as they were.
 inline StepTally run_processes(Simulation& sim, const std::vector<Process>& processes, double dt,
                                long steps) {
   StepTally tally;
   StepInputs in;
   in.dt = dt;
+  Backend& be = sim.backend();
   for (long k = 0; k < steps; ++k) {
     in.t = k * dt;
-    for (Process p : processes) sim.backend().run(p, in, tally);
+    be.begin_step(in);
+    for (Process p : processes) be.run(p);
+    const StepTally step = be.end_step().tally;
+    for (const auto& t : tally_table()) tally.*t.step += step.*t.step;
   }
-  sim.backend().stats();  // a backend may add to the tally as late as this
   return tally;
 }
 

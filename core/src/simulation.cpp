@@ -92,7 +92,8 @@ void Simulation::restore(const RestartPoint& point) {
 const FieldStats& Simulation::current_stats() const {
   if (stale_) {
     stats_ = backend_->stats();
-    if (!coast_cells_.empty()) coast_depth_ = coast_depth(backend_->field(FieldId::bed));
+    if (!coast_cells_.empty())
+      coast_depth_ = coast_depth(backend_->sample(coast_cells_, FieldId::bed));
     stale_ = false;
   }
   return stats_;
@@ -136,7 +137,10 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   resolve_inflows();
   find_coast_cells();
   stats_ = backend_->stats();
-  coast_depth_ = coast_depth(terrain_.bed);
+  std::vector<double> coast_bed;
+  for (const auto cell : coast_cells_)
+    coast_bed.push_back(terrain_.bed[static_cast<std::size_t>(cell)]);
+  coast_depth_ = coast_depth(coast_bed);
   if (stats_.bad_cell >= 0)
     throw Error(ExitCode::data, "initial state: cell " + cell_name(stats_.bad_cell) +
                                     " has a NaN, infinite or negative value");
@@ -216,14 +220,22 @@ void Simulation::find_coast_cells() {
     }
 }
 
-double Simulation::coast_depth(const std::vector<double>& bed) const {
+double Simulation::coast_depth(const std::vector<double>& coast_bed) const {
   // A fixed-level cell g beside active cell a holds its surface at sea_level over a bed no
   // higher than a's (boundary.h, initial_state.cpp), so the flow kernel's face depth
   // h_f = max(eta_g, eta_a) - max(b_g, b_a) = max(sea_level - b_a, d_a).
   double h = 0.0;
-  for (auto cell : coast_cells_)
-    h = std::max(h, params_.boundary.sea_level - bed[static_cast<std::size_t>(cell)]);
+  for (const double b : coast_bed) h = std::max(h, params_.boundary.sea_level - b);
   return h;
+}
+
+void Simulation::set_probes(const std::vector<std::int64_t>& cells,
+                            const std::vector<FieldId>& fields) {
+  backend_->set_probes(cells, fields);
+  probe_cells_ = cells;
+  probe_fields_ = fields;
+  probes_.clear();
+  probes_current_ = false;
 }
 
 double Simulation::source_rise_rate() const {
@@ -357,9 +369,9 @@ std::string Simulation::stability_advice() const {
 void Simulation::check_stability(double dt) const {
   const FieldStats& stats = current_stats();
   if (stats.bad_cell >= 0) {
-    const auto c = static_cast<std::size_t>(stats.bad_cell);
-    const auto d = backend_->field(FieldId::water_depth)[c];
-    const auto b = backend_->field(FieldId::bed)[c];
+    const std::vector<std::int64_t> cell{stats.bad_cell};
+    const double d = backend_->sample(cell, FieldId::water_depth)[0];
+    const double b = backend_->sample(cell, FieldId::bed)[0];
     throw Error(ExitCode::unstable,
                 fmt::format("unstable at step {} (t = {:.6g} s): cell {} has depth {:.6g} m, "
                             "bed {:.6g} m; {}",
@@ -381,12 +393,16 @@ void Simulation::step() {
   const double dt = next_dt();
   if (!(dt > 0)) throw Error(ExitCode::internal, "time step is not positive");
   const StepInputs in = inputs_for(dt);
-  StepTally tally;
-  for (Process p : sequence()) backend_->run(p, in, tally);
+  backend_->begin_step(in);
+  for (Process p : sequence()) backend_->run(p);
+  StepResult result = backend_->end_step();  // the step's one wait
+  const StepTally& tally = result.tally;
   time_ += dt;
   ++steps_;
-  stats_ = backend_->stats();
+  stats_ = result.stats;
   stale_ = false;  // (coast_depth_ keeps the bed of the last refresh: see model.md section 5)
+  probes_ = std::move(result.probes);
+  probes_current_ = true;
 
   double added = 0.0;
   for (const auto& p : in.points) added += p.volume;

@@ -116,7 +116,8 @@ struct ResultWriter::Impl {
   std::vector<Diagnostics> pending;
   std::vector<std::int64_t> pending_steps;
   // gauges/
-  std::vector<std::size_t> gauge_cells;
+  std::vector<std::int64_t> gauge_cells;
+  std::vector<FieldId> gauge_fields;  // depth, velocities, and the bed when it changes
   H5Id gauge_step, gauge_time;
   std::array<H5Id, 3> gauge;
   std::vector<double> pending_gauge_time;
@@ -129,7 +130,7 @@ struct ResultWriter::Impl {
   H5Id restart_steps;
   std::vector<H5Id> restart_ledger;  // ledger_entries(), in order
   bool bed_changes = true;           // erosion or thermal on: the bed is read at every gauge sample
-  std::vector<double> bed;           // the bed, when it does not change
+  std::vector<double> bed;           // the bed at the gauges, when it does not change
 
   H5Id create_group(const char* name) {
     H5Id gcpl = checked(H5Pcreate(H5P_GROUP_CREATE), partial, "group properties");
@@ -253,8 +254,10 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
                       grid.cell_center(grid.nx - 1, 0)[0] + 0.5 * grid.georef.transform[1],
                       grid.cell_center(0, grid.ny - 1)[1] + 0.5 * grid.georef.transform[5],
                       grid.cell_center(0, 0)[1] - 0.5 * grid.georef.transform[5]));
-    m.gauge_cells.push_back(static_cast<std::size_t>(row) * grid.nx + col);
+    m.gauge_cells.push_back(static_cast<std::int64_t>(row) * grid.nx + col);
   }
+  m.gauge_fields = {FieldId::water_depth, FieldId::velocity_x, FieldId::velocity_y};
+  if (m.bed_changes) m.gauge_fields.push_back(FieldId::bed);
 
   // The file, tracking creation order like netCDF-4.
   H5Id fcpl = checked(H5Pcreate(H5P_FILE_CREATE), partial_, "file properties");
@@ -520,20 +523,46 @@ void ResultWriter::record_step(const Simulation& sim) {
   m.pending.push_back(sim.diagnostics());
   m.pending_steps.push_back(sim.steps_done());
   if (m.gauge_cells.empty()) return;
-  if (m.bed.empty() || m.bed_changes) m.bed = sim.field(FieldId::bed);
+  // The gauge fields at the gauge cells: the step's probes where the simulation took them for
+  // these gauges (RunSession registers them: Simulation::set_probes), else sampled now; no
+  // whole field is read. Both give the values field(id)[cell] would.
+  const std::size_t n = m.gauge_cells.size();
+  const std::vector<double>* probes = sim.probes();
+  std::vector<double> sampled;
+  if (!probes || sim.probe_cells() != m.gauge_cells || sim.probe_fields() != m.gauge_fields) {
+    for (const FieldId id : m.gauge_fields) {
+      const auto v = sim.sample(m.gauge_cells, id);
+      sampled.insert(sampled.end(), v.begin(), v.end());
+    }
+    probes = &sampled;
+  }
+  const double* depth = probes->data();  // gauge_fields' order
+  const double* vx = depth + n;
+  const double* vy = vx + n;
+  if (m.bed_changes)
+    m.bed.assign(vy + n, vy + 2 * n);
+  else if (m.bed.empty())
+    m.bed = sim.sample(m.gauge_cells, FieldId::bed);
   const auto& bed = m.bed;
-  const auto depth = sim.field(FieldId::water_depth);
-  const auto vx = sim.field(FieldId::velocity_x);
-  const auto vy = sim.field(FieldId::velocity_y);
   m.pending_gauge_time.push_back(sim.time());
   m.pending_gauge_steps.push_back(sim.steps_done());
-  for (const std::size_t i : m.gauge_cells) {
-    const bool on = sim.terrain().active(i);
+  for (std::size_t j = 0; j < n; ++j) {
+    const bool on = sim.terrain().active(static_cast<std::size_t>(m.gauge_cells[j]));
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    m.pending_gauge[0].push_back(on ? depth[i] : nan);
-    m.pending_gauge[1].push_back(on ? bed[i] + depth[i] : nan);
-    m.pending_gauge[2].push_back(on ? std::hypot(vx[i], vy[i]) : nan);
+    m.pending_gauge[0].push_back(on ? depth[j] : nan);
+    m.pending_gauge[1].push_back(on ? bed[j] + depth[j] : nan);
+    m.pending_gauge[2].push_back(on ? std::hypot(vx[j], vy[j]) : nan);
   }
+}
+
+const std::vector<std::int64_t>& ResultWriter::gauge_cells() const {
+  static const std::vector<std::int64_t> none;
+  return impl_ ? impl_->gauge_cells : none;
+}
+
+const std::vector<FieldId>& ResultWriter::gauge_fields() const {
+  static const std::vector<FieldId> none;
+  return impl_ ? impl_->gauge_fields : none;
 }
 
 bool ResultWriter::snapshot_due(const Simulation& sim) const {

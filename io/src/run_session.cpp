@@ -167,6 +167,8 @@ void RunSession::open_output(const Params& output_params, bool overwrite) {
   // renamed into place when the run completes.
   writer_ = std::make_unique<ResultWriter>(output_params.output.path, sim_->grid(), output_params,
                                            provenance, overwrite);
+  // the gauges sampled with every step (on OpenCL on the device, in the step's one read)
+  sim_->set_probes(writer_->gauge_cells(), writer_->gauge_fields());
   writer_->snapshot(*sim_);  // t = 0, or the state restarted from, or the state now
 }
 

@@ -80,7 +80,17 @@ double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) {
 }
 
 template <class Real>
-void CpuBackend<Real>::run(Process p, const StepInputs& in, StepTally& tally) {
+void CpuBackend<Real>::begin_step(const StepInputs& in) {
+  step_inputs_ = in;
+  step_tally_ = StepTally{};
+  in_step_ = true;
+}
+
+template <class Real>
+void CpuBackend<Real>::run(Process p) {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
+  const StepInputs& in = step_inputs_;
+  StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
   switch (p) {
     case Process::boundary:
@@ -108,6 +118,42 @@ void CpuBackend<Real>::run(Process p, const StepInputs& in, StepTally& tally) {
       run_evaporation(dt, tally);
       break;
   }
+}
+
+template <class Real>
+StepResult CpuBackend<Real>::end_step() {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: end_step() outside a step");
+  in_step_ = false;
+  StepResult r;
+  r.tally = step_tally_;
+  r.stats = stats();
+  // The probes straight from the fields (host memory): no copy of a whole field.
+  r.probes.reserve(probe_fields_.size() * probe_cells_.size());
+  for (const FieldId id : probe_fields_) {
+    const Field* src = const_cast<CpuBackend*>(this)->field_storage(id);
+    for (const std::size_t p : probe_cells_) r.probes.push_back(value_at(id, src, p));
+  }
+  return r;
+}
+
+template <class Real>
+void CpuBackend<Real>::set_probes(const std::vector<std::int64_t>& cells,
+                                  const std::vector<FieldId>& fields) {
+  check_cells(cells, nx_, ny_, "probes");
+  probe_cells_.clear();
+  for (const std::int64_t cell : cells) probe_cells_.push_back(padded(cell));
+  probe_fields_ = fields;
+}
+
+template <class Real>
+std::vector<double> CpuBackend<Real>::sample(const std::vector<std::int64_t>& cells,
+                                             FieldId id) const {
+  check_cells(cells, nx_, ny_, "sample");
+  const Field* src = const_cast<CpuBackend*>(this)->field_storage(id);
+  std::vector<double> out;
+  out.reserve(cells.size());
+  for (const std::int64_t cell : cells) out.push_back(value_at(id, src, padded(cell)));
+  return out;
 }
 
 template <class Real>
@@ -224,15 +270,8 @@ std::vector<double> CpuBackend<Real>::field(FieldId id) const {
   auto* self = const_cast<CpuBackend*>(this);
   const Field* src = self->field_storage(id);
   for (int r = 0; r < ny_; ++r)
-    for (int c = 0; c < nx_; ++c) {
-      const auto p = at(c + 1, r + 1);
-      // the bed and the erosion include the bed's residual (exact in double)
-      const double lo = static_cast<double>(bed_residual_[p]);
-      out[static_cast<std::size_t>(r) * nx_ + c] =
-          !src                 ? (static_cast<double>(bed0_[p]) - static_cast<double>(bed_[p])) - lo
-          : id == FieldId::bed ? static_cast<double>(bed_[p]) + lo
-                               : static_cast<double>((*src)[p]);
-    }
+    for (int c = 0; c < nx_; ++c)
+      out[static_cast<std::size_t>(r) * nx_ + c] = value_at(id, src, at(c + 1, r + 1));
   return out;
 }
 

@@ -45,8 +45,13 @@ class CpuBackend final : public Backend {
 
   std::string name() const override { return "cpu"; }
   std::string device() const override;
-  void run(Process p, const StepInputs& in, StepTally& tally) override;
+  void begin_step(const StepInputs& in) override;
+  void run(Process p) override;
+  StepResult end_step() override;
   FieldStats stats() override;
+  void set_probes(const std::vector<std::int64_t>& cells,
+                  const std::vector<FieldId>& fields) override;
+  std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   std::vector<double> field(FieldId id) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
   HostView host_view(FieldId id) override;
@@ -104,6 +109,15 @@ class CpuBackend final : public Backend {
   /// A per-cell field: each array at its own offset modulo 4 KiB (stagger.hpp).
   using Field = std::vector<Real, StaggeredAllocator<Real>>;
   Field* field_storage(FieldId id);
+  /// Field `id` (stored in `src`, from field_storage) at padded cell `p`, as field() gives
+  /// it: the bed with its residual, the erosion from the bed pair and the initial bed.
+  double value_at(FieldId id, const Field* src, std::size_t p) const {
+    // the bed and the erosion include the bed's residual (exact in double)
+    const double lo = static_cast<double>(bed_residual_[p]);
+    return !src ? (static_cast<double>(bed0_[p]) - static_cast<double>(bed_[p])) - lo
+           : id == FieldId::bed ? static_cast<double>(bed_[p]) + lo
+                                : static_cast<double>((*src)[p]);
+  }
 
   Params params_;
   CellParams<Real> cell_;  // the processes' run constants (cell_params.hpp)
@@ -121,6 +135,13 @@ class CpuBackend final : public Backend {
   Field velocity_x_, velocity_y_;
   Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   std::vector<double> row_sums_a_, row_sums_b_, row_sums_c_;  // scratch for per-row reductions
+  // The step under way (begin_step .. end_step): its inputs and its tallies so far.
+  StepInputs step_inputs_;
+  StepTally step_tally_;
+  bool in_step_ = false;
+  // The probes (set_probes): padded cells and the fields end_step samples at them.
+  std::vector<std::size_t> probe_cells_;
+  std::vector<FieldId> probe_fields_;
 };
 
 }  // namespace ERODEM_CPU_NAMESPACE

@@ -33,9 +33,10 @@ void set_args(cl_kernel k, const Args&... args) {
 constexpr std::size_t kReduceMax = 256;      // ERODEM_REDUCE_MAX of stats.cl
 constexpr std::size_t kCellGroupMax = 1024;  // ERODEM_CELL_GROUP_MAX of reduce.cl
 constexpr std::size_t kReduceGroupsMax = 1024;
-constexpr std::size_t kTallySlots = 9;  // ERODEM_TALLY_SLOTS of reduce.cl
-constexpr int kTallyExchange = 0;       // ERODEM_TALLY_EXCHANGE of reduce.cl
-constexpr int kTallySediment = 2;       // ERODEM_TALLY_SEDIMENT of reduce.cl
+constexpr std::size_t kGatherParts = 6;  // the parts gather_cells (stats.cl) takes a launch
+constexpr std::size_t kTallySlots = 9;   // ERODEM_TALLY_SLOTS of reduce.cl
+constexpr int kTallyExchange = 0;        // ERODEM_TALLY_EXCHANGE of reduce.cl
+constexpr int kTallySediment = 2;        // ERODEM_TALLY_SEDIMENT of reduce.cl
 // one bit per slot of reduce.cl (1 << ERODEM_TALLY_*), then the transport change
 constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
                    kEvaporatedBit = 1u << 3, kWaterGivenBit = 1u << 4, kErodedBit = 1u << 5,

@@ -1,6 +1,7 @@
 // erodem — the OpenCL backend's device memory: field buffers staggered modulo 4 KiB
-// (stagger.hpp), buffer reads, and the fields by id with the rectangular copies of their DEM
-// cells (field(), set_field()).
+// (stagger.hpp), buffer reads, the fields by id with the rectangular copies of their DEM
+// cells (field(), set_field()), and single cells gathered on the device (set_probes(),
+// sample()).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include "common/compat.h"
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
+#include "opencl/launch.hpp"
 #include "opencl/opencl_backend.hpp"
 #include "stagger.hpp"
 
@@ -121,23 +123,108 @@ void write_interior(cl_command_queue q, cl_mem b, int nx, int ny, const std::vec
 
 }  // namespace
 
+std::vector<const Buffer*> OpenClBackend::field_parts(FieldId id) {
+  if (id == FieldId::bed) return {&bed_, &bed_residual_};
+  if (id == FieldId::erosion) return {&bed0_, &bed_, &bed_residual_};
+  return {field_buffer(id)};
+}
+
+std::size_t OpenClBackend::part_count(const std::vector<FieldId>& fields) {
+  std::size_t n = 0;
+  for (const FieldId id : fields) n += id == FieldId::bed ? 2 : id == FieldId::erosion ? 3 : 1;
+  return n;
+}
+
+double OpenClBackend::compose(FieldId id, const float* parts, std::size_t stride) {
+  // the bed and the erosion include the bed's residual (exact in double)
+  if (id == FieldId::bed) return static_cast<double>(parts[0]) + static_cast<double>(parts[stride]);
+  if (id == FieldId::erosion)
+    return (static_cast<double>(parts[0]) - static_cast<double>(parts[stride])) -
+           static_cast<double>(parts[2 * stride]);
+  return static_cast<double>(parts[0]);
+}
+
 std::vector<double> OpenClBackend::field(FieldId id) const {
   auto* self = const_cast<OpenClBackend*>(this);
-  if (id == FieldId::erosion || id == FieldId::bed) {
-    // the bed and the erosion include the bed's residual (exact in double)
-    const auto b = read_interior(queue_.get(), bed_.get(), nx_, ny_);
-    const auto lo = read_interior(queue_.get(), bed_residual_.get(), nx_, ny_);
-    const auto b0 = id == FieldId::erosion ? read_interior(queue_.get(), bed0_.get(), nx_, ny_)
-                                           : std::vector<float>();
-    std::vector<double> out(b.size());
-    for (std::size_t i = 0; i < b.size(); ++i)
-      out[i] = id == FieldId::bed ? static_cast<double>(b[i]) + static_cast<double>(lo[i])
-                                  : (static_cast<double>(b0[i]) - static_cast<double>(b[i])) -
-                                        static_cast<double>(lo[i]);
-    return out;
+  const auto parts = self->field_parts(id);
+  const std::size_t n = static_cast<std::size_t>(nx_) * ny_;
+  std::vector<float> raw;
+  raw.reserve(parts.size() * n);
+  for (const Buffer* b : parts) {
+    const auto v = read_interior(queue_.get(), b->get(), nx_, ny_);
+    raw.insert(raw.end(), v.begin(), v.end());
   }
-  const auto v = read_interior(queue_.get(), self->field_buffer(id)->get(), nx_, ny_);
-  return std::vector<double>(v.begin(), v.end());
+  std::vector<double> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = compose(id, raw.data() + i, n);
+  return out;
+}
+
+void OpenClBackend::enqueue_gather(const Buffer& cells, std::size_t n,
+                                   const std::vector<FieldId>& fields, const Buffer& out) {
+  std::vector<const Buffer*> parts;
+  for (const FieldId id : fields)
+    for (const Buffer* b : field_parts(id)) parts.push_back(b);
+  // gather_cells takes up to kGatherParts parts a launch
+  cl_kernel k = kernel("gather_cells");
+  for (std::size_t first = 0; first < parts.size(); first += kGatherParts) {
+    const std::size_t count = std::min(kGatherParts, parts.size() - first);
+    set_args(k, static_cast<cl_int>(n), static_cast<cl_int>(count), cells, out,
+             static_cast<cl_int>(first * n));
+    for (std::size_t j = 0; j < kGatherParts; ++j)  // unused parameters: any buffer
+      set_arg(k, static_cast<cl_uint>(5 + j), *parts[first + std::min(j, count - 1)]);
+    const std::size_t global = n;
+    check(
+        clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(gather_cells)");
+  }
+}
+
+std::vector<double> OpenClBackend::compose_gathered(const std::vector<FieldId>& fields,
+                                                    const std::vector<float>& raw, std::size_t n) {
+  std::vector<double> out;
+  out.reserve(fields.size() * n);
+  std::size_t part = 0;
+  for (const FieldId id : fields) {
+    for (std::size_t j = 0; j < n; ++j) out.push_back(compose(id, raw.data() + part * n + j, n));
+    part += part_count({id});
+  }
+  return out;
+}
+
+namespace {
+
+/// The padded indices of DEM cells (row-major (ny, nx)) of a grid nx wide.
+std::vector<cl_int> padded_cells(const std::vector<std::int64_t>& cells, int nx) {
+  std::vector<cl_int> out;
+  out.reserve(cells.size());
+  for (const std::int64_t cell : cells)
+    out.push_back(static_cast<cl_int>((cell % nx + 1) + (cell / nx + 1) * (nx + 2)));
+  return out;
+}
+
+}  // namespace
+
+void OpenClBackend::set_probes(const std::vector<std::int64_t>& cells,
+                               const std::vector<FieldId>& fields) {
+  check_cells(cells, nx_, ny_, "probes");
+  probe_fields_ = fields;
+  probe_count_ = cells.size();
+  if (cells.empty() || fields.empty()) return;
+  probe_cells_ = upload(padded_cells(cells, nx_));
+  probe_out_ = make_buffer(part_count(fields) * cells.size() * sizeof(float));
+}
+
+std::vector<double> OpenClBackend::sample(const std::vector<std::int64_t>& cells,
+                                          FieldId id) const {
+  check_cells(cells, nx_, ny_, "sample");
+  if (cells.empty()) return {};
+  auto* self = const_cast<OpenClBackend*>(this);
+  const Buffer where = self->upload(padded_cells(cells, nx_));
+  const Buffer out = self->make_buffer(part_count({id}) * cells.size() * sizeof(float));
+  self->enqueue_gather(where, cells.size(), {id}, out);
+  std::vector<float> raw(part_count({id}) * cells.size());
+  self->read(out, raw.size() * sizeof(float), raw.data(), true);
+  return compose_gathered({id}, raw, cells.size());
 }
 
 void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {

@@ -175,7 +175,19 @@ std::string OpenClBackend::device() const {
   return rt_->info.platform + " / " + rt_->info.device;
 }
 
-void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
+void OpenClBackend::begin_step(const StepInputs& in) {
+  // the tallies of a step begun and not ended are dropped (each kernel rewrites its partials)
+  pending_ = 0;
+  pending_tally_ = nullptr;
+  step_inputs_ = in;
+  step_tally_ = StepTally{};
+  in_step_ = true;
+}
+
+void OpenClBackend::run(Process p) {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
+  const StepInputs& in = step_inputs_;
+  StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
   switch (p) {
     case Process::boundary:
@@ -203,6 +215,15 @@ void OpenClBackend::run(Process p, const StepInputs& in, StepTally& tally) {
       run_evaporation(dt, tally);
       break;
   }
+}
+
+StepResult OpenClBackend::end_step() {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: end_step() outside a step");
+  in_step_ = false;
+  StepResult r;
+  r.stats = collect(&r.probes);  // delivers the step's tallies to step_tally_
+  r.tally = step_tally_;
+  return r;
 }
 
 void OpenClBackend::run_boundary() {
@@ -361,11 +382,15 @@ void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::finish() {
-  flush_tallies();
+  // (the step's tallies stay on the device: end_step reads them with the statistics)
   check(clFinish(queue_.get()), "clFinish");
 }
 
 FieldStats OpenClBackend::stats() {
+  return collect(nullptr);
+}
+
+FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   cl_kernel k = kernel("field_stats");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, depth_, sediment_, velocity_x_,
            velocity_y_, area_, partial_a_, partial_cells_);
@@ -383,9 +408,19 @@ FieldStats OpenClBackend::stats() {
   if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
   std::vector<cl_long> cells(static_cast<std::size_t>(rows) * 3);
   read(row_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
+  const bool gather = probes && probe_count_ > 0 && !probe_fields_.empty();
+  if (gather) {
+    // the probes gathered on the device: a few floats in the step's one batch of reads
+    enqueue_gather(probe_cells_, probe_count_, probe_fields_, probe_out_);
+    probe_raw_.resize(part_count(probe_fields_) * probe_count_);
+    read(probe_out_, probe_raw_.size() * sizeof(float), probe_raw_.data(), false);
+  }
   stats_sums_raw_.resize(static_cast<std::size_t>(rows) * 6 * acc_size_);
   read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
   deliver_tallies();
+  if (probes)
+    *probes =
+        gather ? compose_gathered(probe_fields_, probe_raw_, probe_count_) : std::vector<double>();
   const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * 6);
   // Rows in order, with the rules of CpuBackend::stats: the max depth starts at 0 and a
   // later row takes it when larger (or when none has been taken); the max speed ranks the

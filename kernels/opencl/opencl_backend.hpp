@@ -130,8 +130,13 @@ class OpenClBackend final : public Backend {
 
   std::string name() const override { return "opencl"; }
   std::string device() const override;
-  void run(Process p, const StepInputs& in, StepTally& tally) override;
+  void begin_step(const StepInputs& in) override;
+  void run(Process p) override;
+  StepResult end_step() override;
   FieldStats stats() override;
+  void set_probes(const std::vector<std::int64_t>& cells,
+                  const std::vector<FieldId>& fields) override;
+  std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   void finish() override;
   std::vector<double> field(FieldId id) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
@@ -173,10 +178,10 @@ class OpenClBackend final : public Backend {
   /// `count` accumulator values (double or float on the device, as read) as doubles.
   std::vector<double> acc_values(const std::vector<unsigned char>& raw, std::size_t count) const;
 
-  // The ledger's tallies stay on the device until stats() or finish() (or a run() that would
-  // overwrite them): one read per step instead of one blocking reduction per process. They
-  // are then added to the StepTally the processes were run with, which the caller keeps
-  // alive until then (the driver's step does).
+  // The ledger's tallies stay on the device until end_step() (or a stats() within the step,
+  // or a run() that would overwrite them): one read per step instead of one blocking
+  // reduction per process. They are then added to the step's tally (step_tally_, the `tally`
+  // the run_* functions get), which end_step() returns.
   /// Marks the tallies of `bits` as pending for `tally` (delivering earlier ones first).
   void defer(StepTally& tally, unsigned bits);
   /// Enqueues the reduction of the pending tally slots (no read).
@@ -186,6 +191,25 @@ class OpenClBackend final : public Backend {
   /// Reads and delivers the pending tallies now (blocking).
   void flush_tallies();
   Buffer* field_buffer(FieldId id);
+  /// The buffers field `id` is composed from, as field() composes them (compose): the bed
+  /// and its residual; the initial bed, the bed and its residual for the erosion; else the
+  /// field's own buffer.
+  std::vector<const Buffer*> field_parts(FieldId id);
+  /// Field `id`'s value from the floats of its parts (field_parts), `stride` apart, in double
+  /// as field() gives it.
+  static double compose(FieldId id, const float* parts, std::size_t stride);
+  /// Enqueues gather_cells (stats.cl): out[k * n + j] = part k of `fields` (field_parts, in
+  /// order) at the `n` padded cells of `cells`.
+  void enqueue_gather(const Buffer& cells, std::size_t n, const std::vector<FieldId>& fields,
+                      const Buffer& out);
+  /// The fields' values from the gathered floats of enqueue_gather, [field][cell].
+  static std::vector<double> compose_gathered(const std::vector<FieldId>& fields,
+                                              const std::vector<float>& raw, std::size_t n);
+  /// The number of parts `fields` are composed from (field_parts).
+  static std::size_t part_count(const std::vector<FieldId>& fields);
+  /// The statistics of the current state with one wait, the pending tallies read and
+  /// delivered with them (and, with `probes`, the probe samples into it).
+  FieldStats collect(std::vector<double>* probes);
 
   Params params_;
   CellParams<float> cell_;  // the processes' run constants (cell_params.hpp)
@@ -219,6 +243,15 @@ class OpenClBackend final : public Backend {
   unsigned pending_ = 0;       // bits: 1 << tally slot; kChangeBit: the transport change
   Real pending_water_dt_ = 0;  // the exchange tally is a discharge: times the step
   std::vector<unsigned char> stats_sums_raw_, stats_cells_raw_, tally_raw_, change_raw_;
+  // The step under way (begin_step .. end_step): its inputs and the tallies delivered so far.
+  StepInputs step_inputs_;
+  StepTally step_tally_;
+  bool in_step_ = false;
+  // The probes (set_probes): the padded cells on the device, the fields, their gathered parts.
+  Buffer probe_cells_, probe_out_;
+  std::size_t probe_count_ = 0;
+  std::vector<FieldId> probe_fields_;
+  std::vector<float> probe_raw_;
   Buffer point_cells_, point_amounts_;
   std::size_t point_capacity_ = 0;
   std::vector<cl_int> point_cells_host_;  // the sources of an upload that may be in flight

@@ -4,7 +4,7 @@
  * result; the host combines the partials in group order, so a result does not depend on
  * timing. The reduction kernels' work-groups are a power of two of at most ERODEM_REDUCE_MAX
  * work-items, each work-item first walking its cells with a fixed stride; field_stats is a
- * cell kernel (one work-item per cell). */
+ * cell kernel (one work-item per cell). gather_cells, at the end, reads single cells. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "stats.h"
 /* acc_t, the tally slots and the cell kernels' group sums: reduce.cl. */
@@ -257,4 +257,26 @@ __kernel void stats_rows(int W, int rows, int groups_x, __global const acc_t* re
   row_cells[3 * r + 0] = arg_d;
   row_cells[3 * r + 1] = arg_v;
   row_cells[3 * r + 2] = bad;
+}
+
+/* Single cells of fields, for the probes of a step and Backend::sample: out[offset + k n + j] =
+ * part k (< count <= 6) at the padded cell cells[j] (j < n), the floats as they are; the host
+ * converts them to double and composes the bed with its residual as Backend::field does. One
+ * work-item per cell. The parts may be one buffer (the host binds any to those past count),
+ * so they are not restrict. */
+__kernel void gather_cells(int n, int count, __global const int* restrict cells,
+                           __global real* restrict out, int offset, __global const real* p0,
+                           __global const real* p1, __global const real* p2,
+                           __global const real* p3, __global const real* p4,
+                           __global const real* p5) {
+  const int j = (int)get_global_id(0);
+  if (j >= n) return;
+  const int c = cells[j];
+  __global real* o = out + offset + j;
+  if (count > 0) o[0] = p0[c];
+  if (count > 1) o[n] = p1[c];
+  if (count > 2) o[2 * n] = p2[c];
+  if (count > 3) o[3 * n] = p3[c];
+  if (count > 4) o[4 * n] = p4[c];
+  if (count > 5) o[5 * n] = p5[c];
 }

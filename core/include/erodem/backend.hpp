@@ -67,6 +67,16 @@ struct FieldStats {
   std::int64_t bad_cell = -1;  ///< first cell with NaN, infinite or negative state; -1: none
 };
 
+/// What one step gives back (Backend::end_step): its tallies, the statistics of the state it
+/// ends in, and the probe fields at the probe cells (Backend::set_probes).
+struct StepResult {
+  StepTally tally;   ///< the volumes the step's processes moved, each summed as the process ran
+  FieldStats stats;  ///< the reductions over the state at the end of the step (as stats())
+  /// probes[k * cells + j]: probe field k at probe cell j, as field(id)[cell] would give it
+  /// (the bed with its residual); empty without probes.
+  std::vector<double> probes;
+};
+
 /// Where a backend keeps a field of the DEM grid in host memory (the CPU reference does):
 /// DEM cell (row r, col c) is the element at `data + (r * row_stride + c) * element_size`
 /// bytes. `data` is null where the field is not host-resident (OpenCL) or derived (erosion).
@@ -77,6 +87,10 @@ struct HostView {
   std::ptrdiff_t row_stride = 0;  ///< elements between the starts of two rows
 };
 
+/// Checks that every cell of `cells` is a DEM cell of an nx x ny grid (0 <= cell < nx ny):
+/// Error(ExitCode::usage) naming `what` and the first cell that is not.
+void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const char* what);
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -84,12 +98,29 @@ class Backend {
   virtual std::string name() const = 0;
   /// What runs the kernels, e.g. "CPU reference, float32, 2 threads".
   virtual std::string device() const = 0;
-  /// Runs one process of the step sequence. A backend may add the process's volumes to
-  /// `tally` later, at the next stats() or finish() (the OpenCL backend keeps them on the
-  /// device until then): keep `tally` alive until one of those returns.
-  virtual void run(Process p, const StepInputs& in, StepTally& tally) = 0;
-  /// Reductions over the current state.
+  /// Starts a step with its inputs (time, dt, rain rate, point inflows); the step's tallies
+  /// start at zero. A step begun and not ended is discarded, tallies and all.
+  virtual void begin_step(const StepInputs& in) = 0;
+  /// Runs one process of the step sequence with the inputs of begin_step(); its tallies
+  /// stay with the backend (on OpenCL on the device) until end_step(). Outside a step:
+  /// Error(ExitCode::internal).
+  virtual void run(Process p) = 0;
+  /// Ends the step: its tallies, the statistics of the state it ends in and the probe
+  /// samples, with one wait for the device (OpenCL: one batch of reads). Outside a step:
+  /// Error(ExitCode::internal).
+  virtual StepResult end_step() = 0;
+  /// Reductions over the current state, outside the steps: at the start, after set_field()
+  /// or a restore (a step's come with end_step()).
   virtual FieldStats stats() = 0;
+  /// Registers the probes every end_step() samples: `fields` at the DEM cells `cells`
+  /// (row-major indices row * nx + col), in StepResult::probes, field by field. Replaces
+  /// the earlier probes; empty lists: none. A cell off the grid: Error(ExitCode::usage).
+  virtual void set_probes(const std::vector<std::int64_t>& cells,
+                          const std::vector<FieldId>& fields) = 0;
+  /// `id` at the DEM cells `cells` now, each as field(id)[cell] gives it, without reading
+  /// the whole field (a wait for the device on OpenCL). A cell off the grid:
+  /// Error(ExitCode::usage).
+  virtual std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const = 0;
   /// Waits until every process run so far has finished (for timing; a no-op on the CPU).
   virtual void finish() {}
   /// A field of the DEM grid, row-major (ny, nx), converted to double.

@@ -89,7 +89,26 @@ class Simulation {
   /// next time step is chosen from (and the stability check) are taken again before they
   /// are used. backend() (non-const) calls it, since whoever holds the backend may change
   /// the state (Backend::set_field, or a host view written in place before the next step).
-  void state_changed() { stale_ = true; }
+  void state_changed() {
+    stale_ = true;
+    probes_current_ = false;
+  }
+
+  /// Registers the probes every step samples (Backend::set_probes): `fields` at the DEM
+  /// cells `cells` (row * nx + col), gathered with the step's statistics (on OpenCL on the
+  /// device, in the step's one read). Replaces the earlier ones; empty lists: none.
+  void set_probes(const std::vector<std::int64_t>& cells, const std::vector<FieldId>& fields);
+  const std::vector<std::int64_t>& probe_cells() const { return probe_cells_; }
+  const std::vector<FieldId>& probe_fields() const { return probe_fields_; }
+  /// The probes at the end of the latest step, probe_fields() by probe_cells()
+  /// (StepResult::probes), each as field(id)[cell] gives it; null when no step has run since
+  /// set_probes(), or the state changed since the step (state_changed(), restore()).
+  const std::vector<double>* probes() const { return probes_current_ ? &probes_ : nullptr; }
+  /// Field `id` at the DEM cells `cells` now, as field(id)[cell] gives it, without reading
+  /// the whole field (Backend::sample).
+  std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const {
+    return backend_->sample(cells, id);
+  }
 
   double time() const { return time_; }
   long steps_done() const { return steps_; }
@@ -127,8 +146,9 @@ class Simulation {
   /// The statistics of the current state (taken again when state_changed() was called).
   const FieldStats& current_stats() const;
   /// The largest face depth a fixed-level cell presents to an active cell beside it, less
-  /// the active cell's own depth: max(0, sea_level - bed) over those active cells (m).
-  double coast_depth(const std::vector<double>& bed) const;
+  /// the active cell's own depth: max(0, sea_level - bed) over those active cells (m), from
+  /// the bed at coast_cells_ (in that order).
+  double coast_depth(const std::vector<double>& coast_bed) const;
   /// An upper bound of the depth per second (m/s) that this step's rain and inflows add to
   /// any one cell, for any step starting now no longer than time.dt_max.
   double source_rise_rate() const;
@@ -162,6 +182,12 @@ class Simulation {
   mutable double coast_depth_ = 0.0;
   mutable bool stale_ = false;
   Diagnostics diag_;
+  // The probes (set_probes) and their samples at the end of the latest step, current until
+  // the state changes from outside.
+  std::vector<std::int64_t> probe_cells_;
+  std::vector<FieldId> probe_fields_;
+  std::vector<double> probes_;
+  bool probes_current_ = false;
 };
 
 }  // namespace erodem

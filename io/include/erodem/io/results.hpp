@@ -70,12 +70,18 @@ class ResultWriter {
   /// Appends the configured output fields at the simulation's current time (inactive cells
   /// NaN), writes the buffered diagnostics and gauge rows, and flushes the file.
   void snapshot(const Simulation& sim);
-  /// Buffers one row of diagnostics (and gauge samples) after a step of `sim`. Gauge
-  /// sampling copies whole fields from the backend (water_depth, velocity_x, velocity_y,
-  /// and bed when erosion or thermal erosion is on) to read a few cells: a cost like a
-  /// snapshot's field reads (without the compression), every step (measured: about 15 %
-  /// of the step time of a 256 x 256 CPU run).
+  /// Buffers one row of diagnostics (and gauge samples) after a step of `sim`. The gauges
+  /// read gauge_fields() at gauge_cells(): the step's probe samples when `sim` has them as
+  /// its probes (Simulation::set_probes, as RunSession registers them), else
+  /// Simulation::sample(); no whole field is copied. Level (bed + depth) and speed are
+  /// double arithmetic here.
   void record_step(const Simulation& sim);
+  /// The DEM cells of output.gauges (row * nx + col, in order) and the fields record_step
+  /// reads there (water_depth, velocity_x, velocity_y, and the bed where a sweep of the step
+  /// writes it; a fixed bed is sampled once): the probes to register with the simulation.
+  /// Empty once the file is closed.
+  const std::vector<std::int64_t>& gauge_cells() const;
+  const std::vector<FieldId>& gauge_fields() const;
   /// Whether output.every / output.interval ask for a snapshot at `sim`'s current step
   /// (never twice for the same step).
   bool snapshot_due(const Simulation& sim) const;

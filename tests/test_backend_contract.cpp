@@ -1,0 +1,345 @@
+// erodem — the backend contract (backend.hpp): a step is begin_step, run per process and
+// end_step, which returns the step's tallies, the statistics and the probe samples. On every
+// target: end_step's tallies and statistics equal those of the old path (run(p, in, tally)
+// per process, then stats(); CPU: a digest recorded from it) and do not depend on waits, bit
+// for bit; the probes, sample() and the gauges of a result file equal whole-field reads bit
+// for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "erodem/io/results.hpp"
+#include "erodem/io/run_session.hpp"
+#include "erodem/io/setup.hpp"
+#include "erodem/process.hpp"
+#include "erodem/schema.hpp"
+#include "target_test.hpp"
+#include "temp_dir.hpp"
+
+namespace erodem::test {
+namespace {
+
+/// A 32 x 32 synthetic valley with every process on: rain, a point inflow, erosion,
+/// `transport`, thermal collapse, evaporation, an open and a fixed-level edge (coast cells);
+/// adaptive steps for local inertial, fixed ones for the pipes.
+Params valley_storm(const Target& target, FlowScheme flow, TransportScheme transport) {
+  Params p;
+  p.dem.synthetic = "valley";
+  p.dem.size = 32;
+  p.dem.seed = 3;
+  p.dem.relief = 40.0;
+  p.dem.cell_size = 10.0;
+  p.initial.water_depth.value = 0.05;
+  p.time.adaptive = flow == FlowScheme::local_inertial;  // pipes: fixed steps
+  p.time.dt = 0.05;
+  p.time.dt_max = 2.0;
+  p.flow.scheme = flow;
+  p.rain.rate = 80e-3 / 3600;  // m/s
+  p.inflow.push_back({{{155.0, 255.0}}, {{0.0, 0.5}, {60.0, 2.0}}});
+  p.erosion.enabled = true;
+  p.erosion.sediment_capacity = 0.2;
+  p.erosion.dissolving_rate = 0.01;
+  p.erosion.deposition_rate = 0.05;
+  p.transport.scheme = transport;
+  p.thermal.enabled = true;
+  p.thermal.talus_angle = 30.0;
+  p.thermal.rate = 0.05;
+  p.evaporation.rate = 1e-6;
+  p.boundary.east = BoundaryKind::open;
+  p.boundary.west = BoundaryKind::fixed_level;
+  p.boundary.sea_level = 1.0;
+  p.numerics.precision = target.precision;
+  validate(p, "valley_storm");
+  return p;
+}
+
+struct Schemes {
+  FlowScheme flow;
+  TransportScheme transport;
+  const char* label;
+};
+const Schemes kSchemes[] = {
+    {FlowScheme::local_inertial, TransportScheme::conservative, "local_inertial+conservative"},
+    {FlowScheme::pipes, TransportScheme::semi_lagrangian, "pipes+semi_lagrangian"},
+};
+
+/// Whether two doubles hold the same bits.
+bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof(double)) == 0;
+}
+
+/// The members of a FieldStats that differ in their bits ("" when none).
+std::string stats_differences(const FieldStats& a, const FieldStats& b) {
+  std::string out;
+  auto num = [&](const char* name, double x, double y) {
+    if (!same_bits(x, y)) out += std::string(" ") + name;
+  };
+  num("water_volume", a.water_volume, b.water_volume);
+  num("material_volume", a.material_volume, b.material_volume);
+  num("sediment_volume", a.sediment_volume, b.sediment_volume);
+  num("max_depth", a.max_depth, b.max_depth);
+  num("max_speed", a.max_speed, b.max_speed);
+  if (a.max_depth_cell != b.max_depth_cell) out += " max_depth_cell";
+  if (a.max_speed_cell != b.max_speed_cell) out += " max_speed_cell";
+  if (a.bad_cell != b.bad_cell) out += " bad_cell";
+  return out;
+}
+
+/// The tallies (tally_table()) that differ in their bits ("" when none).
+std::string tally_differences(const StepTally& a, const StepTally& b) {
+  std::string out;
+  for (const auto& t : tally_table())
+    if (!same_bits(a.*t.step, b.*t.step)) out += std::string(" ") + t.name;
+  return out;
+}
+
+/// FNV-1a over the bits of every tally and statistic of a step, chained over the steps.
+std::uint64_t digest(std::uint64_t h, const StepTally& t, const FieldStats& st) {
+  auto add = [&](const void* p, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (std::size_t k = 0; k < n; ++k) h = (h ^ b[k]) * 0x100000001b3ULL;
+  };
+  for (const auto& e : tally_table()) add(&(t.*e.step), sizeof(double));
+  for (const double v :
+       {st.water_volume, st.material_volume, st.sediment_volume, st.max_depth, st.max_speed})
+    add(&v, sizeof v);
+  for (const std::int64_t c : {st.max_depth_cell, st.max_speed_cell, st.bad_cell})
+    add(&c, sizeof c);
+  return h;
+}
+
+/// Cells of an n x n grid to probe: the corners, the edges' middles, inner cells, one twice.
+std::vector<std::int64_t> probe_cells(std::int64_t n) {
+  return {0,           n - 1,     n * (n - 1),         n * n - 1, n / 2,
+          n * (n / 2), 5 * n + 7, (n / 2) * n + n / 2, 5 * n + 7};
+}
+
+/// Every field of the field table.
+std::vector<FieldId> every_field() {
+  std::vector<FieldId> out;
+  for (const auto& f : field_table()) out.push_back(f.id);
+  return out;
+}
+
+class BackendContract : public TargetTest {};
+
+/// The digest of 30 steps' tallies and statistics of valley_storm, as the path before the
+/// backend contract gave them (run(p, in, tally) per process, then stats(); 5f71b35 compared
+/// both paths bit for bit on every target): CPU only, whose bits do not depend on the
+/// instruction set or the thread count (test_cpu_isa.cpp); OpenCL's belong to one device.
+std::uint64_t old_path_digest(const Target& t, FlowScheme flow) {
+  const bool li = flow == FlowScheme::local_inertial;
+  if (t.backend != "cpu") return 0;
+  if (t.f64()) return li ? 0x218ca05766e5842dULL : 0x60cd89222141a995ULL;
+  return li ? 0x8706ca05ca84c2d5ULL : 0xd9ec0168a9106f3aULL;
+}
+
+// end_step gives the tallies and statistics the old path gave, and waits do not change them:
+// two simulations from the same state, one stepped with begin_step, run(p), end_step, the
+// other with finish() after every process and stats() halfway through the step (where the
+// old lifetime rule delivered the OpenCL tallies); every tally and statistic of every step
+// compared bit for bit, and on the CPU the digest of the 30 steps against the old path's.
+TEST_P(BackendContract, EndStepEqualsTheOldPath) {
+  for (const auto& s : kSchemes) {
+    const Params p = valley_storm(target(), s.flow, s.transport);
+    Simulation a = io::make_simulation(p, target().backend);
+    Simulation b = io::make_simulation(p, target().backend);
+    const double dt = a.next_dt();
+    const auto seq = a.sequence();
+    int differing = 0;
+    double moved = 0;
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    Backend& plain = a.backend();
+    Backend& waited = b.backend();
+    for (int step = 0; step < 30; ++step) {
+      StepInputs in = a.inputs_for(dt);
+      in.t = step * dt;
+      plain.begin_step(in);
+      for (const Process proc : seq) plain.run(proc);
+      const StepResult r = plain.end_step();
+      waited.begin_step(in);
+      for (std::size_t k = 0; k < seq.size(); ++k) {
+        waited.run(seq[k]);
+        waited.finish();
+        if (k == seq.size() / 2) (void)waited.stats();
+      }
+      const StepResult w = waited.end_step();
+      const std::string dt_ = tally_differences(r.tally, w.tally),
+                        ds = stats_differences(r.stats, w.stats);
+      if (!dt_.empty() || !ds.empty()) {
+        ++differing;
+        ADD_FAILURE() << s.label << " step " << step << ": differ:" << dt_ << ds;
+      }
+      moved += r.tally.water_exchanged;
+      h = digest(h, r.tally, r.stats);
+    }
+    const std::uint64_t want = old_path_digest(target(), s.flow);
+    std::printf(
+        "[backend contract] %s %s: 30 steps (%.3g m^3 of water exchanged): end_step with "
+        "finish() after every process and stats() within the step against without: %d steps "
+        "differ (bound 0); digest %016llx, the old path's %016llx%s\n",
+        target().label().c_str(), s.label, moved, differing, static_cast<unsigned long long>(h),
+        static_cast<unsigned long long>(want), want ? "" : " (not recorded: CPU only)");
+    if (want) {
+      EXPECT_EQ(h, want) << "the tallies and statistics differ from the old path's";
+    }
+    EXPECT_GT(moved, 0.0) << "the water moved";
+  }
+}
+
+// The probes of end_step and sample() equal whole-field reads bit for bit: every field of
+// the field table at corners, edges and inner cells, after every step of both schemes.
+TEST_P(BackendContract, ProbesAndSampleEqualFieldReads) {
+  for (const auto& s : kSchemes) {
+    const Params p = valley_storm(target(), s.flow, s.transport);
+    Simulation sim = io::make_simulation(p, target().backend);
+    const std::int64_t n = sim.grid().nx;
+    const auto cells = probe_cells(n);
+    const auto fields = every_field();
+    Backend& be = sim.backend();
+    be.set_probes(cells, fields);
+    const double dt = sim.next_dt();
+    long compared = 0, differing = 0;
+    for (int step = 0; step < 20; ++step) {
+      StepInputs in = sim.inputs_for(dt);
+      in.t = step * dt;
+      be.begin_step(in);
+      for (const Process proc : sim.sequence()) be.run(proc);
+      const StepResult r = be.end_step();
+      ASSERT_EQ(r.probes.size(), fields.size() * cells.size());
+      for (std::size_t k = 0; k < fields.size(); ++k) {
+        const auto whole = be.field(fields[k]);
+        const auto sampled = be.sample(cells, fields[k]);
+        ASSERT_EQ(sampled.size(), cells.size());
+        for (std::size_t j = 0; j < cells.size(); ++j) {
+          const double want = whole[static_cast<std::size_t>(cells[j])];
+          const double probe = r.probes[k * cells.size() + j];
+          compared += 2;
+          if (!same_bits(probe, want) || !same_bits(sampled[j], want)) {
+            ++differing;
+            ADD_FAILURE() << s.label << " step " << step << " " << field_info(fields[k]).name
+                          << " cell " << cells[j] << ": field " << want << ", probe " << probe
+                          << ", sample " << sampled[j];
+          }
+        }
+      }
+    }
+    std::printf(
+        "[backend contract] %s %s: %ld probe and sample values of %zu fields at %zu cells over "
+        "20 steps against field()[cell]: %ld differ (bound 0)\n",
+        target().label().c_str(), s.label, compared, fields.size(), cells.size(), differing);
+    // No probes: end_step gives none; sample() of no cells is empty; a cell off the grid is
+    // a usage error.
+    be.set_probes({}, {});
+    be.begin_step(sim.inputs_for(dt));
+    EXPECT_TRUE(be.end_step().probes.empty());
+    EXPECT_TRUE(be.sample({}, FieldId::water_depth).empty());
+    for (const std::int64_t bad : {std::int64_t{-1}, n * n}) {
+      try {
+        (void)be.sample({0, bad}, FieldId::water_depth);
+        ADD_FAILURE() << "sample of cell " << bad << " did not throw";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ExitCode::usage) << e.what();
+      }
+      EXPECT_THROW(be.set_probes({bad}, {FieldId::bed}), Error);
+    }
+  }
+}
+
+// The gauges of a result file equal whole-field reads bit for bit: a run with four gauges
+// through io::RunSession (which registers them as the simulation's probes, gathered by
+// end_step), after every step the expected row from field(): depth, bed + depth and
+// hypot(vx, vy) at the gauge cells; and the same run written by a ResultWriter whose gauges
+// are not the simulation's probes (record_step samples them).
+TEST_P(BackendContract, GaugesEqualWholeFieldReads) {
+  TempDir dir;
+  Params p = valley_storm(target(), FlowScheme::local_inertial, TransportScheme::conservative);
+  p.time.steps = 40;
+  p.output.every = 1000;
+  p.output.fields = {"water_depth"};
+  p.output.restart_state = false;
+  p.output.gauges = {{15.0, 15.0}, {155.0, 155.0}, {305.0, 305.0}, {155.0, 255.0}};
+  p.output.path = dir.file("probed.h5");
+  io::SessionOptions options;
+  options.backend = target().backend;
+  options.command_line = "test_backend_contract";
+  io::RunSession session(p, options);
+  const auto cells = session.writer()->gauge_cells();
+  ASSERT_EQ(cells.size(), 4u);
+  std::vector<double> want;  // [step][gauge][depth, level, speed]
+  long probed = 0;
+  session.advance({}, {}, [&](const Simulation& sim) {
+    if (sim.probes() && sim.probe_cells() == cells) ++probed;
+    const auto d = sim.field(FieldId::water_depth), b = sim.field(FieldId::bed),
+               vx = sim.field(FieldId::velocity_x), vy = sim.field(FieldId::velocity_y);
+    for (const std::int64_t cell : cells) {
+      const auto i = static_cast<std::size_t>(cell);
+      want.insert(want.end(), {d[i], b[i] + d[i], std::hypot(vx[i], vy[i])});
+    }
+  });
+  session.finish();
+  EXPECT_EQ(probed, 40) << "the steps whose gauges came from the probes";
+
+  // The same run, its gauges sampled by record_step (not registered as probes).
+  p.output.path = dir.file("sampled.h5");
+  Simulation sim = io::make_simulation(p, target().backend);
+  {
+    io::ResultWriter writer(p.output.path, sim, "test_backend_contract", false);
+    writer.snapshot(sim);
+    while (!sim.finished()) {
+      sim.step();
+      writer.step_done(sim);
+    }
+    EXPECT_TRUE(sim.probe_cells().empty());
+    writer.finish(sim);
+  }
+
+  long compared = 0, differing = 0;
+  for (const char* name : {"probed.h5", "sampled.h5"}) {
+    const auto g = io::ResultReader(dir.file(name)).gauges();
+    ASSERT_EQ(g.time.size(), 40u) << name;
+    for (std::size_t step = 0; step < g.time.size(); ++step)
+      for (std::size_t j = 0; j < cells.size(); ++j) {
+        const double* w = &want[(step * cells.size() + j) * 3];
+        const double got[3] = {g.water_depth[step][j], g.water_level[step][j], g.speed[step][j]};
+        for (int k = 0; k < 3; ++k) {
+          ++compared;
+          if (!same_bits(got[k], w[k])) {
+            ++differing;
+            ADD_FAILURE() << name << " step " << step + 1 << " gauge " << j << " series " << k
+                          << ": " << got[k] << ", field reads " << w[k];
+          }
+        }
+      }
+  }
+  std::printf(
+      "[backend contract] %s: %ld gauge values (4 gauges, 40 steps, depth, level, speed; "
+      "probed and sampled) against whole-field reads: %ld differ (bound 0); %ld of 40 steps "
+      "took the gauges from the step's probes\n",
+      target().label().c_str(), compared, differing, probed);
+}
+
+// A step outside begin_step .. end_step is a programming error, named as such.
+TEST_P(BackendContract, RunOutsideAStepIsAnError) {
+  const Params p =
+      valley_storm(target(), FlowScheme::local_inertial, TransportScheme::conservative);
+  Simulation sim = io::make_simulation(p, target().backend);
+  Backend& be = sim.backend();
+  try {
+    be.run(Process::flow);
+    ADD_FAILURE() << "run() outside a step did not throw";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::internal) << e.what();
+  }
+  EXPECT_THROW(be.end_step(), Error);
+}
+
+ERODEM_INSTANTIATE_TARGETS(BackendContract);
+
+}  // namespace
+}  // namespace erodem::test
