@@ -7,25 +7,17 @@
 
 namespace erodem {
 
-const std::array<LedgerEntry, 16>& ledger_entries() {
-  static const std::array<LedgerEntry, 16> table{{
-      {"water_initial", &Ledger::water_initial},
-      {"water", &Ledger::water},
-      {"rain", &Ledger::rain},
-      {"inflow", &Ledger::inflow},
-      {"boundary_out", &Ledger::boundary_out},
-      {"evaporated", &Ledger::evaporated},
-      {"clipped", &Ledger::clipped},
-      {"material_initial", &Ledger::material_initial},
-      {"material", &Ledger::material},
-      {"sediment_out", &Ledger::sediment_out},
-      {"transport_change", &Ledger::transport_change},
-      {"water_exchanged", &Ledger::water_exchanged, true},
-      {"eroded", &Ledger::eroded, true},
-      {"deposited", &Ledger::deposited, true},
-      {"sediment_exchanged", &Ledger::sediment_exchanged, true},
-      {"thermal_moved", &Ledger::thermal_moved, true},
-  }};
+const std::vector<LedgerEntry>& ledger_entries() {
+  static const std::vector<LedgerEntry> table{{"water_initial", &Ledger::water_initial},
+                                              {"water", &Ledger::water},
+                                              {"rain", &Ledger::rain},
+                                              {"inflow", &Ledger::inflow},
+                                              {"material_initial", &Ledger::material_initial},
+                                              {"material", &Ledger::material},
+#define ERODEM_TALLY_ENTRY(name, moved, doc) {#name, &Ledger::name, moved},
+                                              ERODEM_TALLIES(ERODEM_TALLY_ENTRY)
+#undef ERODEM_TALLY_ENTRY
+  };
   return table;
 }
 

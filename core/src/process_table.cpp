@@ -200,18 +200,11 @@ const std::vector<ProcessInfo>& process_table() {
 }
 
 const std::vector<TallyInfo>& tally_table() {
-  // the order in which Simulation::step has always added them
+  // ERODEM_TALLIES (ledger.hpp), in its order: the order Simulation::step adds them
   static const std::vector<TallyInfo> table{
-      {"boundary_out", &StepTally::boundary_water_out, &Ledger::boundary_out},
-      {"evaporated", &StepTally::evaporated, &Ledger::evaporated},
-      {"clipped", &StepTally::clipped, &Ledger::clipped},
-      {"sediment_out", &StepTally::sediment_out, &Ledger::sediment_out},
-      {"transport_change", &StepTally::transport_change, &Ledger::transport_change},
-      {"water_exchanged", &StepTally::water_exchanged, &Ledger::water_exchanged},
-      {"eroded", &StepTally::eroded, &Ledger::eroded},
-      {"deposited", &StepTally::deposited, &Ledger::deposited},
-      {"sediment_exchanged", &StepTally::sediment_exchanged, &Ledger::sediment_exchanged},
-      {"thermal_moved", &StepTally::thermal_moved, &Ledger::thermal_moved},
+#define ERODEM_TALLY_INFO(name, moved, doc) {#name, &StepTally::name, &Ledger::name},
+      ERODEM_TALLIES(ERODEM_TALLY_INFO)
+#undef ERODEM_TALLY_INFO
   };
   return table;
 }

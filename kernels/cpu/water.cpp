@@ -33,7 +33,7 @@ void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
     row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
     row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));
   });
-  tally.boundary_water_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
+  tally.boundary_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
   tally.clipped += sum_rows(row_sums_b_);
   tally.water_exchanged += sum_rows(row_sums_c_);
   // depth_next_ keeps the depth the water update started from (after this step's sources):

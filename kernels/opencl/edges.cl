@@ -10,8 +10,8 @@
 /* water.h and transport.h: already included */
 
 /* One work-item per listed cell (the global size is rounded up to whole work-groups; every
- * work-item reaches the group sum): `slot` ERODEM_TALLY_EXCHANGE sums the water exchange
- * (m^3/s), ERODEM_TALLY_SEDIMENT the sediment carried out in dt (m^3; sediment and
+ * work-item reaches the group sum): `slot` ERODEM_TALLY_BOUNDARY_OUT sums the water exchange
+ * (m^3/s), ERODEM_TALLY_SEDIMENT_OUT the sediment carried out in dt (m^3; sediment and
  * depth_flow as the conservative transport reads them). Group g's sum goes to
  * partials[slot * stride + g]. */
 __kernel void edge_tallies(
@@ -25,7 +25,7 @@ __kernel void edge_tallies(
   real v = 0;
   if (e < count) {
     const int i = cells[e];
-    v = slot == ERODEM_TALLY_EXCHANGE
+    v = slot == ERODEM_TALLY_BOUNDARY_OUT
             ? water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom)
             : transport_boundary_out_cell(i, W, kind, sediment, depth_flow, f_left, f_right, f_top,
                                           f_bottom, dt);

@@ -5,11 +5,38 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cstring>
 
+#include "erodem/error.hpp"
+#include "erodem/process.hpp"
 #include "opencl/opencl_backend.hpp"
 
 namespace erodem::opencl {
+
+std::size_t tally_slots() {
+  const std::size_t n = tally_table().size();
+  if (n >= 31) throw Error(ExitCode::internal, "OpenCL: more than 30 tallies for the pending bits");
+  return n;
+}
+
+int tally_slot(double StepTally::*member) {
+  const auto& table = tally_table();
+  for (std::size_t k = 0; k < table.size(); ++k)
+    if (table[k].step == member) return static_cast<int>(k);
+  throw Error(ExitCode::internal, "OpenCL: a tally without an entry in tally_table()");
+}
+
+std::string tally_slot_options() {
+  std::string out;
+  const auto& table = tally_table();
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    std::string name = table[k].name;
+    for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    out += fmt::format(" -D ERODEM_TALLY_{}={}", name, k);
+  }
+  return out + fmt::format(" -D ERODEM_TALLY_SLOTS={}", table.size());
+}
 
 cl_kernel OpenClBackend::kernel(const char* name) {
   for (auto& [n, k] : kernels_)
@@ -74,10 +101,10 @@ void OpenClBackend::defer(StepTally& tally, unsigned bits) {
 }
 
 void OpenClBackend::enqueue_tally_reduction() {
-  if (!(pending_ & kTallyBits)) return;
+  if (!(pending_ & tally_bits())) return;
   cl_kernel k = kernel("reduce_tallies");
   set_args(k, static_cast<cl_int>(tally_stride_), tally_partials_, tally_sums_);
-  launch_reduction(k, kTallySlots);
+  launch_reduction(k, tally_slots());
 }
 
 void OpenClBackend::deliver_tallies() {
@@ -86,18 +113,17 @@ void OpenClBackend::deliver_tallies() {
     return;
   }
   StepTally& t = *pending_tally_;
-  if (pending_ & kTallyBits) {
-    const auto v = acc_values(tally_raw_, kTallySlots);
-    if (pending_ & kExchangeBit)
-      t.boundary_water_out += static_cast<double>(pending_water_dt_) * v[0];
-    if (pending_ & kClippedBit) t.clipped += v[1];
-    if (pending_ & kSedimentBit) t.sediment_out += v[2];
-    if (pending_ & kEvaporatedBit) t.evaporated += v[3];
-    if (pending_ & kWaterGivenBit) t.water_exchanged += v[4];
-    if (pending_ & kErodedBit) t.eroded += v[5];
-    if (pending_ & kDepositedBit) t.deposited += v[6];
-    if (pending_ & kSedimentGivenBit) t.sediment_exchanged += v[7];
-    if (pending_ & kThermalBit) t.thermal_moved += v[8];
+  if (pending_ & tally_bits()) {
+    const auto v = acc_values(tally_raw_, tally_slots());
+    const auto& table = tally_table();
+    for (std::size_t k = 0; k < table.size(); ++k) {
+      if (!(pending_ & (1u << k))) continue;
+      // the boundary slot sums a discharge (m^3/s, edges.cl): the volume is dt times it
+      if (table[k].step == &StepTally::boundary_out)
+        t.boundary_out += static_cast<double>(pending_water_dt_) * v[k];
+      else
+        t.*table[k].step += v[k];
+    }
   }
   if (pending_ & kChangeBit) {
     double change = 0.0;
@@ -111,10 +137,10 @@ void OpenClBackend::deliver_tallies() {
 void OpenClBackend::flush_tallies() {
   if (!pending_) return;
   enqueue_tally_reduction();
-  tally_raw_.resize(kTallySlots * acc_size_);
+  tally_raw_.resize(tally_slots() * acc_size_);
   change_raw_.resize(reduce_groups_ * acc_size_);
   if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
-  if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  if (pending_ & tally_bits()) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
   check(clFinish(queue_.get()), "clFinish");
   deliver_tallies();
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <type_traits>
 
 #include "opencl/opencl_backend.hpp"
@@ -34,13 +35,23 @@ constexpr std::size_t kReduceMax = 256;      // ERODEM_REDUCE_MAX of stats.cl
 constexpr std::size_t kCellGroupMax = 1024;  // ERODEM_CELL_GROUP_MAX of reduce.cl
 constexpr std::size_t kReduceGroupsMax = 1024;
 constexpr std::size_t kGatherParts = 6;  // the parts gather_cells (stats.cl) takes a launch
-constexpr std::size_t kTallySlots = 9;   // ERODEM_TALLY_SLOTS of reduce.cl
-constexpr int kTallyExchange = 0;        // ERODEM_TALLY_EXCHANGE of reduce.cl
-constexpr int kTallySediment = 2;        // ERODEM_TALLY_SEDIMENT of reduce.cl
-// one bit per slot of reduce.cl (1 << ERODEM_TALLY_*), then the transport change
-constexpr unsigned kExchangeBit = 1u << 0, kClippedBit = 1u << 1, kSedimentBit = 1u << 2,
-                   kEvaporatedBit = 1u << 3, kWaterGivenBit = 1u << 4, kErodedBit = 1u << 5,
-                   kDepositedBit = 1u << 6, kSedimentGivenBit = 1u << 7, kThermalBit = 1u << 8,
-                   kTallyBits = (1u << kTallySlots) - 1, kChangeBit = 1u << kTallySlots;
+
+/// The tally slots of the partials buffer: one per entry of tally_table() (ERODEM_TALLIES), at
+/// its index there. The kernels know them as ERODEM_TALLY_<NAME> from the build options.
+std::size_t tally_slots();
+/// The slot of tally `member`.
+int tally_slot(double StepTally::*member);
+/// The pending bit of tally `member` (1 << its slot).
+inline unsigned tally_bit(double StepTally::*member) {
+  return 1u << tally_slot(member);
+}
+/// The bits of every slot.
+inline unsigned tally_bits() {
+  return (1u << tally_slots()) - 1;
+}
+/// The pending bit of the semi-Lagrangian transport change (reduce_change, not a slot).
+constexpr unsigned kChangeBit = 1u << 31;
+/// " -D ERODEM_TALLY_<NAME>=<slot> ... -D ERODEM_TALLY_SLOTS=<n>": the slots for the kernels.
+std::string tally_slot_options();
 
 }  // namespace erodem::opencl

@@ -165,9 +165,9 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   edge_groups_ = std::max<std::size_t>(1, (edge_count_ + edge_local_ - 1) / edge_local_);
   // Every slot holds tally_stride_ partials; what no kernel writes stays 0.
   tally_stride_ = std::max(interior_groups_, edge_groups_);
-  const std::vector<unsigned char> no_partials(kTallySlots * tally_stride_ * acc_size_, 0);
+  const std::vector<unsigned char> no_partials(tally_slots() * tally_stride_ * acc_size_, 0);
   tally_partials_ = upload(no_partials);
-  tally_sums_ = make_buffer(kTallySlots * acc_size_);
+  tally_sums_ = make_buffer(tally_slots() * acc_size_);
   run_boundary();
 }
 
@@ -319,10 +319,11 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
            flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water,
            tally_partials_, static_cast<cl_int>(tally_stride_));
-  defer(tally, kExchangeBit | kClippedBit | kWaterGivenBit);
+  defer(tally, tally_bit(&StepTally::boundary_out) | tally_bit(&StepTally::clipped) |
+                   tally_bit(&StepTally::water_exchanged));
   pending_water_dt_ = dt;
   launch_interior(k);
-  launch_edge_tallies(kTallyExchange, dt);
+  launch_edge_tallies(tally_slot(&StepTally::boundary_out), dt);
   // depth_next_ keeps the depth the water update started from (after this step's sources):
   // conservative transport needs it.
   std::swap(depth_, depth_next_);
@@ -333,7 +334,7 @@ void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_, depth_,
            velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt, cell_.erosion, tally_partials_,
            static_cast<cl_int>(tally_stride_));
-  defer(tally, kErodedBit | kDepositedBit);
+  defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited));
   launch_interior(k);
   std::swap(bed_, bed_next_);
 }
@@ -344,9 +345,10 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
              flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
              static_cast<cl_int>(tally_stride_));
-    defer(tally, kSedimentBit | kSedimentGivenBit);
+    defer(tally, tally_bit(&StepTally::sediment_out) | tally_bit(&StepTally::sediment_exchanged));
     launch_interior(k);
-    launch_edge_tallies(kTallySediment, dt);  // reads sediment_ before the swap
+    launch_edge_tallies(tally_slot(&StepTally::sediment_out),
+                        dt);  // reads sediment_ before the swap
   } else {
     cl_kernel k = kernel("transport_semi_lagrangian");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
@@ -368,7 +370,7 @@ void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   cl_kernel apply = kernel("thermal_apply");
   set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, thermal_share_, dx_, dy_,
            area_, bed_next_, cell_.thermal, tally_partials_, static_cast<cl_int>(tally_stride_));
-  defer(tally, kThermalBit);
+  defer(tally, tally_bit(&StepTally::thermal_moved));
   launch_interior(apply);
   std::swap(bed_, bed_next_);
 }
@@ -377,7 +379,7 @@ void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
   cl_kernel k = kernel("evaporation");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, cell_.evaporation,
            tally_partials_, static_cast<cl_int>(tally_stride_));
-  defer(tally, kEvaporatedBit);
+  defer(tally, tally_bit(&StepTally::evaporated));
   launch_interior(k);
 }
 
@@ -402,10 +404,10 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   launch_reduction(r, (static_cast<std::size_t>(rows) + reduce_local_ - 1) / reduce_local_);
   // The step's tallies with the statistics: one wait per step (the queue is in order).
   enqueue_tally_reduction();
-  tally_raw_.resize(kTallySlots * acc_size_);
+  tally_raw_.resize(tally_slots() * acc_size_);
   change_raw_.resize(reduce_groups_ * acc_size_);
   if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
-  if (pending_ & kTallyBits) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  if (pending_ & tally_bits()) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
   std::vector<cl_long> cells(static_cast<std::size_t>(rows) * 3);
   read(row_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
   const bool gather = probes && probe_count_ > 0 && !probe_fields_.empty();

@@ -50,17 +50,12 @@ typedef int8 acc8_mask_t;
 /* The largest work-group of the cell kernels (the host's local size is at most this). */
 #define ERODEM_CELL_GROUP_MAX 1024
 
-/* The tally slots of the partials buffer. */
-#define ERODEM_TALLY_EXCHANGE 0       /* water: net discharge out through ghost faces (m^3/s) */
-#define ERODEM_TALLY_CLIPPED 1        /* water: volume added to lift rounding-level negatives */
-#define ERODEM_TALLY_SEDIMENT 2       /* conservative transport: sediment carried out */
-#define ERODEM_TALLY_EVAPORATED 3     /* evaporation: volume lost */
-#define ERODEM_TALLY_WATER_GIVEN 4    /* water: volume the cells gave through their faces */
-#define ERODEM_TALLY_ERODED 5         /* erosion: bed taken into suspension */
-#define ERODEM_TALLY_DEPOSITED 6      /* erosion: sediment laid down */
-#define ERODEM_TALLY_SEDIMENT_GIVEN 7 /* conservative transport: sediment the cells gave */
-#define ERODEM_TALLY_THERMAL 8        /* thermal: bed the cells gave to lower neighbours */
-#define ERODEM_TALLY_SLOTS 9
+/* The tally slots of the partials buffer: ERODEM_TALLY_<NAME> for each tally of ERODEM_TALLIES
+ * (core/include/erodem/ledger.hpp), its index there, and ERODEM_TALLY_SLOTS, their number, are
+ * defined by the build options (kernels/opencl/runtime.cpp). */
+#ifndef ERODEM_TALLY_SLOTS
+#error "the host defines the tally slots (ERODEM_TALLY_*) in the build options"
+#endif
 
 /* Linear index of this work-group among the cell kernel's groups. */
 static inline int cell_group_index(void) {

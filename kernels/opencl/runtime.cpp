@@ -10,6 +10,7 @@
 
 #include "erodem/error.hpp"
 #include "opencl/devices.hpp"
+#include "opencl/launch.hpp"
 #include "opencl/opencl_backend.hpp"
 
 namespace erodem::opencl {
@@ -81,6 +82,7 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
   rt->options = "-cl-std=CL1.2 -D real=float";
   if (rt->fp64) rt->options += " -D ERODEM_HAVE_FP64=1";
   if (rt->whole_rows) rt->options += " -D ERODEM_WHOLE_ROWS=1";
+  rt->options += tally_slot_options();
   const auto fp = device_value<cl_device_fp_config>(rt->device, CL_DEVICE_SINGLE_FP_CONFIG);
   if (fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
     rt->options += " -cl-fp32-correctly-rounded-divide-sqrt";

@@ -30,5 +30,5 @@ __kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
   if (!ERODEM_PAST_ROW(x, W))
     thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, share, dx, dy, area, p,
                              &moved);
-  cell_group_sum(s_sum, moved, partials + ERODEM_TALLY_THERMAL * stride + cell_group_index());
+  cell_group_sum(s_sum, moved, partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index());
 }

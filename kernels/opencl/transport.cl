@@ -21,7 +21,7 @@ __kernel void transport_conservative(
     transport_conservative_sweep_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left,
                                       f_right, f_top, f_bottom, area, dt, &carried, &given);
   cell_group_sum(s_sum, given,
-                 partials + ERODEM_TALLY_SEDIMENT_GIVEN * stride + cell_group_index());
+                 partials + ERODEM_TALLY_SEDIMENT_EXCHANGED * stride + cell_group_index());
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */

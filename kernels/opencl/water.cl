@@ -27,5 +27,5 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
                       dy, area, velocity_x, velocity_y, dt, p, &exchange, &clipped, &given);
   const int g = cell_group_index();
   cell_group_sum2(s_clipped, s_given, clipped, given, partials + ERODEM_TALLY_CLIPPED * stride + g,
-                  partials + ERODEM_TALLY_WATER_GIVEN * stride + g);
+                  partials + ERODEM_TALLY_WATER_EXCHANGED * stride + g);
 }

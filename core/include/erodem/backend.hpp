@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "erodem/fields.hpp"
+#include "erodem/ledger.hpp"
 
 namespace erodem {
 
@@ -38,21 +39,6 @@ struct StepInputs {
   double dt = 0.0;                  ///< step (s)
   double rain_rate = 0.0;           ///< uniform rain rate this step (m/s), times the rain factor
   std::vector<PointSource> points;  ///< inflows this step
-};
-
-/// Volumes (m^3) that crossed the model's boundaries during the processes run so far.
-struct StepTally {
-  double boundary_water_out = 0.0;  ///< net water out through open / fixed-level ghosts
-  double evaporated = 0.0;
-  double clipped = 0.0;           ///< water added to lift rounding-level negative depths
-  double sediment_out = 0.0;      ///< sediment carried out through the boundary
-  double transport_change = 0.0;  ///< change of sum(s * area) by the transport step
-  // What moved inside the domain: the scales the ledger's closures are judged against.
-  double water_exchanged = 0.0;     ///< water the cells gave through their faces (m^3)
-  double eroded = 0.0;              ///< bed taken into suspension (m^3)
-  double deposited = 0.0;           ///< suspended sediment laid down on the bed (m^3)
-  double sediment_exchanged = 0.0;  ///< sediment the cells gave through their faces (m^3)
-  double thermal_moved = 0.0;       ///< bed moved between cells by slope collapse (m^3)
 };
 
 /// Reductions over the active cells, for the ledger and the stability check.

@@ -2,33 +2,52 @@
 // double precision whatever the precision of the fields.
 #pragma once
 
-#include <array>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace erodem {
+
+/// The volumes (m^3) the processes book every step, each once: a member of StepTally (the
+/// step's amount, summed as the process ran) and of Ledger (cumulative), an entry of
+/// ledger_entries() and of tally_table() (process.hpp), added in this order. This list is the
+/// one place a new tally is declared; the closures below say which budget it enters.
+///   X(name, moved, doc): `moved` is true for the volumes moved inside the domain (the
+///   closures' scales; absent in files before 2026-11-25).
+#define ERODEM_TALLIES(X)                                                                  \
+  X(boundary_out, false, "net water out through open / fixed-level ghosts")                \
+  X(evaporated, false, "water evaporated")                                                 \
+  X(clipped, false, "water added to lift rounding-level negative depths")                  \
+  X(sediment_out, false, "sediment carried out through the boundary")                      \
+  X(transport_change, false,                                                               \
+    "change of sum(s * area) by transport (non-zero only for the semi-Lagrangian scheme)") \
+  X(water_exchanged, true, "water the cells gave through their faces")                     \
+  X(eroded, true, "bed taken into suspension")                                             \
+  X(deposited, true, "suspended sediment laid down on the bed")                            \
+  X(sediment_exchanged, true, "sediment the cells gave through their faces")               \
+  X(thermal_moved, true, "bed moved between cells by slope collapse")
+
+/// The volumes (m^3) that crossed the model's boundaries or moved inside it during the
+/// processes run so far in one step (ERODEM_TALLIES).
+struct StepTally {
+#define ERODEM_TALLY_MEMBER(name, moved, doc) double name = 0.0;
+  ERODEM_TALLIES(ERODEM_TALLY_MEMBER)
+#undef ERODEM_TALLY_MEMBER
+};
 
 struct Ledger {
   // water (m^3)
   double water_initial = 0.0;
   double water = 0.0;
-  double rain = 0.0;          ///< cumulative rain volume
-  double inflow = 0.0;        ///< cumulative point/line inflow volume
-  double boundary_out = 0.0;  ///< cumulative net outflow through the boundary
-  double evaporated = 0.0;    ///< cumulative evaporated volume
-  double clipped = 0.0;       ///< cumulative volume added when clipping rounding-level negatives
+  double rain = 0.0;    ///< cumulative rain volume
+  double inflow = 0.0;  ///< cumulative point/line inflow volume
   // material: bed + suspended sediment (m^3)
   double material_initial = 0.0;
   double material = 0.0;
-  double sediment_out = 0.0;      ///< cumulative sediment carried out through the boundary
-  double transport_change = 0.0;  ///< cumulative change of sediment volume by transport
-                                  ///< (non-zero only for the semi-Lagrangian scheme)
-  // what moved inside the domain, cumulative (m^3): the scales of the relative closures
-  double water_exchanged = 0.0;     ///< water the cells gave through their faces
-  double eroded = 0.0;              ///< bed taken into suspension
-  double deposited = 0.0;           ///< suspended sediment laid down on the bed
-  double sediment_exchanged = 0.0;  ///< sediment the cells gave through their faces
-  double thermal_moved = 0.0;       ///< bed moved between cells by slope collapse
+  // the cumulative tallies (ERODEM_TALLIES)
+#define ERODEM_TALLY_MEMBER(name, moved, doc) double name = 0.0;
+  ERODEM_TALLIES(ERODEM_TALLY_MEMBER)
+#undef ERODEM_TALLY_MEMBER
 
   /// The relative closures' floor: the closure of a run in which nothing moved is judged
   /// against this fraction of the volume on the grid (the rounding of a double sum).
@@ -65,8 +84,8 @@ struct LedgerEntry {
   bool moved = false;  ///< one of the moved volumes (absent in files before 2026-11-25)
 };
 
-/// Every kept entry of the ledger, in the order of the structure (the derived closure errors
-/// are not kept).
-const std::array<LedgerEntry, 16>& ledger_entries();
+/// Every kept entry of the ledger: the volumes on the grid, rain and inflow, then the tallies
+/// in the order of ERODEM_TALLIES (the derived closure errors are not kept).
+const std::vector<LedgerEntry>& ledger_entries();
 
 }  // namespace erodem
