@@ -5,27 +5,19 @@
 namespace erodem {
 
 const std::vector<FieldInfo>& field_table() {
-  // name, units, long name; state (restart), output choice, restarts with 0 when absent
   static const std::vector<FieldInfo> table{
-      {FieldId::bed, "bed", "m", "bed (terrain) elevation", true, true},
-      {FieldId::water_depth, "water_depth", "m", "water column depth", true, true},
-      {FieldId::sediment, "sediment", "m", "suspended sediment as an equivalent bed layer", true,
-       true},
-      {FieldId::velocity_x, "velocity_x", "m s-1", "depth-averaged eastward velocity", true, true},
-      {FieldId::velocity_y, "velocity_y", "m s-1", "depth-averaged northward velocity", true, true},
-      {FieldId::flux_left, "flux_left", "m3 s-1", "outflow through the west face", true, true},
-      {FieldId::flux_right, "flux_right", "m3 s-1", "outflow through the east face", true, true},
-      {FieldId::flux_top, "flux_top", "m3 s-1", "outflow through the north face", true, true},
-      {FieldId::flux_bottom, "flux_bottom", "m3 s-1", "outflow through the south face", true, true},
-      {FieldId::hardness, "hardness", "1", "erodibility multiplier", false, true},
-      {FieldId::wetness, "wetness", "m", "running mean of water depth", true, true},
-      {FieldId::erosion, "erosion", "m", "cumulative net erosion (negative: deposition)", false,
-       true},
-      {FieldId::manning_n, "manning_n", "s m-1/3", "Manning roughness coefficient"},
-      {FieldId::initial_bed, "initial_bed", "m", "bed elevation at the start of the run", true},
-      {FieldId::bed_residual, "bed_residual", "m",
-       "bed elevation below the precision of bed (the bed is bed + bed_residual)", true, false,
-       true},
+#define ERODEM_FIELD_INFO(id, units, long_name, flags) \
+  {FieldId::id,                                        \
+   #id,                                                \
+   units,                                              \
+   long_name,                                          \
+   ((flags)&kStateField) != 0,                         \
+   ((flags)&kOutputField) != 0,                        \
+   ((flags)&kRestartZero) != 0,                        \
+   ((flags)&kTwinField) != 0,                          \
+   ((flags)&kDerivedField) != 0},
+      ERODEM_FIELDS(ERODEM_FIELD_INFO)
+#undef ERODEM_FIELD_INFO
   };
   return table;
 }
@@ -60,8 +52,8 @@ const FieldInfo& field_info(const std::string& name) {
 }
 
 const FieldInfo& field_info(FieldId id) {
-  for (const auto& f : field_table())
-    if (f.id == id) return f;
+  const auto k = static_cast<std::size_t>(id);
+  if (k < field_table().size()) return field_table()[k];
   throw Error(ExitCode::internal, "field id without a table entry");
 }
 

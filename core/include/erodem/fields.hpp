@@ -6,23 +6,54 @@
 
 namespace erodem {
 
-enum class FieldId {
-  bed,
-  water_depth,
-  sediment,
-  velocity_x,
-  velocity_y,
-  flux_left,
-  flux_right,
-  flux_top,
-  flux_bottom,
-  hardness,
-  wetness,
-  erosion,  ///< derived: initial bed - bed (m); negative = deposition
-  manning_n,
-  initial_bed,   ///< bed at the start of the run (m); erosion = initial_bed - bed
-  bed_residual,  ///< the part of the bed below the precision of `bed` (m; compensated.h)
+/// What a field is (ERODEM_FIELDS' flags).
+enum FieldFlag : unsigned {
+  kStateField = 1u << 0,    ///< FieldInfo::state
+  kOutputField = 1u << 1,   ///< FieldInfo::output
+  kRestartZero = 1u << 2,   ///< FieldInfo::restart_zero_if_absent
+  kTwinField = 1u << 3,     ///< FieldInfo::twin
+  kDerivedField = 1u << 4,  ///< FieldInfo::derived
 };
+
+/// Every field of MODEL.md, in a fixed order (the order of state_fields() and of
+/// output_field_names()), each once: X(id, units, long_name, flags). The id is the name used
+/// in configs, files and Python; units are UDUNITS strings; long_name is the CF long_name. This
+/// list is the one place a new field is declared: FieldId, field_table() and the backends'
+/// storage (a field no hand-written process binds gets a zeroed array) follow from it.
+#define ERODEM_FIELDS(X)                                                                           \
+  X(bed, "m", "bed (terrain) elevation", kStateField | kOutputField | kTwinField)                  \
+  X(water_depth, "m", "water column depth", kStateField | kOutputField | kTwinField)               \
+  X(sediment, "m", "suspended sediment as an equivalent bed layer",                                \
+    kStateField | kOutputField | kTwinField)                                                       \
+  X(velocity_x, "m s-1", "depth-averaged eastward velocity", kStateField | kOutputField)           \
+  X(velocity_y, "m s-1", "depth-averaged northward velocity", kStateField | kOutputField)          \
+  X(flux_left, "m3 s-1", "outflow through the west face", kStateField | kOutputField)              \
+  X(flux_right, "m3 s-1", "outflow through the east face", kStateField | kOutputField)             \
+  X(flux_top, "m3 s-1", "outflow through the north face", kStateField | kOutputField)              \
+  X(flux_bottom, "m3 s-1", "outflow through the south face", kStateField | kOutputField)           \
+  X(hardness, "1", "erodibility multiplier", kOutputField)                                         \
+  X(wetness, "m", "running mean of water depth", kStateField | kOutputField)                       \
+  /* derived: initial bed - bed (m); negative = deposition */                                      \
+  X(erosion, "m", "cumulative net erosion (negative: deposition)", kOutputField | kDerivedField)   \
+  X(manning_n, "s m-1/3", "Manning roughness coefficient", 0u)                                     \
+  /* the bed at the start of the run (m); erosion = initial_bed - bed */                           \
+  X(initial_bed, "m", "bed elevation at the start of the run", kStateField)                        \
+  /* the part of the bed below the precision of `bed` (m; compensated.h) */                        \
+  X(bed_residual, "m", "bed elevation below the precision of bed (the bed is bed + bed_residual)", \
+    kStateField | kRestartZero)
+
+enum class FieldId {
+#define ERODEM_FIELD_ID(id, units, long_name, flags) id,
+  ERODEM_FIELDS(ERODEM_FIELD_ID)
+#undef ERODEM_FIELD_ID
+};
+
+/// The number of fields (FieldId values 0 .. kFieldCount - 1).
+constexpr int kFieldCount = 0
+#define ERODEM_FIELD_COUNT(id, units, long_name, flags) +1
+    ERODEM_FIELDS(ERODEM_FIELD_COUNT)
+#undef ERODEM_FIELD_COUNT
+    ;
 
 struct FieldInfo {
   FieldId id;
@@ -38,6 +69,11 @@ struct FieldInfo {
   /// Absent from the restart state of files written before it existed: such a file restarts
   /// with 0 in it (the bed residual, 2026-11-25).
   bool restart_zero_if_absent = false;
+  /// Kept in two buffers by the backends (a sweep reads the old values of the neighbours
+  /// while it writes the new ones): set_field() writes both.
+  bool twin = false;
+  /// Computed from other fields when read (the erosion); no storage, cannot be set.
+  bool derived = false;
 };
 
 /// All fields, in a fixed order: the order of state_fields() and of output_field_names().
