@@ -41,7 +41,30 @@ CellParams<real> cell_params_of(const Params& params) {
   return c;
 }
 
+template <class real>
+ParamBytes cell_params_bytes(const CellParams<real>& c, Process p) {
+  const auto of = [](const auto& v) { return ParamBytes{&v, sizeof v}; };
+  switch (p) {
+    case Process::boundary:
+      return of(c.boundary);
+    case Process::flow:
+      return of(c.flow);
+    case Process::water:
+      return of(c.water);
+    case Process::erosion:
+      return of(c.erosion);
+    case Process::thermal:
+      return of(c.thermal);
+    case Process::evaporation:
+      return of(c.evaporation);
+    default:
+      return {};
+  }
+}
+
 template CellParams<float> cell_params_of<float>(const Params&);
 template CellParams<double> cell_params_of<double>(const Params&);
+template ParamBytes cell_params_bytes(const CellParams<float>&, Process);
+template ParamBytes cell_params_bytes(const CellParams<double>&, Process);
 
 }  // namespace erodem

@@ -11,6 +11,7 @@
 #include "common/sources.h"
 #include "common/thermal.h"
 #include "common/water.h"
+#include "erodem/backend.hpp"
 #include "erodem/params.hpp"
 
 namespace erodem {
@@ -32,6 +33,16 @@ struct CellParams {
 /// whether it evaporates.
 template <class real>
 CellParams<real> cell_params_of(const Params& params);
+
+/// The bytes of process `p`'s parameter struct in `c` (what the generic sweeps pass to their
+/// cell function and kernel, process.hpp SweepInfo::generic); {nullptr, 0} for a process
+/// without one.
+struct ParamBytes {
+  const void* data = nullptr;
+  std::size_t size = 0;
+};
+template <class real>
+ParamBytes cell_params_bytes(const CellParams<real>& c, Process p);
 
 // Members of type real or int only: the host's structs have the device's layout (OpenCL
 // passes them by value as kernel arguments).

@@ -143,13 +143,20 @@ std::vector<SweepInfo> thermal_sweeps(const Params&) {
            {"thermal_apply"}}};
 }
 
+/// A sweep the backends run through their generic cell loop (SweepInfo::generic): its cell
+/// function is `<name>_sweep_cell`, its kernel `<name>`.
+SweepInfo generic_sweep(const char* name, std::vector<FieldUse> uses) {
+  SweepInfo s{name, Domain::cells, std::move(uses), {name}};
+  s.generic = true;
+  return s;
+}
+
 std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
-  // evaporation_cell and wetness_cell (sources.h): the depth decays (when the rate > 0) and
-  // the wetness follows it
-  return {{"evaporation",
-           Domain::cells,
-           {{"kind", R}, {"water_depth", p.evaporation.rate > 0 ? U : R}, {"wetness", U}},
-           {"evaporation"}}};
+  // evaporation_sweep_cell (sources.h): the depth decays (when the rate > 0) and the wetness
+  // follows it
+  return {generic_sweep(
+      "evaporation",
+      {{"kind", R}, {"water_depth", p.evaporation.rate > 0 ? U : R}, {"wetness", U}})};
 }
 
 }  // namespace

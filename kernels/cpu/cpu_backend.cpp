@@ -115,8 +115,8 @@ void CpuBackend<Real>::run(Process p) {
     case Process::thermal:
       run_thermal(dt, tally);
       break;
-    case Process::evaporation:
-      run_evaporation(dt, tally);
+    default:  // the processes whose sweeps are all generic (SweepInfo::generic)
+      for (const SweepInfo& s : process_info(p).sweeps(params_)) run_generic(s, p, dt, tally);
       break;
   }
 }

@@ -17,6 +17,7 @@
 #include "erodem/backend.hpp"
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
+#include "erodem/process.hpp"
 #include "stagger.hpp"
 
 /// Before a cell loop whose iterations write only their own cells: tells GCC that the
@@ -64,7 +65,11 @@ class CpuBackend final : public Backend {
   void run_erosion(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
   void run_thermal(Real dt, StepTally& tally);
-  void run_evaporation(Real dt, StepTally& tally);
+  /// A generic sweep of the process table (process.hpp SweepInfo::generic), in
+  /// kernels/cpu/sweeps.cpp: the cell function the list there names for it, by cell_sweep.
+  void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
+  template <auto Cell>
+  void cell_sweep(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
 
  private:
   using Kind = cell::erodem_kind_t;
@@ -144,6 +149,7 @@ class CpuBackend final : public Backend {
   std::array<Field*, kFieldCount> storage_{}, twin_storage_{};
   std::vector<std::unique_ptr<Field>> generic_;
   std::vector<double> row_sums_a_, row_sums_b_, row_sums_c_;  // scratch for per-row reductions
+  std::vector<std::vector<double>> row_sums_;  // per tally of a generic sweep (sweeps.cpp)
   // The step under way (begin_step .. end_step): its inputs and its tallies so far.
   StepInputs step_inputs_;
   StepTally step_tally_;

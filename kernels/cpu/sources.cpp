@@ -1,5 +1,5 @@
-// CPU loops of the sources process (rain, point/line inflows) and of evaporation:
-// kernels/common/sources.h.
+// CPU loops of the sources process (rain, point/line inflows): kernels/common/sources.h
+// (evaporation runs through the generic loop of sweeps.cpp).
 #include "common/sources.h"
 
 #include <vector>
@@ -31,31 +31,8 @@ void CpuBackend<Real>::run_sources(const StepInputs& in) {
   }
 }
 
-template <class Real>
-void CpuBackend<Real>::run_evaporation(Real dt, StepTally& tally) {
-  const Kind* kind = kind_.data();
-  const Real* area = area_.data();
-  Real *depth = depth_.data(), *wetness = wetness_.data();
-  const cell_params::EvaporationParams<Real> params = cell_.evaporation;
-  const int W = W_;
-  for_rows(1, H_ - 1, [=](int y) {
-    // Locals, not closure members: stores to Real arrays could alias those.
-    const Real step = dt;
-    const cell_params::EvaporationParams<Real> p = params;
-    const auto lost_row = row_scratch(W);
-    Real* lost = lost_row.get();
-    ERODEM_IVDEP
-    for (int x = 1; x < W - 1; ++x)
-      cell::evaporation_sweep_cell(x, y, W, kind, depth, wetness, area, step, p, lost + x);
-    row_sums_a_[y] = sum_row(lost, static_cast<std::size_t>(W));
-  });
-  tally.evaporated += sum_rows(row_sums_a_);
-}
-
 template void CpuBackend<float>::run_sources(const StepInputs&);
 template void CpuBackend<double>::run_sources(const StepInputs&);
-template void CpuBackend<float>::run_evaporation(float, StepTally&);
-template void CpuBackend<double>::run_evaporation(double, StepTally&);
 
 }  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

@@ -48,6 +48,39 @@ cl_kernel OpenClBackend::kernel(const char* name) {
   return kernels_.back().second.get();
 }
 
+void OpenClBackend::run_generic(const SweepInfo& sweep, Process process, Real dt,
+                                StepTally& tally) {
+  if (!sweep.generic || sweep.domain != Domain::cells)
+    throw Error(ExitCode::internal,
+                fmt::format("sweep '{}' of process '{}' is not generic: the backend has no code "
+                            "for it",
+                            sweep.name, process_name(process)));
+  cl_kernel k = kernel(sweep.name);
+  cl_uint i = 0;
+  set_arg(k, i++, cl_int{W_});
+  set_arg(k, i++, cl_int{H_});
+  for (const FieldUse& u : sweep.uses) {
+    const std::string name = u.field;
+    const Buffer* b = name == "kind" ? &kind_ : field_buffer(field_info(name).id);
+    if (!b)
+      throw Error(ExitCode::internal,
+                  fmt::format("sweep '{}': field '{}' has no buffer", sweep.name, name));
+    set_arg(k, i++, *b);
+  }
+  set_arg(k, i++, area_);
+  set_arg(k, i++, dt);
+  const ParamBytes params = cell_params_bytes(cell_, process);
+  check(clSetKernelArg(k, i++, params.size, params.data), "clSetKernelArg(params)");
+  set_arg(k, i++, tally_partials_);
+  set_arg(k, i++, static_cast<cl_int>(tally_stride_));
+  unsigned bits = 0;
+  for (const char* name : process_info(process).tallies)
+    for (std::size_t slot = 0; slot < tally_table().size(); ++slot)
+      if (std::string(tally_table()[slot].name) == name) bits |= 1u << slot;
+  if (bits) defer(tally, bits);
+  launch_interior(k);
+}
+
 void OpenClBackend::launch_interior(cl_kernel k) {
   launch_rows(k, 1, H_ - 1);
 }

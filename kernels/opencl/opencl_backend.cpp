@@ -212,8 +212,8 @@ void OpenClBackend::run(Process p) {
     case Process::thermal:
       run_thermal(dt, tally);
       break;
-    case Process::evaporation:
-      run_evaporation(dt, tally);
+    default:  // the processes whose sweeps are all generic (SweepInfo::generic)
+      for (const SweepInfo& s : process_info(p).sweeps(params_)) run_generic(s, p, dt, tally);
       break;
   }
 }
@@ -374,14 +374,6 @@ void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   defer(tally, tally_bit(&StepTally::thermal_moved));
   launch_interior(apply);
   std::swap(bed_, bed_next_);
-}
-
-void OpenClBackend::run_evaporation(Real dt, StepTally& tally) {
-  cl_kernel k = kernel("evaporation");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, wetness_, area_, dt, cell_.evaporation,
-           tally_partials_, static_cast<cl_int>(tally_stride_));
-  defer(tally, tally_bit(&StepTally::evaporated));
-  launch_interior(k);
 }
 
 void OpenClBackend::finish() {

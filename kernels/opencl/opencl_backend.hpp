@@ -22,6 +22,7 @@
 #include "erodem/backends.hpp"
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
+#include "erodem/process.hpp"
 
 namespace erodem::opencl {
 
@@ -151,7 +152,10 @@ class OpenClBackend final : public Backend {
   void run_erosion(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
   void run_thermal(Real dt, StepTally& tally);
-  void run_evaporation(Real dt, StepTally& tally);
+  /// A generic sweep of the process table (process.hpp SweepInfo::generic): its kernel with
+  /// the buffers of its uses, the process's parameter struct and the tally partials, over the
+  /// DEM rows; the process's tallies deferred (launch.cpp).
+  void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
 
   /// A device buffer of `bytes`, filled from `data` where given. A buffer of a field (at
   /// least kStaggerMin bytes) starts at its own offset modulo 4 KiB (stagger_next_): see

@@ -51,6 +51,16 @@ struct SweepInfo {
   /// Intermediates it leaves for later sweeps of the step at no traffic of its own (the
   /// water update leaves "depth_flow", the depth it started from, in its second buffer).
   std::vector<const char*> leaves = {};
+  /// Run by the backends' generic cell loop, with no code of their own (one line in
+  /// kernels/cpu/sweeps.cpp names its cell function): a cells sweep over the DEM rows whose
+  /// cell function and OpenCL kernel (named as the sweep) take
+  ///   cell:   (int x, int y, int W, <a pointer per use, in order>, area, dt, params,
+  ///            <a real* per tally of the process, in order>)
+  ///   kernel: (int W, int H, <a buffer per use, in order>, area, dt, params, partials, stride)
+  /// where a use is "kind" or a field of field_table(), `area` the per-row cell areas (m^2),
+  /// `dt` the step (s), `params` the process's struct (kernels/cell_params.hpp), and the
+  /// kernel sums each tally into slot ERODEM_TALLY_<NAME> of `partials` (reduce.cl).
+  bool generic = false;
 };
 
 /// One tally of the ledger: a volume (m^3) a process books per step, added to a Ledger

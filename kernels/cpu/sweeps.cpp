@@ -1,0 +1,140 @@
+// erodem — the CPU's generic cell loop (process.hpp SweepInfo::generic): a sweep of the
+// process table runs its cell function over the DEM rows with the pointers its uses name, the
+// process's parameter struct, and one per-row scratch per tally of the process, summed per row
+// and then in row order (as every CPU reduction). The list below is the only CPU code a
+// generic sweep needs: its name and its cell function.
+#include <fmt/format.h>
+
+#include <array>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+
+#include "common/sources.h"
+#include "cpu/cpu_backend.hpp"
+#include "erodem/error.hpp"
+#include "erodem/process.hpp"
+
+namespace erodem {
+namespace ERODEM_CPU_NAMESPACE {
+namespace {
+
+/// The parameter types of a cell function void(int x, int y, int W, A...).
+template <class F>
+struct CellSignature;
+template <class... A>
+struct CellSignature<void (*)(int, int, int, A...)> {
+  using Args = std::tuple<A...>;
+  static constexpr std::size_t count = sizeof...(A);
+  /// The index (in A...) of the parameter struct: the one class-type parameter.
+  static constexpr std::size_t params_index() {
+    constexpr bool is_class[] = {std::is_class_v<A>...};
+    for (std::size_t k = 0; k < count; ++k)
+      if (is_class[k]) return k;
+    return count;
+  }
+};
+
+/// One row of a generic sweep: Cell over x = 1 .. W - 2 of row y, with the uses' pointers
+/// (`f`, cast to the cell function's parameter types), and tally J of cell x at t[J][x]. The
+/// pointers are locals here, so the compiler knows the stores of the cell function leave them.
+template <auto Cell, class Args, class real, class P, std::size_t N, std::size_t M,
+          std::size_t... I, std::size_t... J>
+inline void cell_row(int y, int W, const std::array<void*, N>& f, const real* area, real dt,
+                     const P& params, const std::array<real*, M>& t, std::index_sequence<I...>,
+                     std::index_sequence<J...>) {
+  const std::tuple<std::tuple_element_t<I, Args>...> ptr{
+      static_cast<std::tuple_element_t<I, Args>>(f[I])...};
+  const std::array<real*, M> tally = t;
+  const P p = params;
+  const real step = dt;
+  ERODEM_IVDEP
+  for (int x = 1; x < W - 1; ++x)
+    Cell(x, y, W, std::get<I>(ptr)..., area, step, p, tally[J] + x...);
+}
+
+}  // namespace
+
+template <class Real>
+template <auto Cell>
+void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real dt,
+                                  StepTally& tally) {
+  using Sig = CellSignature<decltype(Cell)>;
+  using Args = typename Sig::Args;
+  constexpr std::size_t ip = Sig::params_index();
+  static_assert(ip >= 2 && ip < Sig::count, "a cell function takes area, dt and a param struct");
+  constexpr std::size_t nf = ip - 2, nt = Sig::count - ip - 1;  // fields, tallies
+  using P = std::tuple_element_t<ip, Args>;
+
+  // the pointers of the uses, the parameter struct and the tallies, checked against the table
+  const ProcessInfo& info = process_info(process);
+  if (sweep.uses.size() != nf || info.tallies.size() != nt)
+    throw Error(ExitCode::internal,
+                fmt::format("sweep '{}': the table lists {} uses and {} tallies, its cell function "
+                            "takes {} and {}",
+                            sweep.name, sweep.uses.size(), info.tallies.size(), nf, nt));
+  std::array<void*, nf> fields{};
+  for (std::size_t k = 0; k < nf; ++k) {
+    const std::string name = sweep.uses[k].field;
+    Field* f = name == "kind" ? nullptr : field_storage(field_info(name).id);
+    if (name != "kind" && !f)
+      throw Error(ExitCode::internal,
+                  fmt::format("sweep '{}': field '{}' has no storage", sweep.name, name));
+    fields[k] = name == "kind" ? static_cast<void*>(kind_.data()) : static_cast<void*>(f->data());
+  }
+  const ParamBytes bytes = cell_params_bytes(cell_, process);
+  if (bytes.size != sizeof(P))
+    throw Error(ExitCode::internal,
+                fmt::format("sweep '{}': the parameter struct of process '{}' has {} bytes, the "
+                            "cell function's {}",
+                            sweep.name, info.name, bytes.size, sizeof(P)));
+  P params;
+  std::memcpy(&params, bytes.data, sizeof(P));
+  std::array<double StepTally::*, nt> members{};
+  for (std::size_t t = 0; t < nt; ++t)
+    for (const auto& e : tally_table())
+      if (std::string(e.name) == info.tallies[t]) members[t] = e.step;
+  if (row_sums_.size() < nt) row_sums_.resize(nt);
+  for (std::size_t t = 0; t < nt; ++t) row_sums_[t].assign(H_, 0.0);
+
+  const Real* area = area_.data();
+  const int W = W_;
+  for_rows(1, H_ - 1, [&](int y) {
+    std::array<std::unique_ptr<Real[]>, nt> scratch;
+    std::array<Real*, nt> t{};
+    for (std::size_t k = 0; k < nt; ++k) {
+      scratch[k] = row_scratch(W);
+      t[k] = scratch[k].get();
+    }
+    cell_row<Cell, Args>(y, W, fields, area, dt, params, t, std::make_index_sequence<nf>{},
+                         std::make_index_sequence<nt>{});
+    for (std::size_t k = 0; k < nt; ++k)
+      row_sums_[k][y] = sum_row(t[k], static_cast<std::size_t>(W));
+  });
+  for (std::size_t k = 0; k < nt; ++k) tally.*members[k] += sum_rows(row_sums_[k]);
+}
+
+template <class Real>
+void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real dt,
+                                   StepTally& tally) {
+  using Run = void (CpuBackend::*)(const SweepInfo&, Process, Real, StepTally&);
+  // Each generic sweep of the process table by its name, with its cell function.
+  static const std::pair<const char*, Run> sweeps[] = {
+      {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
+  };
+  for (const auto& [name, run] : sweeps)
+    if (std::string(name) == sweep.name) return (this->*run)(sweep, process, dt, tally);
+  throw Error(ExitCode::internal,
+              fmt::format("sweep '{}' is generic but kernels/cpu/sweeps.cpp does not list its "
+                          "cell function",
+                          sweep.name));
+}
+
+template void CpuBackend<float>::run_generic(const SweepInfo&, Process, float, StepTally&);
+template void CpuBackend<double>::run_generic(const SweepInfo&, Process, double, StepTally&);
+
+}  // namespace ERODEM_CPU_NAMESPACE
+}  // namespace erodem
