@@ -156,21 +156,26 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
   // (simulation.cpp and schema.cpp of 2026-11-25), as sets: the order is the table's now.
   std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
   for (FieldId id : state_fields()) state.insert(field_info(id).name);
-  EXPECT_EQ(state, (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment",
-                                          "velocity_x", "velocity_y", "flux_left", "flux_right",
-                                          "flux_top", "flux_bottom", "wetness", "bed_residual"}));
-  EXPECT_EQ(output, (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x",
-                                           "velocity_y", "erosion", "wetness", "hardness",
-                                           "flux_left", "flux_right", "flux_top", "flux_bottom"}));
-  // a field restored from files that lack it starts at 0: only the bed residual, added later
+  EXPECT_EQ(state,
+            (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment", "velocity_x",
+                                   "velocity_y", "flux_left", "flux_right", "flux_top",
+                                   "flux_bottom", "wetness", "bed_residual", "snow"}));
+  EXPECT_EQ(output,
+            (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x", "velocity_y",
+                                   "erosion", "wetness", "hardness", "flux_left", "flux_right",
+                                   "flux_top", "flux_bottom", "snow"}));
+  // a field restored from files that lack it starts at 0: the bed residual and the snow pack,
+  // added later
   for (const auto& f : field_table())
-    EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual) << f.name;
+    EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual || f.id == FieldId::snow)
+        << f.name;
 }
 
 TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // the cell kernels whose work-group the OpenCL backend queried from its own list (before
-  // 2026-11-26), as a set; the program in step order (flow before sources since they run after
-  // it; before, the files were listed in the enum's order)
+  // 2026-11-26) and the snow pack's (added through the table), as a set; the program in step order
+  // (flow before sources since they run after it; before, the files were listed in the enum's
+  // order)
   const auto k = opencl_cell_kernels();
   EXPECT_EQ(std::set<std::string>(k.begin(), k.end()),
             (std::set<std::string>{
@@ -178,12 +183,12 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                 "flow_local_inertial_faces_x_interior", "flow_local_inertial_faces_y_interior",
                 "flow_local_inertial_split", "flow_local_inertial_split_interior", "water_update",
                 "erosion", "transport_conservative", "transport_semi_lagrangian", "thermal_share",
-                "thermal_apply", "evaporation", "field_stats", "edge_tallies"}));
-  EXPECT_EQ(k.size(), 17u) << "a kernel listed twice";
+                "thermal_apply", "evaporation", "snow", "field_stats", "edge_tallies"}));
+  EXPECT_EQ(k.size(), 18u) << "a kernel listed twice";
   EXPECT_EQ(opencl_program_order(),
             (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl",
                                       "water.cl", "erosion.cl", "transport.cl", "thermal.cl",
-                                      "evaporation.cl", "edges.cl", "stats.cl"}));
+                                      "evaporation.cl", "snow.cl", "edges.cl", "stats.cl"}));
 }
 
 }  // namespace

@@ -21,8 +21,9 @@ namespace {
 
 using erodem::test::run_cli;
 
-/// Local inertial flow, conservative transport, thermal collapse, an open and a fixed-level
-/// edge, a rain series and adaptive steps: every state field changes.
+/// Local inertial flow, conservative transport, thermal collapse, a melting snow pack above
+/// 20 m, an open and a fixed-level edge, a rain series and adaptive steps: every state field
+/// changes.
 const char* kInertial = R"([dem]
 synthetic = "valley"
 size = 48
@@ -52,6 +53,12 @@ talus_angle = 30.0
 rate = 0.05
 [evaporation]
 rate = 1e-6
+[snow]
+enabled = true
+initial = "20 mm"
+snow_line = "20 m"
+air_temperature = 3.0
+melt_factor = "100 mm/d"
 [boundary]
 east = "open"
 west = "fixed_level"
@@ -59,7 +66,8 @@ sea_level = 1.0
 [output]
 path = "full.h5"
 interval = "2 min"
-fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness"]
+fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness",
+          "snow"]
 )";
 
 /// Pipes, semi-Lagrangian transport, a point inflow hydrograph and fixed steps.

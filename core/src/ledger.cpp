@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <string>
 
 namespace erodem {
 
@@ -14,32 +16,11 @@ const std::vector<LedgerEntry>& ledger_entries() {
                                               {"inflow", &Ledger::inflow},
                                               {"material_initial", &Ledger::material_initial},
                                               {"material", &Ledger::material},
-#define ERODEM_TALLY_ENTRY(name, moved, doc) {#name, &Ledger::name, moved},
+#define ERODEM_TALLY_ENTRY(name, zero_if_absent, doc) {#name, &Ledger::name, zero_if_absent},
                                               ERODEM_TALLIES(ERODEM_TALLY_ENTRY)
 #undef ERODEM_TALLY_ENTRY
   };
   return table;
-}
-
-double Ledger::water_moved() const {
-  return std::max({rain + inflow + std::abs(boundary_out) + evaporated, water_exchanged,
-                   kVolumeEpsilon * std::max(std::abs(water_initial), std::abs(water))});
-}
-
-double Ledger::relative_closure_error() const {
-  const double scale = water_moved();
-  return scale > 0 ? closure_error() / scale : 0.0;
-}
-
-double Ledger::material_moved() const {
-  return std::max({eroded + deposited + std::abs(sediment_out),
-                   sediment_exchanged + thermal_moved + std::abs(transport_change),
-                   kVolumeEpsilon * std::max(std::abs(material_initial), std::abs(material))});
-}
-
-double Ledger::relative_material_closure_error() const {
-  const double scale = material_moved();
-  return scale > 0 ? material_closure_error() / scale : 0.0;
 }
 
 std::string Ledger::format() const {
@@ -51,6 +32,16 @@ std::string Ledger::format() const {
                    evaporated);
   s += fmt::format("           clipped {:>18.9e}\n", clipped);
   s += fmt::format("           exchanged between cells {:>14.9e}\n", water_exchanged);
+  // the tallies this table does not name (ERODEM_TALLIES grows without editing it)
+  static const std::set<std::string> named{"water_initial", "water",           "rain",
+                                           "inflow",        "boundary_out",    "evaporated",
+                                           "clipped",       "water_exchanged", "material_initial",
+                                           "material",      "sediment_out",    "transport_change",
+                                           "eroded",        "deposited",       "sediment_exchanged",
+                                           "thermal_moved"};
+  for (const auto& e : ledger_entries())
+    if (!named.count(e.name))
+      s += fmt::format("           {:<24} {:>14.9e}\n", e.name, this->*e.member);
   s += fmt::format("           closure {:>18.9e}   relative {:>13.3e} of {:.9e} moved\n",
                    closure_error(), relative_closure_error(), water_moved());
   s += fmt::format("  material initial {:>18.9e}   now {:>18.9e}\n", material_initial, material);

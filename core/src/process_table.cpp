@@ -26,6 +26,9 @@ bool erosion_on(const Params& p) {
 bool thermal_on(const Params& p) {
   return p.thermal.enabled;
 }
+bool snow_on(const Params& p) {
+  return p.snow.enabled;
+}
 bool rains(const Params& p) {
   return p.rain.rate > 0 || !p.rain.series.empty();
 }
@@ -159,6 +162,21 @@ std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
       {{"kind", R}, {"water_depth", p.evaporation.rate > 0 ? U : R}, {"wetness", U}})};
 }
 
+std::vector<SweepInfo> snow_sweeps(const Params&) {
+  // snow_sweep_cell (snow.h): the degree-day melt of the pack into the depth
+  return {generic_sweep("snow", {{"kind", R}, {"bed", R}, {"snow", U}, {"water_depth", U}})};
+}
+
+/// The initial pack: snow.initial on the active cells at or above snow.snow_line.
+std::vector<std::pair<FieldId, std::vector<double>>> snow_initial(const Terrain& t,
+                                                                  const Params& p) {
+  std::vector<double> snow(t.bed.size(), 0.0);
+  for (std::size_t i = 0; i < snow.size(); ++i)
+    if (t.active(i) && (!p.snow.snow_line || t.bed[i] >= *p.snow.snow_line))
+      snow[i] = p.snow.initial;
+  return {{FieldId::snow, std::move(snow)}};
+}
+
 }  // namespace
 
 const std::vector<ProcessInfo>& process_table() {
@@ -202,6 +220,14 @@ const std::vector<ProcessInfo>& process_table() {
        evaporation_sweeps,
        {"evaporated"},
        "evaporation.cl"},
+      {Process::snow,
+       "snow",
+       "snow",
+       snow_on,
+       snow_sweeps,
+       {"snow_melted"},
+       "snow.cl",
+       snow_initial},
   };
   return table;
 }
@@ -209,7 +235,7 @@ const std::vector<ProcessInfo>& process_table() {
 const std::vector<TallyInfo>& tally_table() {
   // ERODEM_TALLIES (ledger.hpp), in its order: the order Simulation::step adds them
   static const std::vector<TallyInfo> table{
-#define ERODEM_TALLY_INFO(name, moved, doc) {#name, &StepTally::name, &Ledger::name},
+#define ERODEM_TALLY_INFO(name, zero_if_absent, doc) {#name, &StepTally::name, &Ledger::name},
       ERODEM_TALLIES(ERODEM_TALLY_INFO)
 #undef ERODEM_TALLY_INFO
   };
@@ -325,16 +351,16 @@ std::vector<std::string> opencl_cell_kernels() {
     for (const char* k : sweep.opencl_kernels)
       if (std::find(out.begin(), out.end(), k) == out.end()) out.emplace_back(k);
   };
-  // every process on, with each flow and transport scheme
+  // every process of the table (enabled or not), with each flow and transport scheme
   Params p;
   p.rain.rate = 1.0;
-  p.erosion.enabled = p.thermal.enabled = true;
   p.evaporation.rate = 1.0;
   for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial})
     for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian}) {
       p.flow.scheme = flow;
       p.transport.scheme = transport;
-      for (const auto& [process, sweep] : step_sweeps(p)) add(sweep);
+      for (const auto& e : process_table())
+        for (const auto& sweep : e.sweeps(p)) add(sweep);
     }
   add(stats_sweep());
   return out;

@@ -118,6 +118,23 @@ const std::vector<Descriptor>& descriptor_table() {
       number(ERODEM_FIELD(evaporation.rate), D::inverse_time, at_least(0),
              "evaporation rate K_e (1/s)"),
 
+      boolean(ERODEM_FIELD(snow.enabled), "a snow pack that melts by a degree-day rule"),
+      number(ERODEM_FIELD(snow.initial), D::length, at_least(0),
+             "initial snow water equivalent S_0 (m)"),
+      optional_number(ERODEM_FIELD(snow.snow_line), D::length, any_finite(),
+                      "the initial pack lies only where the bed is at or above this (m)"),
+      number(ERODEM_FIELD(snow.melt_factor), D::speed, at_least(0),
+             "degree-day factor DDF: melt per kelvin above snow.melt_temperature (m/s per K; "
+             "e.g. '4 mm/d')"),
+      number(ERODEM_FIELD(snow.melt_temperature), D::dimensionless, any_finite(),
+             "air temperature above which snow melts, T_melt (degrees C)"),
+      number(ERODEM_FIELD(snow.air_temperature), D::dimensionless, any_finite(),
+             "air temperature T_ref at snow.reference_elevation (degrees C)"),
+      number(ERODEM_FIELD(snow.reference_elevation), D::length, any_finite(),
+             "elevation z_ref of snow.air_temperature (m)"),
+      number(ERODEM_FIELD(snow.lapse_rate), D::dimensionless, any_finite(),
+             "air temperature lapse rate dT/dz (K/m; -0.0065 is -6.5 K/km)"),
+
       choice(ERODEM_FIELD(boundary.north), boundary, "north edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.south), boundary, "south edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.east), boundary, "east edge: closed, open or fixed_level"),

@@ -136,6 +136,10 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     }
   resolve_inflows();
   find_coast_cells();
+  // the initial values of the fields the processes own (process.hpp ProcessInfo::initial)
+  for (const Process p : step_sequence(params_))
+    if (const auto initial = process_info(p).initial)
+      for (const auto& [id, values] : initial(terrain_, params_)) backend_->set_field(id, values);
   stats_ = backend_->stats();
   std::vector<double> coast_bed;
   for (const auto cell : coast_cells_)

@@ -197,16 +197,17 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
   RestartPoint p;
   p.time = times_[index];
   p.steps = static_cast<long>(steps[index]);
-  // Files of erodem before the bed residual and the moved volumes (2026-11-25) lack those:
-  // they start at 0 (the residual then holds nothing yet, as in any new run).
+  // Files of erodem before the bed residual and the moved volumes (2026-11-25) or the snow pack
+  // (2026-11-26) lack those: they start at 0 (the residual then holds nothing yet, as in any
+  // new run; a run without snow has none).
   for (const auto& e : ledger_entries()) {
     const std::string name = std::string("restart/ledger_") + e.name;
     p.ledger.*e.member =
-        exists(file_, name) || !e.moved ? read_doubles(file_, name, path_).at(index) : 0.0;
+        exists(file_, name) || !e.zero_if_absent ? read_doubles(file_, name, path_).at(index) : 0.0;
   }
   for (FieldId id : state_fields()) {
     const std::string name = std::string("restart/") + field_info(id).name;
-    if (id == FieldId::bed_residual && !exists(file_, name)) {
+    if (field_info(id).restart_zero_if_absent && !exists(file_, name)) {
       p.fields.emplace_back(grid_.cells(), 0.0);
       continue;
     }

@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "common/snow.h"
 #include "common/sources.h"
 #include "cpu/cpu_backend.hpp"
 #include "erodem/error.hpp"
@@ -124,6 +125,7 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
   // Each generic sweep of the process table by its name, with its cell function.
   static const std::pair<const char*, Run> sweeps[] = {
       {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
+      {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
   };
   for (const auto& [name, run] : sweeps)
     if (std::string(name) == sweep.name) return (this->*run)(sweep, process, dt, tally);

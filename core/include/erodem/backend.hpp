@@ -24,6 +24,7 @@ enum class Process {
   transport,    ///< suspended sediment transport
   thermal,      ///< slope collapse
   evaporation,  ///< evaporation and the wetness running mean
+  snow,         ///< degree-day melt of the snow pack into the depth
 };
 const char* process_name(Process p);
 

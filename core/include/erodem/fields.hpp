@@ -40,7 +40,9 @@ enum FieldFlag : unsigned {
   X(initial_bed, "m", "bed elevation at the start of the run", kStateField)                        \
   /* the part of the bed below the precision of `bed` (m; compensated.h) */                        \
   X(bed_residual, "m", "bed elevation below the precision of bed (the bed is bed + bed_residual)", \
-    kStateField | kRestartZero)
+    kStateField | kRestartZero)                                                                    \
+  /* the snow pack (snow.h); files before 2026-11-26 restart without snow */                       \
+  X(snow, "m", "snow water equivalent", kStateField | kOutputField | kRestartZero)
 
 enum class FieldId {
 #define ERODEM_FIELD_ID(id, units, long_name, flags) id,

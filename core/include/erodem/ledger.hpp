@@ -2,6 +2,8 @@
 // double precision whatever the precision of the fields.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -12,8 +14,9 @@ namespace erodem {
 /// step's amount, summed as the process ran) and of Ledger (cumulative), an entry of
 /// ledger_entries() and of tally_table() (process.hpp), added in this order. This list is the
 /// one place a new tally is declared; the closures below say which budget it enters.
-///   X(name, moved, doc): `moved` is true for the volumes moved inside the domain (the
-///   closures' scales; absent in files before 2026-11-25).
+///   X(name, zero_if_absent, doc): `zero_if_absent` for the tallies added after the first
+///   result files (the moved volumes of 2026-11-25, the snow melt of 2026-11-26): a restart
+///   from a file without them starts them at 0.
 #define ERODEM_TALLIES(X)                                                                  \
   X(boundary_out, false, "net water out through open / fixed-level ghosts")                \
   X(evaporated, false, "water evaporated")                                                 \
@@ -25,12 +28,13 @@ namespace erodem {
   X(eroded, true, "bed taken into suspension")                                             \
   X(deposited, true, "suspended sediment laid down on the bed")                            \
   X(sediment_exchanged, true, "sediment the cells gave through their faces")               \
-  X(thermal_moved, true, "bed moved between cells by slope collapse")
+  X(thermal_moved, true, "bed moved between cells by slope collapse")                      \
+  X(snow_melted, true, "snow melted into the water depth (water equivalent)")
 
 /// The volumes (m^3) that crossed the model's boundaries or moved inside it during the
 /// processes run so far in one step (ERODEM_TALLIES).
 struct StepTally {
-#define ERODEM_TALLY_MEMBER(name, moved, doc) double name = 0.0;
+#define ERODEM_TALLY_MEMBER(name, zero_if_absent, doc) double name = 0.0;
   ERODEM_TALLIES(ERODEM_TALLY_MEMBER)
 #undef ERODEM_TALLY_MEMBER
 };
@@ -45,7 +49,7 @@ struct Ledger {
   double material_initial = 0.0;
   double material = 0.0;
   // the cumulative tallies (ERODEM_TALLIES)
-#define ERODEM_TALLY_MEMBER(name, moved, doc) double name = 0.0;
+#define ERODEM_TALLY_MEMBER(name, zero_if_absent, doc) double name = 0.0;
   ERODEM_TALLIES(ERODEM_TALLY_MEMBER)
 #undef ERODEM_TALLY_MEMBER
 
@@ -53,24 +57,40 @@ struct Ledger {
   /// against this fraction of the volume on the grid (the rounding of a double sum).
   static constexpr double kVolumeEpsilon = std::numeric_limits<double>::epsilon();
 
-  /// V(t) - V(0) - rain - inflow + out + evaporated - clipped: 0 up to rounding (m^3).
+  /// V(t) - V(0) - rain - inflow + out + evaporated - clipped - snow melted: 0 up to rounding
+  /// (m^3).
   double closure_error() const {
-    return water - water_initial - rain - inflow + boundary_out + evaporated - clipped;
+    return water - water_initial - rain - inflow + boundary_out + evaporated - clipped -
+           snow_melted;
   }
-  /// What moved of the water (m^3): max(rain + inflow + |boundary out| + evaporated, water
-  /// exchanged between cells, kVolumeEpsilon * water on the grid).
-  double water_moved() const;
+  /// What moved of the water (m^3): max(rain + inflow + |boundary out| + evaporated + snow
+  /// melted, water exchanged between cells, kVolumeEpsilon * water on the grid).
+  double water_moved() const {
+    return std::max({rain + inflow + std::abs(boundary_out) + evaporated + snow_melted,
+                     water_exchanged,
+                     kVolumeEpsilon * std::max(std::abs(water_initial), std::abs(water))});
+  }
   /// Closure error relative to water_moved().
-  double relative_closure_error() const;
+  double relative_closure_error() const {
+    const double scale = water_moved();
+    return scale > 0 ? closure_error() / scale : 0.0;
+  }
   /// M(t) - M(0) + sediment out - transport change: 0 up to rounding (m^3).
   double material_closure_error() const {
     return material - material_initial + sediment_out - transport_change;
   }
   /// What moved of the material (m^3): max(eroded + deposited + sediment out, sediment and
   /// bed exchanged between cells, kVolumeEpsilon * material on the grid).
-  double material_moved() const;
+  double material_moved() const {
+    return std::max({eroded + deposited + std::abs(sediment_out),
+                     sediment_exchanged + thermal_moved + std::abs(transport_change),
+                     kVolumeEpsilon * std::max(std::abs(material_initial), std::abs(material))});
+  }
   /// Material closure error relative to material_moved().
-  double relative_material_closure_error() const;
+  double relative_material_closure_error() const {
+    const double scale = material_moved();
+    return scale > 0 ? material_closure_error() / scale : 0.0;
+  }
 
   /// A human-readable table.
   std::string format() const;
@@ -81,7 +101,9 @@ struct Ledger {
 struct LedgerEntry {
   const char* name;
   double Ledger::*member;
-  bool moved = false;  ///< one of the moved volumes (absent in files before 2026-11-25)
+  /// Absent from files written before it existed: a restart from such a file starts it at 0
+  /// (the moved volumes, 2026-11-25; the snow melt, 2026-11-26).
+  bool zero_if_absent = false;
 };
 
 /// Every kept entry of the ledger: the volumes on the grid, rain and inflow, then the tallies

@@ -118,6 +118,17 @@ struct Params {
     double rate = 0.0;  ///< K_e (1/s)
   } evaporation;
 
+  struct Snow {
+    bool enabled = false;
+    double initial = 0.0;                   ///< initial snow water equivalent S_0 (m)
+    std::optional<double> snow_line;        ///< the initial pack lies where bed >= this (m)
+    double melt_factor = 4.0e-3 / 86400.0;  ///< degree-day factor DDF (m/s per K): 4 mm/d/K
+    double melt_temperature = 0.0;          ///< T_melt (degrees C)
+    double air_temperature = 0.0;           ///< T_ref, the air temperature at z_ref (degrees C)
+    double reference_elevation = 0.0;       ///< z_ref (m)
+    double lapse_rate = -0.0065;            ///< dT/dz (K/m)
+  } snow;
+
   struct Boundary {
     BoundaryKind north = BoundaryKind::closed;
     BoundaryKind south = BoundaryKind::closed;

@@ -10,9 +10,11 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "erodem/backend.hpp"
+#include "erodem/grid.hpp"
 #include "erodem/ledger.hpp"
 #include "erodem/params.hpp"
 
@@ -83,6 +85,12 @@ struct ProcessInfo {
   std::vector<const char*> tallies;
   /// The file of kernels/opencl/ with its kernels.
   const char* opencl_source;
+  /// The initial values of fields it owns (a field of field_table() and one value per DEM
+  /// cell, row-major), from the terrain and the parameters: Simulation sets them when it is
+  /// built, before the initial ledger (a restart then replaces them). nullptr: none (the
+  /// backends start every field they do not build from the terrain at 0).
+  std::vector<std::pair<FieldId, std::vector<double>>> (*initial)(const Terrain&,
+                                                                  const Params&) = nullptr;
 };
 
 /// Every process, in step order (the sources run after the flow: model.md section 2).
