@@ -62,7 +62,8 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   row_sums_a_.assign(H_, 0.0);
   row_sums_b_.assign(H_, 0.0);
   row_sums_c_.assign(H_, 0.0);
-  bind_storage();
+  const std::size_t cells = n;
+  fields_.bind(*this, [cells] { return Field(cells, Real(0)); });
   run_boundary();
 }
 
@@ -229,39 +230,6 @@ FieldStats CpuBackend<Real>::stats() {
 }
 
 template <class Real>
-void CpuBackend<Real>::bind_storage() {
-  auto bind = [&](FieldId id, Field* f, Field* twin = nullptr) {
-    storage_[static_cast<std::size_t>(id)] = f;
-    twin_storage_[static_cast<std::size_t>(id)] = twin;
-  };
-  bind(FieldId::bed, &bed_, &bed_next_);
-  bind(FieldId::water_depth, &depth_, &depth_next_);
-  bind(FieldId::sediment, &sediment_, &sediment_next_);
-  bind(FieldId::velocity_x, &velocity_x_);
-  bind(FieldId::velocity_y, &velocity_y_);
-  bind(FieldId::flux_left, &flux_[ERODEM_LEFT]);
-  bind(FieldId::flux_right, &flux_[ERODEM_RIGHT]);
-  bind(FieldId::flux_top, &flux_[ERODEM_TOP]);
-  bind(FieldId::flux_bottom, &flux_[ERODEM_BOTTOM]);
-  bind(FieldId::hardness, &hardness_);
-  bind(FieldId::wetness, &wetness_);
-  bind(FieldId::manning_n, &manning_);
-  bind(FieldId::initial_bed, &bed0_);
-  bind(FieldId::bed_residual, &bed_residual_);
-  const std::size_t n = static_cast<std::size_t>(W_) * H_;
-  for (const auto& f : field_table()) {
-    const auto k = static_cast<std::size_t>(f.id);
-    if (f.derived || storage_[k]) continue;
-    generic_.push_back(std::make_unique<Field>(n, Real(0)));
-    storage_[k] = generic_.back().get();
-    if (f.twin) {
-      generic_.push_back(std::make_unique<Field>(n, Real(0)));
-      twin_storage_[k] = generic_.back().get();
-    }
-  }
-}
-
-template <class Real>
 std::vector<double> CpuBackend<Real>::field(FieldId id) const {
   std::vector<double> out(static_cast<std::size_t>(nx_) * ny_);
   auto* self = const_cast<CpuBackend*>(this);
@@ -282,7 +250,7 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
     throw Error(ExitCode::usage,
                 fmt::format("field '{}' is derived and cannot be set", field_info(id).name));
   // Fields kept in two buffers get both, so the next step starts from the new values.
-  Field* twin = twin_storage_[static_cast<std::size_t>(id)];
+  Field* twin = fields_.twin(id);
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, r + 1);

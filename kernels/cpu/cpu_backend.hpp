@@ -18,6 +18,7 @@
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
 #include "erodem/process.hpp"
+#include "field_registry.hpp"
 #include "stagger.hpp"
 
 /// Before a cell loop whose iterations write only their own cells: tells GCC that the
@@ -114,10 +115,9 @@ class CpuBackend final : public Backend {
   /// A per-cell field: each array at its own offset modulo 4 KiB (stagger.hpp).
   using Field = std::vector<Real, StaggeredAllocator<Real>>;
   Field* field_storage(FieldId id) {
-    return storage_[static_cast<std::size_t>(id)];
+    return fields_.get(id);
   }
-  /// Points storage_ and twin_storage_ at the members and allocates the other fields.
-  void bind_storage();
+  friend class FieldRegistry<Field>;
   /// Field `id` (stored in `src`, from field_storage) at padded cell `p`, as field() gives
   /// it: the bed with its residual, the erosion from the bed pair and the initial bed.
   double value_at(FieldId id, const Field* src, std::size_t p) const {
@@ -143,11 +143,9 @@ class CpuBackend final : public Backend {
   std::array<Field, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
   Field velocity_x_, velocity_y_;
   Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
-  // Every field's storage by FieldId (nullptr: derived) and the second buffer of the twins
-  // (FieldInfo::twin): the members above for the fields the hand-written processes bind, an
-  // array of generic_ (zeros) for any other.
-  std::array<Field*, kFieldCount> storage_{}, twin_storage_{};
-  std::vector<std::unique_ptr<Field>> generic_;
+  // Every field's storage by FieldId: the members above, and an array (zeros) for any other
+  // field of ERODEM_FIELDS (field_registry.hpp).
+  FieldRegistry<Field> fields_;
   std::vector<double> row_sums_a_, row_sums_b_, row_sums_c_;  // scratch for per-row reductions
   std::vector<std::vector<double>> row_sums_;  // per tally of a generic sweep (sweeps.cpp)
   // The step under way (begin_step .. end_step): its inputs and its tallies so far.

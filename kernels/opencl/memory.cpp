@@ -57,38 +57,6 @@ void OpenClBackend::read(const Buffer& b, std::size_t bytes, void* dst, bool blo
         "clEnqueueReadBuffer");
 }
 
-void OpenClBackend::bind_storage() {
-  auto bind = [&](FieldId id, Buffer* b, Buffer* twin = nullptr) {
-    storage_[static_cast<std::size_t>(id)] = b;
-    twin_storage_[static_cast<std::size_t>(id)] = twin;
-  };
-  bind(FieldId::bed, &bed_, &bed_next_);
-  bind(FieldId::water_depth, &depth_, &depth_next_);
-  bind(FieldId::sediment, &sediment_, &sediment_next_);
-  bind(FieldId::velocity_x, &velocity_x_);
-  bind(FieldId::velocity_y, &velocity_y_);
-  bind(FieldId::flux_left, &flux_[ERODEM_LEFT]);
-  bind(FieldId::flux_right, &flux_[ERODEM_RIGHT]);
-  bind(FieldId::flux_top, &flux_[ERODEM_TOP]);
-  bind(FieldId::flux_bottom, &flux_[ERODEM_BOTTOM]);
-  bind(FieldId::hardness, &hardness_);
-  bind(FieldId::wetness, &wetness_);
-  bind(FieldId::manning_n, &manning_);
-  bind(FieldId::initial_bed, &bed0_);
-  bind(FieldId::bed_residual, &bed_residual_);
-  const std::vector<float> zeros(n_, 0.0f);
-  for (const auto& f : field_table()) {
-    const auto k = static_cast<std::size_t>(f.id);
-    if (f.derived || storage_[k]) continue;
-    generic_.push_back(std::make_unique<Buffer>(upload(zeros)));
-    storage_[k] = generic_.back().get();
-    if (f.twin) {
-      generic_.push_back(std::make_unique<Buffer>(upload(zeros)));
-      twin_storage_[k] = generic_.back().get();
-    }
-  }
-}
-
 namespace {
 
 /// The DEM cells (the padded raster without its halo) of a buffer, row-major (ny, nx).
@@ -232,7 +200,7 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
     throw Error(ExitCode::usage,
                 fmt::format("field '{}' is derived and cannot be set", field_info(id).name));
   // Fields kept in two buffers get both, so the next step starts from the new values.
-  Buffer* twin = twin_storage_[static_cast<std::size_t>(id)];
+  Buffer* twin = fields_.twin(id);
   const std::vector<float> v(values.begin(), values.end());
   write_interior(queue_.get(), dst->get(), nx_, ny_, v);
   if (twin) write_interior(queue_.get(), twin->get(), nx_, ny_, v);

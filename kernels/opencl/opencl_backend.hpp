@@ -23,6 +23,7 @@
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
 #include "erodem/process.hpp"
+#include "field_registry.hpp"
 
 namespace erodem::opencl {
 
@@ -194,9 +195,8 @@ class OpenClBackend final : public Backend {
   void deliver_tallies();
   /// Reads and delivers the pending tallies now (blocking).
   void flush_tallies();
-  Buffer* field_buffer(FieldId id) { return storage_[static_cast<std::size_t>(id)]; }
-  /// Points storage_ and twin_storage_ at the members and allocates the other fields (zeros).
-  void bind_storage();
+  Buffer* field_buffer(FieldId id) { return fields_.get(id); }
+  friend class FieldRegistry<Buffer>;
   /// The buffers field `id` is composed from, as field() composes them (compose): the bed
   /// and its residual; the initial bed, the bed and its residual for the erosion; else the
   /// field's own buffer.
@@ -242,11 +242,9 @@ class OpenClBackend final : public Backend {
   std::array<Buffer, 4> flux_, flux_next_;
   Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
-  // Every field's buffer by FieldId (nullptr: derived) and the second buffer of the twins
-  // (FieldInfo::twin): the members above for the fields the hand-written processes bind, a
-  // buffer of generic_ for any other.
-  std::array<Buffer*, kFieldCount> storage_{}, twin_storage_{};
-  std::vector<std::unique_ptr<Buffer>> generic_;
+  // Every field's buffer by FieldId: the members above, and a buffer (zeros) for any other
+  // field of ERODEM_FIELDS (field_registry.hpp).
+  FieldRegistry<Buffer> fields_;
   Buffer partial_a_, partial_b_, partial_cells_;
   Buffer row_sums_, row_cells_;         // stats_rows: one result per padded row 1 .. H - 2
   Buffer tally_partials_, tally_sums_;  // [slot][tally_stride_] partials, [slot] sums
