@@ -12,6 +12,7 @@
 #endif
 
 #include "common/stats.h"
+#include "stats_merge.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
@@ -160,32 +161,29 @@ std::vector<double> CpuBackend<Real>::sample(const std::vector<std::int64_t>& ce
 
 template <class Real>
 FieldStats CpuBackend<Real>::stats() {
-  struct Row {
-    double water = 0, material = 0, sediment = 0, max_d = -1, max_v2 = -1;
-    std::int64_t arg_d = -1, arg_v = -1, bad = -1;
-  };
-  std::vector<Row> rows(H_);
+  std::vector<RowStats> rows(static_cast<std::size_t>(H_ - 2));
   const Kind* kind = kind_.data();
   const Real *bed = bed_.data(), *bed_lo = bed_residual_.data(), *depth = depth_.data(),
              *sediment = sediment_.data(), *vx = velocity_x_.data(), *vy = velocity_y_.data();
   for_rows(1, H_ - 1, [&](int y) {
-    Row row;
+    RowStats row;
     const double a = area_[y];
     const std::size_t base = static_cast<std::size_t>(y) * W_;
     const std::int64_t row_cell = static_cast<std::int64_t>(y - 1) * nx_ - 1;
     double water = 0, material = 0, sed = 0, max_d = -1, max_v2 = -1;
+    std::size_t fastest = 0;
     for (int x = 1; x < W_ - 1; ++x) {
       const std::size_t i = base + static_cast<std::size_t>(x);
       if (kind[i] != ERODEM_CELL_ACTIVE) continue;
       const Real d = depth[i], b = bed[i], s = sediment[i];
-      if (row.bad < 0 && !cell::cell_state_ok(b, d, s)) row.bad = row_cell + x;
+      if (row.bad_cell < 0 && !cell::cell_state_ok(b, d, s)) row.bad_cell = row_cell + x;
       water += static_cast<double>(d) * a;
       material +=
           (static_cast<double>(b) + static_cast<double>(bed_lo[i]) + static_cast<double>(s)) * a;
       sed += static_cast<double>(s) * a;
       if (d > max_d) {
         max_d = d;
-        row.arg_d = row_cell + x;
+        row.max_depth_cell = row_cell + x;
       }
       // The squared speed ranks the cells (products of floats are exact in double), as in
       // stats.cl; the winner's speed is hypot below.
@@ -193,40 +191,20 @@ FieldStats CpuBackend<Real>::stats() {
       const double v2 = u * u + v * v;
       if (v2 > max_v2) {
         max_v2 = v2;
-        row.arg_v = row_cell + x;
+        row.max_speed_cell = row_cell + x;
+        fastest = i;
       }
     }
     row.water = water;
     row.material = material;
     row.sediment = sed;
-    row.max_d = max_d;
-    row.max_v2 = max_v2;
-    rows[y] = row;
+    row.max_depth = max_d;
+    row.max_speed2 = max_v2;
+    if (row.max_speed_cell >= 0)
+      row.speed = std::hypot(static_cast<double>(vx[fastest]), static_cast<double>(vy[fastest]));
+    rows[static_cast<std::size_t>(y - 1)] = row;
   });
-  FieldStats st;
-  st.max_depth = 0.0;
-  st.max_speed = 0.0;
-  double best_v2 = -1;
-  for (const auto& row : rows) {
-    st.water_volume += row.water;
-    st.material_volume += row.material;
-    st.sediment_volume += row.sediment;
-    if (row.max_d > st.max_depth || (st.max_depth_cell < 0 && row.arg_d >= 0)) {
-      st.max_depth = std::max(0.0, row.max_d);
-      st.max_depth_cell = row.arg_d;
-    }
-    if (row.arg_v >= 0 && (st.max_speed_cell < 0 || row.max_v2 > best_v2)) {
-      best_v2 = row.max_v2;
-      st.max_speed_cell = row.arg_v;
-    }
-    if (st.bad_cell < 0 && row.bad >= 0) st.bad_cell = row.bad;
-  }
-  if (st.max_speed_cell >= 0) {
-    const auto i = padded(st.max_speed_cell);
-    st.max_speed = std::max(
-        0.0, std::hypot(static_cast<double>(velocity_x_[i]), static_cast<double>(velocity_y_[i])));
-  }
-  return st;
+  return merge_row_stats(rows);
 }
 
 template <class Real>

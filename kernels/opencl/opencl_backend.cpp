@@ -17,6 +17,7 @@
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
 #include "erodem/process.hpp"
+#include "stats_merge.hpp"
 #include "opencl/launch.hpp"
 
 namespace erodem {
@@ -417,31 +418,21 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
     *probes =
         gather ? compose_gathered(probe_fields_, probe_raw_, probe_count_) : std::vector<double>();
   const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * 6);
-  // Rows in order, with the rules of CpuBackend::stats: the max depth starts at 0 and a
-  // later row takes it when larger (or when none has been taken); the max speed ranks the
-  // rows by the squared speed; the first bad cell.
-  FieldStats st;
-  st.max_depth = 0.0;
-  st.max_speed = 0.0;
-  double best_v2 = -1;
-  for (std::size_t y = 0; y < static_cast<std::size_t>(rows); ++y) {
-    st.water_volume += sums[6 * y + 0];
-    st.material_volume += sums[6 * y + 1];
-    st.sediment_volume += sums[6 * y + 2];
-    const double max_d = sums[6 * y + 3], max_v2 = sums[6 * y + 4];
-    const std::int64_t arg_d = cells[3 * y + 0], arg_v = cells[3 * y + 1], bad = cells[3 * y + 2];
-    if (max_d > st.max_depth || (st.max_depth_cell < 0 && arg_d >= 0)) {
-      st.max_depth = std::max(0.0, max_d);
-      st.max_depth_cell = arg_d;
-    }
-    if (arg_v >= 0 && (st.max_speed_cell < 0 || max_v2 > best_v2)) {
-      best_v2 = max_v2;
-      st.max_speed_cell = arg_v;
-      st.max_speed = std::max(0.0, sums[6 * y + 5]);
-    }
-    if (st.bad_cell < 0 && bad >= 0) st.bad_cell = bad;
+  // Rows in order, merged as the CPU's (stats_merge.hpp).
+  std::vector<RowStats> row_stats(static_cast<std::size_t>(rows));
+  for (std::size_t y = 0; y < row_stats.size(); ++y) {
+    RowStats& row = row_stats[y];
+    row.water = sums[6 * y + 0];
+    row.material = sums[6 * y + 1];
+    row.sediment = sums[6 * y + 2];
+    row.max_depth = sums[6 * y + 3];
+    row.max_speed2 = sums[6 * y + 4];
+    row.speed = sums[6 * y + 5];
+    row.max_depth_cell = cells[3 * y + 0];
+    row.max_speed_cell = cells[3 * y + 1];
+    row.bad_cell = cells[3 * y + 2];
   }
-  return st;
+  return merge_row_stats(row_stats);
 }
 
 }  // namespace opencl
