@@ -185,4 +185,17 @@ inline double erodem_cbrt_positive(double x) {
 #define ERODEM_TOP 2    /* north, y - 1 */
 #define ERODEM_BOTTOM 3 /* south, y + 1 */
 
+/* The geometry between padded rows j and j + 1 (each row has its own dx, dy: geographic grids),
+ * one formula for every stencil and both backends: the width (m) of the faces between them,
+ * the mean of the rows' east-west sizes, and the distance (m) between their centres, the mean
+ * of their north-south sizes. */
+ERODEM_BEGIN_NAMESPACE
+ERODEM_FN real face_y_width(GLOBAL const real* dx, int j) {
+  return (real)0.5 * (dx[j] + dx[j + 1]);
+}
+ERODEM_FN real centre_distance_y(GLOBAL const real* dy, int j) {
+  return (real)0.5 * (dy[j] + dy[j + 1]);
+}
+ERODEM_END_NAMESPACE
+
 #endif

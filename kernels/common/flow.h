@@ -328,11 +328,10 @@ ERODEM_FN real local_inertial_face_y_interior(int x, int y, int W, GLOBAL const 
                                               real theta, real dry_depth) {
   const int a = x + y * W; /* a - W >= 0 and a + 2 W < W * H */
   return local_inertial_face_at(a, a + W, a - W, a + 2 * W, kind[a - W] != ERODEM_CELL_WALL,
-                                kind[a + 2 * W] != ERODEM_CELL_WALL,
-                                (real)0.5 * (dx[y - 1] + dx[y]), (real)0.5 * (dx[y] + dx[y + 1]),
-                                (real)0.5 * (dx[y + 1] + dx[y + 2]),
-                                (real)0.5 * (dy[y] + dy[y + 1]), kind, bed, depth, manning,
-                                f_bottom, f_top, dt, gravity, theta, dry_depth);
+                                kind[a + 2 * W] != ERODEM_CELL_WALL, face_y_width(dx, y - 1),
+                                face_y_width(dx, y), face_y_width(dx, y + 1),
+                                centre_distance_y(dy, y), kind, bed, depth, manning, f_bottom,
+                                f_top, dt, gravity, theta, dry_depth);
 }
 
 /* The same for any row 0 <= y <= H - 1 (any value for y = H - 1: no such face); rows 0,
@@ -350,13 +349,12 @@ ERODEM_FN real local_inertial_face_y(int x, int y, int W, int H, GLOBAL const er
   const int a = x + yc * W;
   const int y_up = yc >= 1 ? yc - 1 : yc;           /* clamped: unused at the edge */
   const int y_down = yc + 2 <= H - 1 ? yc + 1 : yc; /* clamped: unused at the edge */
-  return local_inertial_face_at(
-      a, a + W, x + y_up * W, x + (y_down + 1) * W,
-      kind_at(kind, x, yc - 1, W, H) != ERODEM_CELL_WALL,
-      kind_at(kind, x, yc + 2, W, H) != ERODEM_CELL_WALL, (real)0.5 * (dx[y_up] + dx[y_up + 1]),
-      (real)0.5 * (dx[yc] + dx[yc + 1]), (real)0.5 * (dx[y_down] + dx[y_down + 1]),
-      (real)0.5 * (dy[yc] + dy[yc + 1]), kind, bed, depth, manning, f_bottom, f_top, dt, gravity,
-      theta, dry_depth);
+  return local_inertial_face_at(a, a + W, x + y_up * W, x + (y_down + 1) * W,
+                                kind_at(kind, x, yc - 1, W, H) != ERODEM_CELL_WALL,
+                                kind_at(kind, x, yc + 2, W, H) != ERODEM_CELL_WALL,
+                                face_y_width(dx, y_up), face_y_width(dx, yc),
+                                face_y_width(dx, y_down), centre_distance_y(dy, yc), kind, bed,
+                                depth, manning, f_bottom, f_top, dt, gravity, theta, dry_depth);
 }
 
 /* The four face discharges around a cell of kind k (m^3/s; q_left, q_top positive into the

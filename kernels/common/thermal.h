@@ -31,8 +31,8 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real rate = p.rate, tan_talus = p.tan_talus;
   const int i = x + y * W;
   const real b = bed[i];
-  const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
-  const real dist_b = (real)0.5 * (dy[y] + dy[y + 1]);
+  const real dist_t = centre_distance_y(dy, y - 1);
+  const real dist_b = centre_distance_y(dy, y);
   /* every load unconditional and every choice a select: branch-free, so loops vectorise */
   const real b_l = bed[i - 1], b_r = bed[i + 1], b_t = bed[i - W], b_b = bed[i + W];
   const real x_l = talus_excess(b, b_l, dx[y], tan_talus);
@@ -68,8 +68,8 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real tan_talus = p.tan_talus;
   const int i = x + y * W;
   const real b = bed[i];
-  const real dist_t = (real)0.5 * (dy[y] + dy[y - 1]);
-  const real dist_b = (real)0.5 * (dy[y] + dy[y + 1]);
+  const real dist_t = centre_distance_y(dy, y - 1);
+  const real dist_b = centre_distance_y(dy, y);
   const real dist_x = dx[y], cell_area = area[y]; /* loaded unconditionally */
   /* inactive neighbours add +0 (branch-free, the same sums as skipping them) */
   const int has_l = kind[i - 1] == ERODEM_CELL_ACTIVE, has_r = kind[i + 1] == ERODEM_CELL_ACTIVE;

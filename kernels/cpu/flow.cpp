@@ -33,7 +33,7 @@ template <class Real>
 void unit_discharge_y_row(int j, int W, const Real* __restrict f_top,
                           const Real* __restrict f_bottom, const Real* __restrict dx,
                           Real* __restrict q) {
-  const Real width = Real(0.5) * (dx[j] + dx[j + 1]);
+  const Real width = cell::face_y_width(dx, j);
   const Real* __restrict fb = f_bottom + static_cast<std::ptrdiff_t>(j) * W;
   const Real* __restrict ft = f_top + static_cast<std::ptrdiff_t>(j + 1) * W;
   for (int x = 0; x < W; ++x) q[x] = cell::face_unit_discharge(fb[x], ft[x], width);
@@ -57,8 +57,7 @@ void face_y_row(int j, int W, int H, const int* __restrict k_up, const int* __re
   const Real* __restrict b_a = bed + row, * __restrict b_b = bed + row + W;
   const Real* __restrict d_a = depth + row, * __restrict d_b = depth + row + W;
   const Real* __restrict n_a = manning + row, * __restrict n_b = manning + row + W;
-  const Real width = Real(0.5) * (dx[j] + dx[j + 1]);
-  const Real dist = Real(0.5) * (dy[j] + dy[j + 1]);
+  const Real width = cell::face_y_width(dx, j), dist = cell::centre_distance_y(dy, j);
   const Real dt = p.dt, g = p.gravity, theta = p.theta, dry = p.dry_depth;
   ERODEM_IVDEP
   for (int x = 0; x < W; ++x)
