@@ -14,9 +14,9 @@ namespace erodem {
 /// The statistics of one padded row of DEM cells.
 struct RowStats {
   double water = 0, material = 0, sediment = 0;  ///< volumes (m^3)
-  double max_depth = -1;     ///< the row's largest depth (m); -1: no active cell
-  double max_speed2 = -1;    ///< the row's largest squared speed (m^2/s^2); -1: none
-  double speed = -1;         ///< the speed (m/s, hypot) of the cell of max_speed2
+  double max_depth = -1;   ///< the row's largest depth (m); -1: no active cell
+  double max_speed2 = -1;  ///< the row's largest squared speed (m^2/s^2); -1: none
+  double speed = -1;       ///< the speed (m/s, hypot) of the cell of max_speed2
   std::int64_t max_depth_cell = -1, max_speed_cell = -1;  ///< row-major DEM cells; -1: none
   std::int64_t bad_cell = -1;  ///< the row's first cell whose state is not physical; -1: none
 };

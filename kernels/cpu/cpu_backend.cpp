@@ -12,10 +12,10 @@
 #endif
 
 #include "common/stats.h"
-#include "stats_merge.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
+#include "stats_merge.hpp"
 
 namespace erodem {
 namespace ERODEM_CPU_NAMESPACE {

@@ -17,8 +17,8 @@
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
 #include "erodem/process.hpp"
-#include "stats_merge.hpp"
 #include "opencl/launch.hpp"
+#include "stats_merge.hpp"
 
 namespace erodem {
 namespace opencl {

@@ -13,6 +13,7 @@ __kernel void snow(int W, int H, __global const uchar* restrict kind,
   __local real s[ERODEM_CELL_GROUP_MAX];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real melted = 0;
-  if (!ERODEM_PAST_ROW(x, W)) snow_sweep_cell(x, y, W, kind, bed, snow, depth, area, dt, p, &melted);
+  if (!ERODEM_PAST_ROW(x, W))
+    snow_sweep_cell(x, y, W, kind, bed, snow, depth, area, dt, p, &melted);
   cell_group_sum(s, melted, partials + ERODEM_TALLY_SNOW_MELTED * stride + cell_group_index());
 }
