@@ -248,7 +248,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(AgreementCase{"local_inertial_conservative", FlowScheme::local_inertial,
                                     TransportScheme::conservative, true, 2.0},
                       AgreementCase{"pipes_semi_lagrangian", FlowScheme::pipes,
-                                    TransportScheme::semi_lagrangian, false, 0.5}),
+                                    TransportScheme::semi_lagrangian, false, 0.5},
+                      AgreementCase{"shallow_water_conservative", FlowScheme::shallow_water,
+                                    TransportScheme::conservative, true, 2.0}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
 
 }  // namespace

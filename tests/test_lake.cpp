@@ -113,7 +113,8 @@ TEST_P(RealDemLake, LakeAtRestWithSeaNodataStaysAtRest) {
   ASSERT_GT(dry, 1000);
   ASSERT_GT(coast, 10);
 
-  for (FlowScheme scheme : {FlowScheme::pipes, FlowScheme::local_inertial}) {
+  for (FlowScheme scheme :
+       {FlowScheme::pipes, FlowScheme::local_inertial, FlowScheme::shallow_water}) {
     const char* name = scheme_name(scheme);
     SCOPED_TRACE(name);
     auto sim = make_simulation(terrain, lake_params(scheme, dt), target());

@@ -129,6 +129,11 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
   p.transport.scheme = TransportScheme::semi_lagrangian;
   EXPECT_EQ(bytes(Process::flow), 41);
   EXPECT_EQ(bytes(Process::transport), 17);
+  // shallow water: kind bed depth q_x q_y manning | flux*4 q_x q_y; the water update and the
+  // velocity from q (kind depth q_x q_y | velocity_x, _y)
+  p.flow.scheme = FlowScheme::shallow_water;
+  EXPECT_EQ(bytes(Process::flow), 1 + 20 + 24);
+  EXPECT_EQ(bytes(Process::water), 37 + 1 + 12 + 8);
   p.evaporation.rate = 0;
   EXPECT_EQ(bytes(Process::evaporation), 13);  // the depth is only read
   p.rain.rate = 0;
@@ -153,21 +158,24 @@ TEST(ProcessTable, BedChangesWithErosionOrThermal) {
 
 TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
   // state_fields() and output.fields' choices as written by hand before the table
-  // (simulation.cpp and schema.cpp of 2026-11-25), as sets: the order is the table's now.
+  // (simulation.cpp and schema.cpp of 2026-11-25) with the snow pack and the shallow-water
+  // scheme's unit discharges added, as sets: the order is the table's now.
   std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
   for (FieldId id : state_fields()) state.insert(field_info(id).name);
-  EXPECT_EQ(state,
-            (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment", "velocity_x",
-                                   "velocity_y", "flux_left", "flux_right", "flux_top",
-                                   "flux_bottom", "wetness", "bed_residual", "snow"}));
+  EXPECT_EQ(state, (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment",
+                                          "velocity_x", "velocity_y", "flux_left", "flux_right",
+                                          "flux_top", "flux_bottom", "wetness", "bed_residual",
+                                          "snow", "momentum_x", "momentum_y"}));
   EXPECT_EQ(output,
             (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x", "velocity_y",
                                    "erosion", "wetness", "hardness", "flux_left", "flux_right",
-                                   "flux_top", "flux_bottom", "snow"}));
+                                   "flux_top", "flux_bottom", "snow", "momentum_x", "momentum_y"}));
   // a field restored from files that lack it starts at 0: the bed residual and the snow pack,
   // added later
   for (const auto& f : field_table())
-    EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual || f.id == FieldId::snow)
+    EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual || f.id == FieldId::snow ||
+                                            f.id == FieldId::momentum_x ||
+                                            f.id == FieldId::momentum_y)
         << f.name;
 }
 
@@ -178,13 +186,27 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // order)
   const auto k = opencl_cell_kernels();
   EXPECT_EQ(std::set<std::string>(k.begin(), k.end()),
-            (std::set<std::string>{
-                "sources_rain", "flow_pipes", "flow_pipes_interior", "flow_local_inertial_faces",
-                "flow_local_inertial_faces_x_interior", "flow_local_inertial_faces_y_interior",
-                "flow_local_inertial_split", "flow_local_inertial_split_interior", "water_update",
-                "erosion", "transport_conservative", "transport_semi_lagrangian", "thermal_share",
-                "thermal_apply", "evaporation", "snow", "field_stats", "edge_tallies"}));
-  EXPECT_EQ(k.size(), 18u) << "a kernel listed twice";
+            (std::set<std::string>{"sources_rain",
+                                   "flow_pipes",
+                                   "flow_pipes_interior",
+                                   "flow_local_inertial_faces",
+                                   "flow_local_inertial_faces_x_interior",
+                                   "flow_local_inertial_faces_y_interior",
+                                   "flow_local_inertial_split",
+                                   "flow_local_inertial_split_interior",
+                                   "water_update",
+                                   "erosion",
+                                   "transport_conservative",
+                                   "transport_semi_lagrangian",
+                                   "thermal_share",
+                                   "thermal_apply",
+                                   "evaporation",
+                                   "snow",
+                                   "flow_shallow_water",
+                                   "shallow_water_velocity",
+                                   "field_stats",
+                                   "edge_tallies"}));
+  EXPECT_EQ(k.size(), 20u) << "a kernel listed twice";
   EXPECT_EQ(opencl_program_order(),
             (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl",
                                       "water.cl", "erosion.cl", "transport.cl", "thermal.cl",

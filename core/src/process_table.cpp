@@ -33,6 +33,16 @@ bool rains(const Params& p) {
   return p.rain.rate > 0 || !p.rain.series.empty();
 }
 
+/// A sweep the backends run through their generic cell loop (SweepInfo::generic): its cell
+/// function is `<name>_sweep_cell`, its kernel `<name>`.
+SweepInfo generic_sweep(const char* name, std::vector<FieldUse> uses,
+                        std::vector<const char*> tallies) {
+  SweepInfo s{name, Domain::cells, std::move(uses), {name}};
+  s.generic = true;
+  s.tallies = std::move(tallies);
+  return s;
+}
+
 // ---- the sweeps of each process --------------------------------------------------------
 
 std::vector<SweepInfo> boundary_sweeps(const Params&) {
@@ -59,6 +69,23 @@ std::vector<SweepInfo> sources_sweeps(const Params& p) {
 std::vector<SweepInfo> flow_sweeps(const Params& p) {
   const std::vector<FieldUse> fluxes{
       {"flux_left", U}, {"flux_right", U}, {"flux_top", U}, {"flux_bottom", U}};
+  if (p.flow.scheme == FlowScheme::shallow_water) {
+    // shallow_water_cell (shallow_water.h): the four faces of each cell (Chen & Noelle
+    // reconstruction, HLLC) give its outflows and its new unit discharges
+    return {{"flow_shallow_water",
+             Domain::cells,
+             {{"kind", N},
+              {"bed", N},
+              {"water_depth", N},
+              {"momentum_x", U},
+              {"momentum_y", U},
+              {"manning_n", R},
+              {"flux_left", Wr},
+              {"flux_right", Wr},
+              {"flux_top", Wr},
+              {"flux_bottom", Wr}},
+             {"flow_shallow_water"}}};
+  }
   if (p.flow.scheme == FlowScheme::local_inertial) {
     // local_inertial_face + local_inertial_split (flow.h): the face discharges from the old
     // outflows, the levels and the face's Manning n; then the outflows of each cell
@@ -77,23 +104,35 @@ std::vector<SweepInfo> flow_sweeps(const Params& p) {
   return {{"flow_pipes", Domain::cells, uses, {"flow_pipes", "flow_pipes_interior"}}};
 }
 
-std::vector<SweepInfo> water_sweeps(const Params&) {
+std::vector<SweepInfo> water_sweeps(const Params& p) {
   // water_update_cell (water.h): the depth from the outflows in and out, the velocity from the
   // faces' discharges over their flow depths (bed and depth of the neighbours); the depth it
   // started from stays in the second buffer for conservative transport ("depth_flow")
-  return {{"water_update",
-           Domain::cells,
-           {{"kind", N},
-            {"bed", N},
-            {"water_depth", U},
-            {"flux_left", N},
-            {"flux_right", N},
-            {"flux_top", N},
-            {"flux_bottom", N},
-            {"velocity_x", Wr},
-            {"velocity_y", Wr}},
-           {"water_update", "edge_tallies"},
-           {"depth_flow"}}};
+  std::vector<SweepInfo> s{{"water_update",
+                            Domain::cells,
+                            {{"kind", N},
+                             {"bed", N},
+                             {"water_depth", U},
+                             {"flux_left", N},
+                             {"flux_right", N},
+                             {"flux_top", N},
+                             {"flux_bottom", N},
+                             {"velocity_x", Wr},
+                             {"velocity_y", Wr}},
+                            {"water_update", "edge_tallies"},
+                            {"depth_flow"}}};
+  if (p.flow.scheme == FlowScheme::shallow_water)
+    // shallow_water_velocity_sweep_cell (shallow_water.h): the velocity from the unit
+    // discharges over the new depth, in place of the faces'
+    s.push_back(generic_sweep("shallow_water_velocity",
+                              {{"kind", R},
+                               {"water_depth", R},
+                               {"momentum_x", R},
+                               {"momentum_y", R},
+                               {"velocity_x", Wr},
+                               {"velocity_y", Wr}},
+                              {}));
+  return s;
 }
 
 std::vector<SweepInfo> erosion_sweeps(const Params&) {
@@ -146,25 +185,18 @@ std::vector<SweepInfo> thermal_sweeps(const Params&) {
            {"thermal_apply"}}};
 }
 
-/// A sweep the backends run through their generic cell loop (SweepInfo::generic): its cell
-/// function is `<name>_sweep_cell`, its kernel `<name>`.
-SweepInfo generic_sweep(const char* name, std::vector<FieldUse> uses) {
-  SweepInfo s{name, Domain::cells, std::move(uses), {name}};
-  s.generic = true;
-  return s;
-}
-
 std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
   // evaporation_sweep_cell (sources.h): the depth decays (when the rate > 0) and the wetness
   // follows it
   return {generic_sweep(
-      "evaporation",
-      {{"kind", R}, {"water_depth", p.evaporation.rate > 0 ? U : R}, {"wetness", U}})};
+      "evaporation", {{"kind", R}, {"water_depth", p.evaporation.rate > 0 ? U : R}, {"wetness", U}},
+      {"evaporated"})};
 }
 
 std::vector<SweepInfo> snow_sweeps(const Params&) {
   // snow_sweep_cell (snow.h): the degree-day melt of the pack into the depth
-  return {generic_sweep("snow", {{"kind", R}, {"bed", R}, {"snow", U}, {"water_depth", U}})};
+  return {generic_sweep("snow", {{"kind", R}, {"bed", R}, {"snow", U}, {"water_depth", U}},
+                        {"snow_melted"})};
 }
 
 /// The initial pack: snow.initial on the active cells at or above snow.snow_line.
@@ -355,7 +387,7 @@ std::vector<std::string> opencl_cell_kernels() {
   Params p;
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
-  for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial})
+  for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial, FlowScheme::shallow_water})
     for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian}) {
       p.flow.scheme = flow;
       p.transport.scheme = transport;

@@ -68,8 +68,10 @@ const std::vector<Descriptor>& descriptor_table() {
 
       choice(ERODEM_FIELD(flow.scheme),
              Choices<FlowScheme>{{"pipes", FlowScheme::pipes},
-                                 {"local_inertial", FlowScheme::local_inertial}},
-             "flow scheme: pipes (Mei 2007) or local_inertial (Bates 2010)"),
+                                 {"local_inertial", FlowScheme::local_inertial},
+                                 {"shallow_water", FlowScheme::shallow_water}},
+             "flow scheme: pipes (Mei 2007), local_inertial (Bates 2010) or shallow_water "
+             "(HLLC, Chen & Noelle 2017)"),
       scalar_or_raster(ERODEM_FIELD(flow.manning_n), D::manning, at_least(0),
                        "Manning roughness n (s m^-1/3), uniform or a raster path"),
       number(ERODEM_FIELD(flow.theta), D::dimensionless, closed(0, 1),

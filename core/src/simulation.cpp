@@ -278,7 +278,11 @@ double Simulation::next_dt() const {
     // sources, d_max + s dt (s: source_rise_rate), and at a fixed-level face the sea's depth
     // over the active cell's bed (coast_depth). dt is the largest step whose fastest signal
     // crosses at most alpha dx_min.
-    const double reach = t.cfl * dx_min;
+    // The shallow-water scheme's condition is the unsplit one, dt max((|u| + c) / dx +
+    // (|v| + c) / dy) <= cfl (positivity; Audusse et al. 2004): with |u|, |v| <= the speed
+    // and dx, dy >= dx_min, half the reach of the others keeps it.
+    const double reach =
+        (params_.flow.scheme == FlowScheme::shallow_water ? 0.5 : 1.0) * t.cfl * dx_min;
     const double d = std::max(stats.max_depth, 0.0), s = source_rise_rate();
     dt = t.dt_max;
     if (coast_depth_ > 0) dt = std::min(dt, reach / std::sqrt(g * coast_depth_));
@@ -294,7 +298,7 @@ double Simulation::next_dt() const {
     // velocity over it is no speed a signal travels at; their waves move at sqrt(g A dx /
     // (l dy)), bounded below)
     const double u =
-        params_.flow.scheme == FlowScheme::local_inertial ? std::max(stats.max_speed, 0.0) : 0.0;
+        params_.flow.scheme != FlowScheme::pipes ? std::max(stats.max_speed, 0.0) : 0.0;
     if (d > 0 || s > 0 || u > 0) {
       // Newton from the right of the root: both starts have f >= 0, and f is convex and
       // increasing for dt > 0, so the iterates fall monotonically onto the root.
@@ -381,7 +385,7 @@ void Simulation::check_stability(double dt) const {
                             "bed {:.6g} m; {}",
                             steps_, time_, cell_name(stats.bad_cell), d, b, stability_advice()));
   }
-  if (params_.flow.scheme == FlowScheme::local_inertial && stats.max_depth > 0) {
+  if (params_.flow.scheme != FlowScheme::pipes && stats.max_depth > 0) {
     const double courant =
         dt * std::sqrt(params_.flow.gravity * stats.max_depth) / terrain_.grid.dx_min();
     if (courant > 1.0)

@@ -117,10 +117,12 @@ void CpuBackend<Real>::run(Process p) {
     case Process::thermal:
       run_thermal(dt, tally);
       break;
-    default:  // the processes whose sweeps are all generic (SweepInfo::generic)
-      for (const SweepInfo& s : process_info(p).sweeps(params_)) run_generic(s, p, dt, tally);
+    default:  // the processes whose sweeps are all generic
       break;
   }
+  // the generic sweeps of the process (SweepInfo::generic), after its own loops
+  for (const SweepInfo& s : process_info(p).sweeps(params_))
+    if (s.generic) run_generic(s, p, dt, tally);
 }
 
 template <class Real>

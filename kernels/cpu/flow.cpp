@@ -11,6 +11,8 @@
 
 #include <vector>
 
+#include "common/shallow_water.h"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -147,6 +149,27 @@ void CpuBackend<Real>::run_flow(Real dt) {
        *ob = flux_next_[3].data();
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const int W = W_, H = H_;
+  if (params_.flow.scheme == FlowScheme::shallow_water) {
+    // Every padded cell: its four faces, its outflows and (active) its new unit discharges
+    // into the second buffers, swapped below.
+    Field &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
+    Field &qx_next = *fields_.twin(FieldId::momentum_x),
+          &qy_next = *fields_.twin(FieldId::momentum_y);
+    const Real *q_x = qx.data(), *q_y = qy.data(), *manning = manning_.data();
+    Real *q_x_new = qx_next.data(), *q_y_new = qy_next.data();
+    const cell_params::FlowParams<Real> params = f;
+    for_rows(0, H, [=](int y) {
+      const Real step = dt;
+      const cell_params::FlowParams<Real> fp = params;
+      for (int x = 0; x < W; ++x)
+        cell::shallow_water_cell(x, y, W, H, kind, b, d, q_x, q_y, manning, dx, dy, area, step, fp,
+                                 ol, orr, ot, ob, q_x_new, q_y_new);
+    });
+    std::swap(qx, qx_next);
+    std::swap(qy, qy_next);
+    std::swap(flux_, flux_next_);
+    return;
+  }
   if (params_.flow.scheme == FlowScheme::pipes) {
     const Real area_pipe = f.pipe_area;
     const Real length = f.pipe_length;

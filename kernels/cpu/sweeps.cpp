@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "common/shallow_water.h"
 #include "common/snow.h"
 #include "common/sources.h"
 #include "cpu/cpu_backend.hpp"
@@ -50,6 +51,7 @@ inline void cell_row(int y, int W, const std::array<void*, N>& f, const real* ar
   const std::tuple<std::tuple_element_t<I, Args>...> ptr{
       static_cast<std::tuple_element_t<I, Args>>(f[I])...};
   const std::array<real*, M> tally = t;
+  (void)tally;  // none for a sweep without tallies
   const P p = params;
   const real step = dt;
   ERODEM_IVDEP
@@ -72,11 +74,11 @@ void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real 
 
   // the pointers of the uses, the parameter struct and the tallies, checked against the table
   const ProcessInfo& info = process_info(process);
-  if (sweep.uses.size() != nf || info.tallies.size() != nt)
+  if (sweep.uses.size() != nf || sweep.tallies.size() != nt)
     throw Error(ExitCode::internal,
                 fmt::format("sweep '{}': the table lists {} uses and {} tallies, its cell function "
                             "takes {} and {}",
-                            sweep.name, sweep.uses.size(), info.tallies.size(), nf, nt));
+                            sweep.name, sweep.uses.size(), sweep.tallies.size(), nf, nt));
   std::array<void*, nf> fields{};
   for (std::size_t k = 0; k < nf; ++k) {
     const std::string name = sweep.uses[k].field;
@@ -97,7 +99,7 @@ void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real 
   std::array<double StepTally::*, nt> members{};
   for (std::size_t t = 0; t < nt; ++t)
     for (const auto& e : tally_table())
-      if (std::string(e.name) == info.tallies[t]) members[t] = e.step;
+      if (std::string(e.name) == sweep.tallies[t]) members[t] = e.step;
   if (row_sums_.size() < nt) row_sums_.resize(nt);
   for (std::size_t t = 0; t < nt; ++t) row_sums_[t].assign(H_, 0.0);
 
@@ -126,6 +128,8 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
   static const std::pair<const char*, Run> sweeps[] = {
       {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
       {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
+      {"shallow_water_velocity",
+       &CpuBackend::cell_sweep<&cell::shallow_water_velocity_sweep_cell<Real>>},
   };
   for (const auto& [name, run] : sweeps)
     if (std::string(name) == sweep.name) return (this->*run)(sweep, process, dt, tally);

@@ -2,6 +2,7 @@
  * water too), as the CPU loop of kernels/cpu/flow.cpp; the host swaps the flux buffers. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "flow.h"
+#include "shallow_water.h"
 
 /* One work-item per padded cell (where the global size is rounded up, the work-items past
  * the raster stop); the host runs flow_pipes_interior on rows 1 .. H - 2 and this one on rows
@@ -121,4 +122,22 @@ __kernel void flow_local_inertial_split_interior(
   if (ERODEM_PAST_ROW(x, W)) return;
   flow_local_inertial_cell_interior(x, y, W, kind, depth, area, face_x, face_y, out_left, out_right,
                                     out_top, out_bottom, dt);
+}
+
+/* The shallow-water scheme (shallow_water.h): one work-item per padded cell (rows 0 .. H - 1);
+ * each writes its outflows and, for an active cell, its new unit discharges into the second
+ * buffers the host then swaps. */
+__kernel void flow_shallow_water(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict q_x,
+    __global const real* restrict q_y, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict area, real dt, FlowParams p, __global real* restrict out_left,
+    __global real* restrict out_right, __global real* restrict out_top,
+    __global real* restrict out_bottom, __global real* restrict q_x_new,
+    __global real* restrict q_y_new) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
+  shallow_water_cell(x, y, W, H, kind, bed, depth, q_x, q_y, manning, dx, dy, area, dt, p, out_left,
+                     out_right, out_top, out_bottom, q_x_new, q_y_new);
 }

@@ -74,7 +74,7 @@ void OpenClBackend::run_generic(const SweepInfo& sweep, Process process, Real dt
   set_arg(k, i++, tally_partials_);
   set_arg(k, i++, static_cast<cl_int>(tally_stride_));
   unsigned bits = 0;
-  for (const char* name : process_info(process).tallies)
+  for (const char* name : sweep.tallies)
     for (std::size_t slot = 0; slot < tally_table().size(); ++slot)
       if (std::string(tally_table()[slot].name) == name) bits |= 1u << slot;
   if (bits) defer(tally, bits);

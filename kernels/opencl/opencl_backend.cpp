@@ -213,10 +213,12 @@ void OpenClBackend::run(Process p) {
     case Process::thermal:
       run_thermal(dt, tally);
       break;
-    default:  // the processes whose sweeps are all generic (SweepInfo::generic)
-      for (const SweepInfo& s : process_info(p).sweeps(params_)) run_generic(s, p, dt, tally);
+    default:  // the processes whose sweeps are all generic
       break;
   }
+  // the generic sweeps of the process (SweepInfo::generic), after its own loops
+  for (const SweepInfo& s : process_info(p).sweeps(params_))
+    if (s.generic) run_generic(s, p, dt, tally);
 }
 
 StepResult OpenClBackend::end_step() {
@@ -285,6 +287,20 @@ void OpenClBackend::run_sources(const StepInputs& in) {
 }
 
 void OpenClBackend::run_flow(Real dt) {
+  if (params_.flow.scheme == FlowScheme::shallow_water) {
+    Buffer &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
+    Buffer &qx_next = *fields_.twin(FieldId::momentum_x),
+           &qy_next = *fields_.twin(FieldId::momentum_y);
+    cl_kernel k = kernel("flow_shallow_water");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_, dt,
+             cell_.flow, flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], qx_next,
+             qy_next);
+    launch_rows(k, 0, H_);
+    std::swap(qx, qx_next);
+    std::swap(qy, qy_next);
+    std::swap(flux_, flux_next_);
+    return;
+  }
   if (params_.flow.scheme == FlowScheme::pipes) {
     // The interior rows by a kernel without clamping, the first and last row by the general one.
     for (const char* name : {"flow_pipes_interior", "flow_pipes"})

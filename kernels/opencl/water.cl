@@ -4,6 +4,7 @@
  * faces with ghosts is summed over the cells beside ghosts only (edges.cl). The host swaps the
  * depth buffers. */
 #pragma OPENCL FP_CONTRACT OFF
+#include "shallow_water.h"
 #include "water.h"
 
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
@@ -28,4 +29,23 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
   const int g = cell_group_index();
   cell_group_sum2(s_clipped, s_given, clipped, given, partials + ERODEM_TALLY_CLIPPED * stride + g,
                   partials + ERODEM_TALLY_WATER_EXCHANGED * stride + g);
+}
+
+/* The shallow-water scheme's cell velocities (the generic sweep "shallow_water_velocity",
+ * shallow_water.h) from the unit discharges over the updated depth. */
+__kernel void shallow_water_velocity(int W, int H, __global const uchar* restrict kind,
+                                     __global const real* restrict depth,
+                                     __global const real* restrict q_x,
+                                     __global const real* restrict q_y,
+                                     __global real* restrict velocity_x,
+                                     __global real* restrict velocity_y,
+                                     __global const real* restrict area, real dt, WaterParams p,
+                                     __global acc_t* restrict partials, int stride) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  (void)H;
+  (void)partials;
+  (void)stride;
+  if (ERODEM_PAST_ROW(x, W)) return;
+  shallow_water_velocity_sweep_cell(x, y, W, kind, depth, q_x, q_y, velocity_x, velocity_y, area,
+                                    dt, p);
 }

@@ -42,7 +42,12 @@ enum FieldFlag : unsigned {
   X(bed_residual, "m", "bed elevation below the precision of bed (the bed is bed + bed_residual)", \
     kStateField | kRestartZero)                                                                    \
   /* the snow pack (snow.h); files before 2026-11-26 restart without snow */                       \
-  X(snow, "m", "snow water equivalent", kStateField | kOutputField | kRestartZero)
+  X(snow, "m", "snow water equivalent", kStateField | kOutputField | kRestartZero)                 \
+  /* the shallow-water scheme's state (shallow_water.h); 0 with the other schemes */               \
+  X(momentum_x, "m2 s-1", "depth-integrated eastward discharge per unit width",                    \
+    kStateField | kOutputField | kRestartZero | kTwinField)                                        \
+  X(momentum_y, "m2 s-1", "depth-integrated northward discharge per unit width",                   \
+    kStateField | kOutputField | kRestartZero | kTwinField)
 
 enum class FieldId {
 #define ERODEM_FIELD_ID(id, units, long_name, flags) id,

@@ -11,12 +11,14 @@
 
 namespace erodem {
 
-enum class FlowScheme { pipes, local_inertial };
+enum class FlowScheme { pipes, local_inertial, shallow_water };
 enum class TransportScheme { conservative, semi_lagrangian };
 
 /// The schemes' names as configs, HDF5 attributes and logs spell them.
 inline const char* scheme_name(FlowScheme s) {
-  return s == FlowScheme::pipes ? "pipes" : "local_inertial";
+  return s == FlowScheme::pipes            ? "pipes"
+         : s == FlowScheme::local_inertial ? "local_inertial"
+                                           : "shallow_water";
 }
 inline const char* scheme_name(TransportScheme s) {
   return s == TransportScheme::conservative ? "conservative" : "semi_lagrangian";

@@ -57,12 +57,15 @@ struct SweepInfo {
   /// kernels/cpu/sweeps.cpp names its cell function): a cells sweep over the DEM rows whose
   /// cell function and OpenCL kernel (named as the sweep) take
   ///   cell:   (int x, int y, int W, <a pointer per use, in order>, area, dt, params,
-  ///            <a real* per tally of the process, in order>)
+  ///            <a real* per tally of `tallies`, in order>)
   ///   kernel: (int W, int H, <a buffer per use, in order>, area, dt, params, partials, stride)
   /// where a use is "kind" or a field of field_table(), `area` the per-row cell areas (m^2),
   /// `dt` the step (s), `params` the process's struct (kernels/cell_params.hpp), and the
   /// kernel sums each tally into slot ERODEM_TALLY_<NAME> of `partials` (reduce.cl).
   bool generic = false;
+  /// A generic sweep's tallies (entries of tally_table()), in the order its cell function
+  /// takes them: each one of the process's tallies.
+  std::vector<const char*> tallies = {};
 };
 
 /// One tally of the ledger: a volume (m^3) a process books per step, added to a Ledger

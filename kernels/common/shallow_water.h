@@ -1,0 +1,272 @@
+/* erodem — the shallow-water scheme (flow.scheme = "shallow_water"): a cell-centred,
+ * first-order Godunov finite-volume solver of the 2D shallow-water equations
+ *
+ *   dh/dt + div(q) = 0
+ *   dq/dt + div(q u + g h^2 / 2 I) = -g h grad(z) - g n^2 |q| q / h^(7/3)
+ *
+ * with HLLC fluxes (Toro 2001), the hydrostatic reconstruction of Chen & Noelle (2017) at
+ * every face (well balanced, positive, and with a bed-slope force that does not vanish for a
+ * film thinner than the bed step between two cells: model.md section 3.10), a semi-implicit
+ * Manning friction, and velocities desingularised on thin films (Kurganov & Petrova 2007).
+ * State: depth h (m) and the unit discharges q_x (eastwards), q_y (northwards) (m^2/s). Each
+ * cell computes the four faces around it (every face twice over the grid, by the same function
+ * with the same arguments, so both sides see the same bits) and writes its outflows (m^3/s,
+ * the other schemes' `flux_*`: the water update, the ledger and sediment transport take them
+ * unchanged) and its new unit discharges. */
+#ifndef ERODEM_KERNELS_COMMON_SHALLOW_WATER_H
+#define ERODEM_KERNELS_COMMON_SHALLOW_WATER_H
+
+#include "water.h"
+
+ERODEM_BEGIN_NAMESPACE
+
+/* The velocity (m/s) of unit discharge q (m^2/s) over depth h (m), desingularised below
+ * h_eps (m) (Kurganov & Petrova 2007): 2 h q / (h^2 + max(h^2, h_eps^2)); q / h above h_eps, 0
+ * on a dry cell, and bounded by q / h_eps on a film. */
+ERODEM_FN real sw_velocity(real q, real h, real h_eps) {
+  const real h2 = h * h, e2 = h_eps * h_eps;
+  const real den = h2 + (h2 > e2 ? h2 : e2);
+  return den > (real)0 ? (real)2 * h * q / den : (real)0;
+}
+
+/* HLLC flux (Toro 2001, sections 10.3-10.5) across a face between the states (h_l, u_l,
+ * t_l) and (h_r, u_r, t_r): depths (m) reconstructed at the face, velocities normal to it
+ * (positive from l to r) and along it (m/s); gravity g (m/s^2). Returns the mass flux (m^2/s)
+ * and writes the flux of the normal momentum (m^3/s^2, with the pressure g h^2 / 2) through
+ * *f_n and of the tangential momentum through *f_t (the mass flux carrying t of the side the
+ * contact wave comes from). Wave speeds of Toro (2001, eq. 10.48): Einfeldt-type where both
+ * sides are wet, the dry-front speeds u -+ 2c where one is dry; no flux between two dry
+ * sides; two equal states give their physical flux exactly (a lake at rest stays at rest). */
+ERODEM_FN real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r, real t_r, real g,
+                       real* f_n, real* f_t) {
+  const int wet_l = h_l > (real)0, wet_r = h_r > (real)0;
+  if (!wet_l && !wet_r) {
+    *f_n = (real)0;
+    *f_t = (real)0;
+    return (real)0;
+  }
+  const real c_l = sqrt(g * h_l), c_r = sqrt(g * h_r);
+  const real q_l = h_l * u_l, q_r = h_r * u_r;
+  const real m_l = q_l * u_l + (real)0.5 * g * h_l * h_l;
+  const real m_r = q_r * u_r + (real)0.5 * g * h_r * h_r;
+  if (h_l == h_r && u_l == u_r && t_l == t_r) {
+    *f_n = m_l;
+    *f_t = q_l * t_l;
+    return q_l;
+  }
+  real s_l, s_r;
+  if (!wet_l) {
+    s_l = u_r - (real)2 * c_r;
+    s_r = u_r + c_r;
+  } else if (!wet_r) {
+    s_l = u_l - c_l;
+    s_r = u_l + (real)2 * c_l;
+  } else {
+    const real u_star = (real)0.5 * (u_l + u_r) + c_l - c_r;
+    const real c_star = (real)0.5 * (c_l + c_r) + (real)0.25 * (u_l - u_r);
+    s_l = fmin(u_l - c_l, u_star - c_star);
+    s_r = fmax(u_r + c_r, u_star + c_star);
+  }
+  real f_h, f_m;
+  if (s_l >= (real)0) {
+    f_h = q_l;
+    f_m = m_l;
+  } else if (s_r <= (real)0) {
+    f_h = q_r;
+    f_m = m_r;
+  } else {
+    const real inv = (real)1 / (s_r - s_l);
+    f_h = (s_r * q_l - s_l * q_r + s_l * s_r * (h_r - h_l)) * inv;
+    f_m = (s_r * m_l - s_l * m_r + s_l * s_r * (q_r - q_l)) * inv;
+  }
+  /* the contact wave's speed (Toro 2001, eq. 10.71); where its denominator vanishes the mass
+   * flux's direction picks the side */
+  const real den = h_r * (u_r - s_r) - h_l * (u_l - s_l);
+  const real s_star =
+      den != (real)0 ? (s_l * h_r * (u_r - s_r) - s_r * h_l * (u_l - s_l)) / den : f_h;
+  *f_n = f_m;
+  *f_t = f_h * (s_star >= (real)0 ? t_l : t_r);
+  return f_h;
+}
+
+/* The face between padded cells a (west or north of it) and b (east or south), the normal
+ * from a to b: kinds k_a, k_b; each side's depth h (m), bed z (m), velocity u normal to the
+ * face (positive from a to b) and t along it (m/s). A ghost side takes the state its kind
+ * gives it (model.md section 3.10): a wall mirrors the other side (the normal velocity
+ * reversed: no mass crosses), an open edge copies it without any inflow (transmissive free
+ * outflow), a fixed level is still water: its own depth and bed (set by the boundary process:
+ * its surface at the level) at rest, so the Riemann problem with the active side gives the
+ * inflow or outflow the level drives. Then the reconstruction of Chen & Noelle (2017): the face bed
+ *   z_f = min(max(z_a, z_b), min(eta_a, eta_b)),  eta = z + h,
+ * each side's depth at the face h_a' = max(0, min(eta_a - z_f, h_a)) (and b's alike), and
+ * the HLLC flux between them. Returns the mass flux (m^2/s, positive from a to b) and writes
+ * the normal and tangential momentum fluxes (sw_hllc), the two reconstructed depths and the
+ * face bed. No flux between two ghosts. */
+ERODEM_FN real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b, real z_b,
+                       real u_b, real t_b, real g, real* f_n, real* f_t, real* h_a_f, real* h_b_f,
+                       real* z_f) {
+  const int active_a = k_a == ERODEM_CELL_ACTIVE, active_b = k_b == ERODEM_CELL_ACTIVE;
+  if (!active_a && !active_b) {
+    *f_n = (real)0;
+    *f_t = (real)0;
+    *h_a_f = (real)0;
+    *h_b_f = (real)0;
+    *z_f = z_a > z_b ? z_a : z_b;
+    return (real)0;
+  }
+  if (!active_b) {
+    const int fixed = k_b == ERODEM_CELL_FIXED;
+    h_b = fixed ? h_b : h_a;
+    z_b = fixed ? z_b : z_a;
+    u_b = fixed ? (real)0 : k_b == ERODEM_CELL_WALL ? -u_a : (u_a > (real)0 ? u_a : (real)0);
+    t_b = fixed ? (real)0 : t_a;
+  } else if (!active_a) {
+    const int fixed = k_a == ERODEM_CELL_FIXED;
+    h_a = fixed ? h_a : h_b;
+    z_a = fixed ? z_a : z_b;
+    u_a = fixed ? (real)0 : k_a == ERODEM_CELL_WALL ? -u_b : (u_b < (real)0 ? u_b : (real)0);
+    t_a = fixed ? (real)0 : t_b;
+  }
+  const real eta_a = z_a + h_a, eta_b = z_b + h_b;
+  const real z_hi = z_a > z_b ? z_a : z_b, eta_lo = eta_a < eta_b ? eta_a : eta_b;
+  const real zf = z_hi < eta_lo ? z_hi : eta_lo;
+  const real ra = eta_a - zf < h_a ? eta_a - zf : h_a;
+  const real rb = eta_b - zf < h_b ? eta_b - zf : h_b;
+  *h_a_f = ra > (real)0 ? ra : (real)0;
+  *h_b_f = rb > (real)0 ? rb : (real)0;
+  *z_f = zf;
+  return sw_hllc(*h_a_f, u_a, t_a, *h_b_f, u_b, t_b, g, f_n, f_t);
+}
+
+/* The shallow-water step of padded cell (x, y), 0 <= x < W, 0 <= y < H, from the state at the
+ * start of the step: depth, bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n
+ * (s m^-1/3), the rows' dx, dy (m) and cell areas (m^2); dt (s); p.gravity (m/s^2) and
+ * p.dry_depth (m: velocities are desingularised below it, and a cell left shallower has no
+ * discharge). Writes the cell's outflows (m^3/s; an active cell's scaled like the other
+ * schemes' so it gives no more than it holds; a fixed-level ghost gives to its active
+ * neighbours; other ghosts give nothing) and, for an active cell, its new unit discharges:
+ *
+ *   q' = q - dt / A (sum over faces of L F_q - S),  then  q'' = q' / (1 + dt g n^2 |q'| / h'^(7/3))
+ *
+ * with the bed-slope source of Chen & Noelle (2017) on the reconstructed depths of the cell's
+ * sides of its faces, S_x = -g (h_E + h_W) / 2 (z_E - z_W) L_x, and in y the same over the
+ * mean face length plus the pressure on the cell's sides where the north and south faces
+ * differ in length (geographic grids), -g (h_N^2 + h_S^2) / 4 (L_S - L_N) (model.md section
+ * 3.10: together they balance the fluxes of a lake at rest exactly); h' the depth after the
+ * fluxes. Other cells keep their discharges. */
+ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
+                                  GLOBAL const real* bed, GLOBAL const real* depth,
+                                  GLOBAL const real* q_x, GLOBAL const real* q_y,
+                                  GLOBAL const real* manning, GLOBAL const real* dx,
+                                  GLOBAL const real* dy, GLOBAL const real* area, real dt,
+                                  ERODEM_P(FlowParams) p, GLOBAL real* out_left,
+                                  GLOBAL real* out_right, GLOBAL real* out_top,
+                                  GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+                                  GLOBAL real* q_y_new) {
+  const int i = x + y * W;
+  const int k = kind[i];
+  const real g = p.gravity, eps = p.dry_depth;
+  if (k != ERODEM_CELL_ACTIVE && k != ERODEM_CELL_FIXED) {
+    out_left[i] = out_right[i] = out_top[i] = out_bottom[i] = (real)0;
+    q_x_new[i] = q_x[i];
+    q_y_new[i] = q_y[i];
+    return;
+  }
+  /* the neighbours: indices clamped into the raster, kinds outside it walls */
+  const int k_w = kind_at(kind, x - 1, y, W, H), k_e = kind_at(kind, x + 1, y, W, H);
+  const int k_n = kind_at(kind, x, y - 1, W, H), k_s = kind_at(kind, x, y + 1, W, H);
+  const int i_w = x >= 1 ? i - 1 : i, i_e = x + 1 < W ? i + 1 : i;
+  const int i_n = y >= 1 ? i - W : i, i_s = y + 1 < H ? i + W : i;
+  const real h = depth[i], z = bed[i];
+  const real u = sw_velocity(q_x[i], h, eps), v = sw_velocity(q_y[i], h, eps);
+  /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
+  const int y_n = y >= 1 ? y - 1 : y, y_s = y + 1 < H ? y : (y >= 1 ? y - 1 : y);
+  const real l_x = dy[y], l_n = face_y_width(dx, y_n), l_s = face_y_width(dx, y_s);
+  real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n;
+  real he_a, he_b, ze, hw_a, hw_b, zw, hs_a, hs_b, zs, hn_a, hn_b, zn;
+  /* east face: a = this cell, b = east; normal east, tangent north */
+  const real f_e =
+      sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
+              sw_velocity(q_y[i_e], depth[i_e], eps), g, &fn_e, &ft_e, &he_a, &he_b, &ze);
+  /* west face: a = west, b = this cell */
+  const real f_w = sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
+                           sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, &fn_w, &ft_w,
+                           &hw_a, &hw_b, &zw);
+  /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
+  const real f_s =
+      sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
+              sw_velocity(q_x[i_s], depth[i_s], eps), g, &fn_s, &ft_s, &hs_a, &hs_b, &zs);
+  /* north face: a = north, b = this cell */
+  const real f_n = sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
+                           sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, &fn_n, &ft_n,
+                           &hn_a, &hn_b, &zn);
+  /* outflows: what leaves through each face (m^3/s); a fixed-level ghost gives only to active
+   * cells (sw_face gives no flux between ghosts) */
+  real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
+  real o_l = (f_w < (real)0 ? -f_w : (real)0) * l_x;
+  real o_b = (f_s > (real)0 ? f_s : (real)0) * l_s;
+  real o_t = (f_n < (real)0 ? -f_n : (real)0) * l_n;
+  const real a = area[y];
+  if (k == ERODEM_CELL_ACTIVE) {
+    const real K = outflow_limit(h, a, o_l + o_r + o_t + o_b, dt);
+    o_l *= K;
+    o_r *= K;
+    o_t *= K;
+    o_b *= K;
+  }
+  out_left[i] = o_l;
+  out_right[i] = o_r;
+  out_top[i] = o_t;
+  out_bottom[i] = o_b;
+  if (k != ERODEM_CELL_ACTIVE) {
+    q_x_new[i] = q_x[i];
+    q_y_new[i] = q_y[i];
+    return;
+  }
+  /* the outward fluxes of q_x and of q_y (north) through the four faces (m^4/s^2): a y-face's
+   * normal momentum is southward, so q_y takes its negative */
+  const real phi_x = (fn_e - fn_w) * l_x + ft_s * l_s - ft_n * l_n;
+  const real phi_y = (ft_e - ft_w) * l_x - fn_s * l_s + fn_n * l_n;
+  /* the bed-slope and side-pressure sources (m^4/s^2) on this cell's reconstructed depths */
+  const real l_mean = (real)0.5 * (l_n + l_s);
+  const real s_x = -g * (real)0.5 * (he_a + hw_b) * (ze - zw) * l_x;
+  const real s_y = -g * (real)0.5 * (hn_b + hs_a) * (zn - zs) * l_mean -
+                   g * (real)0.25 * (hs_a * hs_a + hn_b * hn_b) * (l_s - l_n);
+  const real qx1 = q_x[i] - dt / a * (phi_x - s_x);
+  const real qy1 = q_y[i] - dt / a * (phi_y - s_y);
+  /* the depth after the fluxes (this cell's mass balance) for the friction */
+  const real mass = (f_e - f_w) * l_x + f_s * l_s - f_n * l_n;
+  const real h1 = h - dt / a * mass;
+  const real n = manning[i];
+  const real h_f = h1 > eps ? h1 : eps;
+  const real q_mag = sqrt(qx1 * qx1 + qy1 * qy1);
+  const real h_7_3 = h_f * h_f * erodem_cbrt_positive(h_f);
+  const real den = (real)1 + dt * g * n * n * q_mag / h_7_3;
+  const int wet = h1 > eps;
+  q_x_new[i] = wet ? qx1 / den : (real)0;
+  q_y_new[i] = wet ? qy1 / den : (real)0;
+}
+
+/* The velocity of padded cell (x, y) from its unit discharges and its depth after the water
+ * update: sw_velocity (eastwards and northwards, m/s) with h_eps the water update's
+ * velocity_min_depth (m): the velocity the other processes, the statistics and the adaptive
+ * step read. 0 on other cells. The generic sweep "shallow_water_velocity" of the water
+ * process (kernels/cpu/sweeps.cpp, kernels/opencl/shallow_water.cl). */
+ERODEM_FN void shallow_water_velocity_sweep_cell(int x, int y, int W,
+                                                 GLOBAL const erodem_kind_t* kind,
+                                                 GLOBAL const real* depth, GLOBAL const real* q_x,
+                                                 GLOBAL const real* q_y, GLOBAL real* velocity_x,
+                                                 GLOBAL real* velocity_y, GLOBAL const real* area,
+                                                 real dt, ERODEM_P(WaterParams) p) {
+  (void)area;
+  (void)dt;
+  const int i = x + y * W;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  const real h = depth[i];
+  velocity_x[i] = active ? sw_velocity(q_x[i], h, p.velocity_min_depth) : (real)0;
+  velocity_y[i] = active ? sw_velocity(q_y[i], h, p.velocity_min_depth) : (real)0;
+}
+
+ERODEM_END_NAMESPACE
+
+#endif
