@@ -18,6 +18,7 @@
 /* always_inline: PoCL (LLVM) otherwise keeps the larger cell functions as calls, and a
  * work-item loop with a call in it is not vectorised */
 #define ERODEM_FN static inline __attribute__((always_inline))
+#define ERODEM_FN_INLINED ERODEM_FN
 #define ERODEM_INLINE static inline __attribute__((always_inline))
 #define GLOBAL __global
 #define ERODEM_EPSILON(T) ((T)FLT_EPSILON)
@@ -43,6 +44,11 @@ typedef std::uint8_t erodem_kind_t;
 #define ERODEM_FN       \
   template <class real> \
   inline
+/* A cell function too large for GCC's inliner that a vectorised loop must still inline (the
+ * shallow-water cell: its four faces and their Riemann problems). */
+#define ERODEM_FN_INLINED \
+  template <class real>   \
+  inline __attribute__((always_inline))
 #define ERODEM_INLINE inline
 #define GLOBAL
 #define ERODEM_EPSILON(T) std::numeric_limits<T>::epsilon()

@@ -23,10 +23,11 @@ ERODEM_BEGIN_NAMESPACE
 /* The velocity (m/s) of unit discharge q (m^2/s) over depth h (m), desingularised below
  * h_eps (m) (Kurganov & Petrova 2007): 2 h q / (h^2 + max(h^2, h_eps^2)); q / h above h_eps, 0
  * on a dry cell, and bounded by q / h_eps on a film. */
-ERODEM_FN real sw_velocity(real q, real h, real h_eps) {
+ERODEM_FN_INLINED real sw_velocity(real q, real h, real h_eps) {
   const real h2 = h * h, e2 = h_eps * h_eps;
   const real den = h2 + (h2 > e2 ? h2 : e2);
-  return den > (real)0 ? (real)2 * h * q / den : (real)0;
+  const real v = (real)2 * h * q / (den > (real)0 ? den : (real)1);
+  return den > (real)0 ? v : (real)0;
 }
 
 /* HLLC flux (Toro 2001, sections 10.3-10.5) across a face between the states (h_l, u_l,
@@ -37,53 +38,33 @@ ERODEM_FN real sw_velocity(real q, real h, real h_eps) {
  * contact wave comes from). Wave speeds of Toro (2001, eq. 10.48): Einfeldt-type where both
  * sides are wet, the dry-front speeds u -+ 2c where one is dry; no flux between two dry
  * sides; two equal states give their physical flux exactly (a lake at rest stays at rest). */
-ERODEM_FN real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r, real t_r, real g,
-                       real* f_n, real* f_t) {
+ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r, real t_r, real g,
+                               real* f_n, real* f_t) {
+  /* Branch-free (selects only), so loops over cells vectorise; two dry sides give 0 through
+   * the same arithmetic (all speeds u_r, every flux 0). */
   const int wet_l = h_l > (real)0, wet_r = h_r > (real)0;
-  if (!wet_l && !wet_r) {
-    *f_n = (real)0;
-    *f_t = (real)0;
-    return (real)0;
-  }
   const real c_l = sqrt(g * h_l), c_r = sqrt(g * h_r);
   const real q_l = h_l * u_l, q_r = h_r * u_r;
   const real m_l = q_l * u_l + (real)0.5 * g * h_l * h_l;
   const real m_r = q_r * u_r + (real)0.5 * g * h_r * h_r;
-  if (h_l == h_r && u_l == u_r && t_l == t_r) {
-    *f_n = m_l;
-    *f_t = q_l * t_l;
-    return q_l;
-  }
-  real s_l, s_r;
-  if (!wet_l) {
-    s_l = u_r - (real)2 * c_r;
-    s_r = u_r + c_r;
-  } else if (!wet_r) {
-    s_l = u_l - c_l;
-    s_r = u_l + (real)2 * c_l;
-  } else {
-    const real u_star = (real)0.5 * (u_l + u_r) + c_l - c_r;
-    const real c_star = (real)0.5 * (c_l + c_r) + (real)0.25 * (u_l - u_r);
-    s_l = fmin(u_l - c_l, u_star - c_star);
-    s_r = fmax(u_r + c_r, u_star + c_star);
-  }
-  real f_h, f_m;
-  if (s_l >= (real)0) {
-    f_h = q_l;
-    f_m = m_l;
-  } else if (s_r <= (real)0) {
-    f_h = q_r;
-    f_m = m_r;
-  } else {
-    const real inv = (real)1 / (s_r - s_l);
-    f_h = (s_r * q_l - s_l * q_r + s_l * s_r * (h_r - h_l)) * inv;
-    f_m = (s_r * m_l - s_l * m_r + s_l * s_r * (q_r - q_l)) * inv;
-  }
+  const real u_star = (real)0.5 * (u_l + u_r) + c_l - c_r;
+  const real c_star = (real)0.5 * (c_l + c_r) + (real)0.25 * (u_l - u_r);
+  const real s_l =
+      wet_l ? (wet_r ? fmin(u_l - c_l, u_star - c_star) : u_l - c_l) : u_r - (real)2 * c_r;
+  const real s_r =
+      wet_l ? (wet_r ? fmax(u_r + c_r, u_star + c_star) : u_l + (real)2 * c_l) : u_r + c_r;
+  const real span = s_r - s_l;
+  const real inv = (real)1 / (span > (real)0 ? span : (real)1);
+  const real h_hll = (s_r * q_l - s_l * q_r + s_l * s_r * (h_r - h_l)) * inv;
+  const real m_hll = (s_r * m_l - s_l * m_r + s_l * s_r * (q_r - q_l)) * inv;
+  const int same = (h_l == h_r) & (u_l == u_r) & (t_l == t_r);
+  const real f_h = (same | (s_l >= (real)0)) ? q_l : (s_r <= (real)0 ? q_r : h_hll);
+  const real f_m = (same | (s_l >= (real)0)) ? m_l : (s_r <= (real)0 ? m_r : m_hll);
   /* the contact wave's speed (Toro 2001, eq. 10.71); where its denominator vanishes the mass
    * flux's direction picks the side */
   const real den = h_r * (u_r - s_r) - h_l * (u_l - s_l);
-  const real s_star =
-      den != (real)0 ? (s_l * h_r * (u_r - s_r) - s_r * h_l * (u_l - s_l)) / den : f_h;
+  const real num = s_l * h_r * (u_r - s_r) - s_r * h_l * (u_l - s_l);
+  const real s_star = den != (real)0 ? num / (den != (real)0 ? den : (real)1) : f_h;
   *f_n = f_m;
   *f_t = f_h * (s_star >= (real)0 ? t_l : t_r);
   return f_h;
@@ -102,49 +83,48 @@ ERODEM_FN real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r, real t_
  * the HLLC flux between them. Returns the mass flux (m^2/s, positive from a to b) and writes
  * the normal and tangential momentum fluxes (sw_hllc), the two reconstructed depths and the
  * face bed. No flux between two ghosts. */
-ERODEM_FN real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b, real z_b,
-                       real u_b, real t_b, real g, real* f_n, real* f_t, real* h_a_f, real* h_b_f,
-                       real* z_f) {
+ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b,
+                               real z_b, real u_b, real t_b, real g, real* f_n, real* f_t,
+                               real* h_a_f, real* h_b_f, real* z_f) {
+  /* branch-free: the ghost side's state selected, both sides computed, a face between two
+   * ghosts masked to 0 at the end */
   const int active_a = k_a == ERODEM_CELL_ACTIVE, active_b = k_b == ERODEM_CELL_ACTIVE;
-  if (!active_a && !active_b) {
-    *f_n = (real)0;
-    *f_t = (real)0;
-    *h_a_f = (real)0;
-    *h_b_f = (real)0;
-    *z_f = z_a > z_b ? z_a : z_b;
-    return (real)0;
-  }
-  if (!active_b) {
-    const int fixed = k_b == ERODEM_CELL_FIXED;
-    h_b = fixed ? h_b : h_a;
-    z_b = fixed ? z_b : z_a;
-    u_b = fixed ? (real)0 : k_b == ERODEM_CELL_WALL ? -u_a : (u_a > (real)0 ? u_a : (real)0);
-    t_b = fixed ? (real)0 : t_a;
-  } else if (!active_a) {
-    const int fixed = k_a == ERODEM_CELL_FIXED;
-    h_a = fixed ? h_a : h_b;
-    z_a = fixed ? z_a : z_b;
-    u_a = fixed ? (real)0 : k_a == ERODEM_CELL_WALL ? -u_b : (u_b < (real)0 ? u_b : (real)0);
-    t_a = fixed ? (real)0 : t_b;
-  }
+  const int ghost_b = active_a & !active_b, ghost_a = active_b & !active_a;
+  const int fixed_b = k_b == ERODEM_CELL_FIXED, fixed_a = k_a == ERODEM_CELL_FIXED;
+  const int wall_b = k_b == ERODEM_CELL_WALL, wall_a = k_a == ERODEM_CELL_WALL;
+  const real hb0 = h_b, zb0 = z_b, ub0 = u_b, tb0 = t_b;
+  h_b = ghost_b & !fixed_b ? h_a : hb0;
+  z_b = ghost_b & !fixed_b ? z_a : zb0;
+  u_b = ghost_b ? (fixed_b ? (real)0 : wall_b ? -u_a : (u_a > (real)0 ? u_a : (real)0)) : ub0;
+  t_b = ghost_b ? (fixed_b ? (real)0 : t_a) : tb0;
+  const real ha0 = h_a, za0 = z_a, ua0 = u_a, ta0 = t_a;
+  h_a = ghost_a & !fixed_a ? hb0 : ha0;
+  z_a = ghost_a & !fixed_a ? zb0 : za0;
+  u_a = ghost_a ? (fixed_a ? (real)0 : wall_a ? -ub0 : (ub0 < (real)0 ? ub0 : (real)0)) : ua0;
+  t_a = ghost_a ? (fixed_a ? (real)0 : tb0) : ta0;
+  const int any = active_a | active_b;
   const real eta_a = z_a + h_a, eta_b = z_b + h_b;
   const real z_hi = z_a > z_b ? z_a : z_b, eta_lo = eta_a < eta_b ? eta_a : eta_b;
   const real zf = z_hi < eta_lo ? z_hi : eta_lo;
   const real ra = eta_a - zf < h_a ? eta_a - zf : h_a;
   const real rb = eta_b - zf < h_b ? eta_b - zf : h_b;
-  *h_a_f = ra > (real)0 ? ra : (real)0;
-  *h_b_f = rb > (real)0 ? rb : (real)0;
+  const real ha_f = any & (ra > (real)0) ? ra : (real)0;
+  const real hb_f = any & (rb > (real)0) ? rb : (real)0;
+  *h_a_f = ha_f;
+  *h_b_f = hb_f;
   *z_f = zf;
-  return sw_hllc(*h_a_f, u_a, t_a, *h_b_f, u_b, t_b, g, f_n, f_t);
+  return sw_hllc(ha_f, u_a, t_a, hb_f, u_b, t_b, g, f_n, f_t);
 }
 
-/* The shallow-water step of padded cell (x, y), 0 <= x < W, 0 <= y < H, from the state at the
- * start of the step: depth, bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n
- * (s m^-1/3), the rows' dx, dy (m) and cell areas (m^2); dt (s); p.gravity (m/s^2) and
- * p.dry_depth (m: velocities are desingularised below it, and a cell left shallower has no
- * discharge). Writes the cell's outflows (m^3/s; an active cell's scaled like the other
- * schemes' so it gives no more than it holds; a fixed-level ghost gives to its active
- * neighbours; other ghosts give nothing) and, for an active cell, its new unit discharges:
+/* The shallow-water step of padded cell i of row y, its neighbours' kinds k_* and indices i_*
+ * (west, east, north, south) and the rows y_n, y_s of its north and south faces (the faces
+ * between rows y_n and y_n + 1, y_s and y_s + 1), from the state at the start of the step: depth,
+ * bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n (s m^-1/3), the rows' dx, dy (m)
+ * and cell areas (m^2); dt (s); p.gravity (m/s^2) and p.dry_depth (m: velocities are desingularised
+ * below it, and a cell left shallower has no discharge). Writes the cell's outflows (m^3/s; an
+ * active cell's scaled like the other schemes' so it gives no more than it holds; a fixed-level
+ * ghost gives to its active neighbours; other ghosts give nothing) and, for an active cell, its new
+ * unit discharges:
  *
  *   q' = q - dt / A (sum over faces of L F_q - S),  then  q'' = q' / (1 + dt g n^2 |q'| / h'^(7/3))
  *
@@ -154,33 +134,20 @@ ERODEM_FN real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a,
  * differ in length (geographic grids), -g (h_N^2 + h_S^2) / 4 (L_S - L_N) (model.md section
  * 3.10: together they balance the fluxes of a lake at rest exactly); h' the depth after the
  * fluxes. Other cells keep their discharges. */
-ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
-                                  GLOBAL const real* bed, GLOBAL const real* depth,
-                                  GLOBAL const real* q_x, GLOBAL const real* q_y,
-                                  GLOBAL const real* manning, GLOBAL const real* dx,
-                                  GLOBAL const real* dy, GLOBAL const real* area, real dt,
-                                  ERODEM_P(FlowParams) p, GLOBAL real* out_left,
-                                  GLOBAL real* out_right, GLOBAL real* out_top,
-                                  GLOBAL real* out_bottom, GLOBAL real* q_x_new,
-                                  GLOBAL real* q_y_new) {
-  const int i = x + y * W;
+ERODEM_FN_INLINED void shallow_water_cell_at(
+    int i, int y, int k_w, int k_e, int k_n, int k_s, int i_w, int i_e, int i_n, int i_s, int y_n,
+    int y_s, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed, GLOBAL const real* depth,
+    GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* manning,
+    GLOBAL const real* dx, GLOBAL const real* dy, GLOBAL const real* area, real dt,
+    ERODEM_P(FlowParams) p, GLOBAL real* out_left, GLOBAL real* out_right, GLOBAL real* out_top,
+    GLOBAL real* out_bottom, GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
+  /* branch-free: everything computed for every cell, the results selected by its kind */
   const int k = kind[i];
   const real g = p.gravity, eps = p.dry_depth;
-  if (k != ERODEM_CELL_ACTIVE && k != ERODEM_CELL_FIXED) {
-    out_left[i] = out_right[i] = out_top[i] = out_bottom[i] = (real)0;
-    q_x_new[i] = q_x[i];
-    q_y_new[i] = q_y[i];
-    return;
-  }
-  /* the neighbours: indices clamped into the raster, kinds outside it walls */
-  const int k_w = kind_at(kind, x - 1, y, W, H), k_e = kind_at(kind, x + 1, y, W, H);
-  const int k_n = kind_at(kind, x, y - 1, W, H), k_s = kind_at(kind, x, y + 1, W, H);
-  const int i_w = x >= 1 ? i - 1 : i, i_e = x + 1 < W ? i + 1 : i;
-  const int i_n = y >= 1 ? i - W : i, i_s = y + 1 < H ? i + W : i;
+  const int active = k == ERODEM_CELL_ACTIVE, gives = active | (k == ERODEM_CELL_FIXED);
   const real h = depth[i], z = bed[i];
   const real u = sw_velocity(q_x[i], h, eps), v = sw_velocity(q_y[i], h, eps);
   /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
-  const int y_n = y >= 1 ? y - 1 : y, y_s = y + 1 < H ? y : (y >= 1 ? y - 1 : y);
   const real l_x = dy[y], l_n = face_y_width(dx, y_n), l_s = face_y_width(dx, y_s);
   real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n;
   real he_a, he_b, ze, hw_a, hw_b, zw, hs_a, hs_b, zs, hn_a, hn_b, zn;
@@ -202,27 +169,16 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
                            &hn_a, &hn_b, &zn);
   /* outflows: what leaves through each face (m^3/s); a fixed-level ghost gives only to active
    * cells (sw_face gives no flux between ghosts) */
-  real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
-  real o_l = (f_w < (real)0 ? -f_w : (real)0) * l_x;
-  real o_b = (f_s > (real)0 ? f_s : (real)0) * l_s;
-  real o_t = (f_n < (real)0 ? -f_n : (real)0) * l_n;
+  const real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
+  const real o_l = (f_w < (real)0 ? -f_w : (real)0) * l_x;
+  const real o_b = (f_s > (real)0 ? f_s : (real)0) * l_s;
+  const real o_t = (f_n < (real)0 ? -f_n : (real)0) * l_n;
   const real a = area[y];
-  if (k == ERODEM_CELL_ACTIVE) {
-    const real K = outflow_limit(h, a, o_l + o_r + o_t + o_b, dt);
-    o_l *= K;
-    o_r *= K;
-    o_t *= K;
-    o_b *= K;
-  }
-  out_left[i] = o_l;
-  out_right[i] = o_r;
-  out_top[i] = o_t;
-  out_bottom[i] = o_b;
-  if (k != ERODEM_CELL_ACTIVE) {
-    q_x_new[i] = q_x[i];
-    q_y_new[i] = q_y[i];
-    return;
-  }
+  const real K = active ? outflow_limit(h, a, o_l + o_r + o_t + o_b, dt) : (real)1;
+  out_left[i] = gives ? o_l * K : (real)0;
+  out_right[i] = gives ? o_r * K : (real)0;
+  out_top[i] = gives ? o_t * K : (real)0;
+  out_bottom[i] = gives ? o_b * K : (real)0;
   /* the outward fluxes of q_x and of q_y (north) through the four faces (m^4/s^2): a y-face's
    * normal momentum is southward, so q_y takes its negative */
   const real phi_x = (fn_e - fn_w) * l_x + ft_s * l_s - ft_n * l_n;
@@ -243,8 +199,45 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
   const real h_7_3 = h_f * h_f * erodem_cbrt_positive(h_f);
   const real den = (real)1 + dt * g * n * n * q_mag / h_7_3;
   const int wet = h1 > eps;
-  q_x_new[i] = wet ? qx1 / den : (real)0;
-  q_y_new[i] = wet ? qy1 / den : (real)0;
+  q_x_new[i] = active ? (wet ? qx1 / den : (real)0) : q_x[i];
+  q_y_new[i] = active ? (wet ? qy1 / den : (real)0) : q_y[i];
+}
+
+/* shallow_water_cell_at for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices
+ * clamped into the raster, their kinds outside it walls. */
+ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
+                                  GLOBAL const real* bed, GLOBAL const real* depth,
+                                  GLOBAL const real* q_x, GLOBAL const real* q_y,
+                                  GLOBAL const real* manning, GLOBAL const real* dx,
+                                  GLOBAL const real* dy, GLOBAL const real* area, real dt,
+                                  ERODEM_P(FlowParams) p, GLOBAL real* out_left,
+                                  GLOBAL real* out_right, GLOBAL real* out_top,
+                                  GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+                                  GLOBAL real* q_y_new) {
+  const int i = x + y * W;
+  shallow_water_cell_at(
+      i, y, kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
+      kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H), x >= 1 ? i - 1 : i,
+      x + 1 < W ? i + 1 : i, y >= 1 ? i - W : i, y + 1 < H ? i + W : i, y >= 1 ? y - 1 : y,
+      y + 1 < H ? y : (y >= 1 ? y - 1 : y), kind, bed, depth, q_x, q_y, manning, dx, dy, area, dt,
+      p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
+}
+
+/* The same for a cell with four neighbours inside the raster (1 <= x <= W - 2, 1 <= y <= H - 2):
+ * no clamping, so a loop over x vectorises. */
+ERODEM_FN void shallow_water_cell_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                           GLOBAL const real* bed, GLOBAL const real* depth,
+                                           GLOBAL const real* q_x, GLOBAL const real* q_y,
+                                           GLOBAL const real* manning, GLOBAL const real* dx,
+                                           GLOBAL const real* dy, GLOBAL const real* area, real dt,
+                                           ERODEM_P(FlowParams) p, GLOBAL real* out_left,
+                                           GLOBAL real* out_right, GLOBAL real* out_top,
+                                           GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+                                           GLOBAL real* q_y_new) {
+  const int i = x + y * W;
+  shallow_water_cell_at(i, y, kind[i - 1], kind[i + 1], kind[i - W], kind[i + W], i - 1, i + 1,
+                        i - W, i + W, y - 1, y, kind, bed, depth, q_x, q_y, manning, dx, dy, area,
+                        dt, p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* The velocity of padded cell (x, y) from its unit discharges and its depth after the water

@@ -158,12 +158,25 @@ void CpuBackend<Real>::run_flow(Real dt) {
     const Real *q_x = qx.data(), *q_y = qy.data(), *manning = manning_.data();
     Real *q_x_new = qx_next.data(), *q_y_new = qy_next.data();
     const cell_params::FlowParams<Real> params = f;
+    // Rows 1 .. H - 2 without clamping but for their first and last cell (the loop
+    // vectorises), the first and last row clamped.
     for_rows(0, H, [=](int y) {
       const Real step = dt;
       const cell_params::FlowParams<Real> fp = params;
-      for (int x = 0; x < W; ++x)
+      auto general = [&](int x) {
         cell::shallow_water_cell(x, y, W, H, kind, b, d, q_x, q_y, manning, dx, dy, area, step, fp,
                                  ol, orr, ot, ob, q_x_new, q_y_new);
+      };
+      if (y >= 1 && y <= H - 2) {
+        general(0);
+        ERODEM_IVDEP
+        for (int x = 1; x < W - 1; ++x)
+          cell::shallow_water_cell_interior(x, y, W, kind, b, d, q_x, q_y, manning, dx, dy, area,
+                                            step, fp, ol, orr, ot, ob, q_x_new, q_y_new);
+        general(W - 1);
+      } else {
+        for (int x = 0; x < W; ++x) general(x);
+      }
     });
     std::swap(qx, qx_next);
     std::swap(qy, qy_next);
