@@ -44,9 +44,10 @@ struct PlaneRun {
   std::vector<double> t, q, q_exact;  ///< the outlet hydrograph: step ends (s), m^2/s
 };
 
-PlaneRun run_plane(const KinematicPlane& kp, double dx, double dt_max, const Target& target) {
+PlaneRun run_plane(const KinematicPlane& kp, double dx, double dt_max, const Target& target,
+                   FlowScheme flow) {
   const int n = static_cast<int>(std::lround(kp.length / dx));
-  Params p = quiet_params(FlowScheme::local_inertial, dt_max);
+  Params p = quiet_params(flow, dt_max);
   p.flow.manning_n.value = kp.manning;
   p.rain.rate = kp.rain;
   p.time.adaptive = true;  // the default CFL (0.7); dt_max as given
@@ -110,23 +111,24 @@ PlaneRun run_plane(const KinematicPlane& kp, double dx, double dt_max, const Tar
 //   and the outlet cell differ from it: bound 1.1 (the semi-implicit scheme ran at dx/dt).
 // - convergence: upwind in space and explicit in time, first order when dt shrinks with dx
 //   (dt_max = dx / 2 s/m): observed order from 4 to 2 m cells above 0.7.
-TEST_P(Runoff, KinematicWaveOnSteepPlane) {
+/// The checks above for one flow scheme on one target.
+void kinematic_plane_case(const Target& tgt, FlowScheme flow) {
   const double rain = 50.0 / 1000.0 / 3600.0;  // 50 mm/h
   const char* reference = "kinematic wave (Eagleson 1970; Singh 1996)";
   for (double slope : {0.3, 1.0}) {
     const KinematicPlane kp{100.0, slope, 0.03, rain};
     const double te = kp.t_equilibrium(), half_rise = std::pow(0.5, 0.6) * te;
-    const std::string scheme = slope < 0.5 ? "local_inertial S 0.3" : "local_inertial S 1.0";
+    const std::string scheme = std::string(scheme_name(flow)) + (slope < 0.5 ? " S 0.3" : " S 1.0");
     auto fig = [&](const char* quantity, double dx) {
-      return vr::Figure{"kinematic_plane", target().label(), scheme, quantity, dx, reference};
+      return vr::Figure{"kinematic_plane", tgt.label(), scheme, quantity, dx, reference};
     };
-    const PlaneRun r = run_plane(kp, 2.0, 5.0, target());
+    const PlaneRun r = run_plane(kp, 2.0, 5.0, tgt, flow);
     std::printf(
-        "[kinematic plane] %s S %.1f, 2 m cells, dt_max 5 s: t_e %.1f s; rising-limb error %.4f "
+        "[kinematic plane] %s %s S %.1f, 2 m cells, dt_max 5 s: t_e %.1f s; rising-limb error %.4f "
         "(bound 0.05; idle %.1f); half rise at %.1f s, exact %.1f s (bound 10 s); late outflow / "
         "iL %.4f (bound 1 %%); largest speed %.3f m/s = %.3f x Manning (bound 1.1); %ld steps\n",
-        target().label().c_str(), slope, te, r.rising_error, r.idle_error, r.half_rise_time,
-        half_rise, r.late_ratio, r.max_speed, r.speed_ratio, r.steps);
+        tgt.label().c_str(), scheme_name(flow), slope, te, r.rising_error, r.idle_error,
+        r.half_rise_time, half_rise, r.late_ratio, r.max_speed, r.speed_ratio, r.steps);
     vr::profile(fig("", 2.0), slope < 0.5 ? "S0.3" : "S1.0", {"t", "q", "q_exact"},
                 {r.t, r.q, r.q_exact});
     vr::expect_below(fig("rising-limb error (relative L1), defaults", 2.0), r.rising_error, 0.05);
@@ -138,17 +140,60 @@ TEST_P(Runoff, KinematicWaveOnSteepPlane) {
     std::vector<double> dxs{4.0, 2.0};
     if (full) dxs.push_back(1.0);
     std::vector<double> errors;
-    for (double dx : dxs) errors.push_back(run_plane(kp, dx, 0.5 * dx, target()).rising_error);
+    for (double dx : dxs) errors.push_back(run_plane(kp, dx, 0.5 * dx, tgt, flow).rising_error);
     vr::report(fig("rising-limb error (relative L1), dt_max = dx/2", dxs[0]), errors[0]);
     for (std::size_t k = 1; k < dxs.size(); ++k) {
       const double order = observed_order(errors[k - 1], errors[k]);
       std::printf(
-          "[kinematic plane] %s S %.1f, dt_max = dx / 2: rising-limb error %.4f (%g m), %.4f "
+          "[kinematic plane] %s %s S %.1f, dt_max = dx / 2: rising-limb error %.4f (%g m), %.4f "
           "(%g m), observed order %.2f (bound > 0.7)\n",
-          target().label().c_str(), slope, errors[k - 1], dxs[k - 1], errors[k], dxs[k], order);
+          tgt.label().c_str(), scheme_name(flow), slope, errors[k - 1], dxs[k - 1], errors[k],
+          dxs[k], order);
       vr::report(fig("rising-limb error (relative L1), dt_max = dx/2", dxs[k]), errors[k], order);
       vr::expect_above(fig("observed order, dt_max = dx/2", dxs[k]), order, 0.7, order);
     }
+  }
+}
+
+TEST_P(Runoff, KinematicWaveOnSteepPlane) {
+  kinematic_plane_case(target(), FlowScheme::local_inertial);
+}
+
+// The shallow-water scheme on the same planes: recorded, not bounded, because it fails them
+// (issue 16, open). With the hydrostatic reconstruction of Chen & Noelle (2017) every cell of
+// a film of 2-3 mm on a step of 0.6-2 m sees its downhill neighbour as dry at their face: the
+// face flux is the dry-bed Riemann problem's (a weir, h (u + 2c) / 3), not the film's
+// momentum, and the film's own discharge stays at about 0.1 of Manning's speed; the open edge
+// passes only that discharge, so the water piles up at the outlet. Measured (2 m cells,
+// defaults): rising-limb error 0.85 (S 0.3) and 0.96 (S 1.0) against the bound 0.05 of the
+// other schemes, late outflow 0.79 and 0.39 of i L, speeds 0.17 and 0.07 of Manning's
+// (model.md section 3.10). The assertions are only that it moves water towards the exact
+// hydrograph (better than an idle solver, which scores 1) and closes its ledger.
+TEST_P(Runoff, KinematicWaveOnSteepPlaneShallowWaterIsRecorded) {
+  const double rain = 50.0 / 1000.0 / 3600.0;  // 50 mm/h
+  for (double slope : {0.3, 1.0}) {
+    const KinematicPlane kp{100.0, slope, 0.03, rain};
+    const PlaneRun r = run_plane(kp, 2.0, 5.0, target(), FlowScheme::shallow_water);
+    const std::string scheme = std::string("shallow_water") + (slope < 0.5 ? " S 0.3" : " S 1.0");
+    std::printf(
+        "[kinematic plane] %s shallow_water S %.1f, 2 m cells, dt_max 5 s: rising-limb error "
+        "%.4f (recorded; the other schemes' bound 0.05; idle %.1f); half rise at %.1f s, exact "
+        "%.1f s; late outflow / iL %.4f; largest speed %.3f m/s = %.3f x Manning\n",
+        target().label().c_str(), slope, r.rising_error, r.idle_error, r.half_rise_time,
+        std::pow(0.5, 0.6) * kp.t_equilibrium(), r.late_ratio, r.max_speed, r.speed_ratio);
+    auto fig = [&](const char* quantity) {
+      return vr::Figure{"kinematic_plane",
+                        target().label(),
+                        scheme,
+                        quantity,
+                        2.0,
+                        "kinematic wave (Eagleson 1970; Singh 1996)"};
+    };
+    vr::report(fig("rising-limb error (relative L1), defaults"), r.rising_error);
+    vr::report(fig("late outflow / (i L)"), r.late_ratio);
+    vr::report(fig("largest speed / Manning speed"), r.speed_ratio);
+    EXPECT_LT(r.rising_error, 1.0) << "an idle solver scores 1";
+    EXPECT_GT(r.late_ratio, 0.1) << "water reaches the outlet";
   }
 }
 
