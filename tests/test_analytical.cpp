@@ -290,7 +290,8 @@ TEST_P(Analytical, RainOnTiltedPlaneReachesEquilibrium) {
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c)
       t.bed[static_cast<std::size_t>(r) * n + c] = slope * (n - r - 0.5) * dx;  // down to south
-  for (FlowScheme scheme : {FlowScheme::local_inertial, FlowScheme::pipes}) {
+  for (FlowScheme scheme :
+       {FlowScheme::local_inertial, FlowScheme::pipes, FlowScheme::shallow_water}) {
     Params p = quiet_params(scheme, 1.0);
     p.flow.manning_n.value = 0.03;
     p.rain.rate = rain;

@@ -72,48 +72,98 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
 
 /* The face between padded cells a (west or north of it) and b (east or south), the normal
  * from a to b: kinds k_a, k_b; each side's depth h (m), bed z (m), velocity u normal to the
- * face (positive from a to b) and t along it (m/s). A ghost side takes the state its kind
- * gives it (model.md section 3.10): a wall mirrors the other side (the normal velocity
- * reversed: no mass crosses), an open edge copies it without any inflow (transmissive free
- * outflow), a fixed level is still water: its own depth and bed (set by the boundary process:
- * its surface at the level) at rest, so the Riemann problem with the active side gives the
- * inflow or outflow the level drives. Then the reconstruction of Chen & Noelle (2017): the face bed
+ * face (positive from a to b) and t along it (m/s); gravity g (m/s^2); eps (m) the depth below
+ * which a side is dry. A ghost side takes the state its kind gives it (model.md section 3.10):
+ * a wall mirrors the other side (the normal velocity reversed: no mass crosses), an open edge
+ * copies its depth and velocity without any inflow over the ghost's own bed, which the boundary
+ * process lowers by one cell of the local slope (a free outflow that continues the slope: on a
+ * plane the last cell's film spills as every other does), a fixed level is still water: its
+ * own depth and bed (set by the boundary process: its surface at the level) at rest, so the
+ * Riemann problem with the active side gives the inflow or outflow the level drives.
+ *
+ * A face where the water meets: the reconstruction of Chen & Noelle (2017), the face bed
  *   z_f = min(max(z_a, z_b), min(eta_a, eta_b)),  eta = z + h,
- * each side's depth at the face h_a' = max(0, min(eta_a - z_f, h_a)) (and b's alike), and
- * the HLLC flux between them. Returns the mass flux (m^2/s, positive from a to b) and writes
- * the normal and tangential momentum fluxes (sw_hllc), the two reconstructed depths and the
- * face bed. No flux between two ghosts. */
+ * each side's depth at the face h' = max(0, min(eta - z_f, h)), and the HLLC flux between
+ * them, the same for both sides (well balanced: a lake at rest, wet or against a dry bank,
+ * stays at rest).
+ *
+ * A step (model.md section 3.10): the high side is wet and the low side's surface lies at or
+ * below the high side's bed, a film spilling down a bed step. The reconstruction would see
+ * the low side as dry there, and the dry-bed Riemann problem's flux is a weir's, h (u + 2c) / 3,
+ * which does not depend on the slope: rain on a steep plane ran off at a tenth of Manning's
+ * speed. Here the film leaves with its own discharge instead, h max(u, 0) towards the step
+ * (it is accelerated by the bed-slope source, which then sees the whole step: face bed the
+ * mean of the two beds, each side's own depth), with its momentum h u^2 + g h^2 / 2; the low
+ * side receives that discharge and momentum flux of the jet and the pressure of its own water
+ * against the step, g h_low^2 / 2, or a wall's reflection where it runs towards the step. Mass
+ * is conserved (one mass flux); momentum is not, as the step takes the force.
+ *
+ * Returns the mass flux (m^2/s, positive from a to b); writes the normal and tangential
+ * momentum fluxes that leave a (f_n_a, f_t_a) and that enter b (f_n_b, f_t_b), positive from a
+ * to b and equal at a face where the water meets, the two sides' depths at the face for the
+ * source and the face bed. No flux between two ghosts. Branch-free. */
 ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b,
-                               real z_b, real u_b, real t_b, real g, real* f_n, real* f_t,
-                               real* h_a_f, real* h_b_f, real* z_f) {
-  /* branch-free: the ghost side's state selected, both sides computed, a face between two
-   * ghosts masked to 0 at the end */
+                               real z_b, real u_b, real t_b, real g, real eps, real* f_n_a,
+                               real* f_t_a, real* f_n_b, real* f_t_b, real* h_a_f, real* h_b_f,
+                               real* z_f) {
+  /* the ghost side's state selected, both sides computed, a face between two ghosts masked to
+   * 0 at the end */
   const int active_a = k_a == ERODEM_CELL_ACTIVE, active_b = k_b == ERODEM_CELL_ACTIVE;
   const int ghost_b = active_a & !active_b, ghost_a = active_b & !active_a;
   const int fixed_b = k_b == ERODEM_CELL_FIXED, fixed_a = k_a == ERODEM_CELL_FIXED;
   const int wall_b = k_b == ERODEM_CELL_WALL, wall_a = k_a == ERODEM_CELL_WALL;
   const real hb0 = h_b, zb0 = z_b, ub0 = u_b, tb0 = t_b;
   h_b = ghost_b & !fixed_b ? h_a : hb0;
-  z_b = ghost_b & !fixed_b ? z_a : zb0;
+  z_b = ghost_b & wall_b ? z_a : zb0;
   u_b = ghost_b ? (fixed_b ? (real)0 : wall_b ? -u_a : (u_a > (real)0 ? u_a : (real)0)) : ub0;
   t_b = ghost_b ? (fixed_b ? (real)0 : t_a) : tb0;
   const real ha0 = h_a, za0 = z_a, ua0 = u_a, ta0 = t_a;
   h_a = ghost_a & !fixed_a ? hb0 : ha0;
-  z_a = ghost_a & !fixed_a ? zb0 : za0;
+  z_a = ghost_a & wall_a ? zb0 : za0;
   u_a = ghost_a ? (fixed_a ? (real)0 : wall_a ? -ub0 : (ub0 < (real)0 ? ub0 : (real)0)) : ua0;
   t_a = ghost_a ? (fixed_a ? (real)0 : tb0) : ta0;
   const int any = active_a | active_b;
   const real eta_a = z_a + h_a, eta_b = z_b + h_b;
+  /* where the water meets: Chen & Noelle */
   const real z_hi = z_a > z_b ? z_a : z_b, eta_lo = eta_a < eta_b ? eta_a : eta_b;
   const real zf = z_hi < eta_lo ? z_hi : eta_lo;
   const real ra = eta_a - zf < h_a ? eta_a - zf : h_a;
   const real rb = eta_b - zf < h_b ? eta_b - zf : h_b;
   const real ha_f = any & (ra > (real)0) ? ra : (real)0;
   const real hb_f = any & (rb > (real)0) ? rb : (real)0;
-  *h_a_f = ha_f;
-  *h_b_f = hb_f;
-  *z_f = zf;
-  return sw_hllc(ha_f, u_a, t_a, hb_f, u_b, t_b, g, f_n, f_t);
+  real fn, ft;
+  const real fh = sw_hllc(ha_f, u_a, t_a, hb_f, u_b, t_b, g, &fn, &ft);
+  /* a step: a film on the high side spilling onto the low side */
+  const int a_high = z_a > z_b, b_high = z_b > z_a;
+  const int step =
+      any & ((a_high & (h_a > eps) & (eta_b <= z_a)) | (b_high & (h_b > eps) & (eta_a <= z_b)));
+  const real h_hi = a_high ? h_a : h_b, h_lo = a_high ? h_b : h_a;
+  const real t_hi = a_high ? t_a : t_b;
+  /* the high side's velocity towards the step, and the low side's away from it */
+  const real u_hi = a_high ? u_a : -u_b, u_lo = a_high ? u_b : -u_a;
+  const real u_out = u_hi > (real)0 ? u_hi : (real)0;
+  const real q_out = h_hi * u_out; /* the film's discharge over the step (m^2/s) */
+  const real p_hi = (real)0.5 * g * h_hi * h_hi, p_lo = (real)0.5 * g * h_lo * h_lo;
+  /* the low side against the step: its pressure, or a wall's reflection (mirror Riemann
+   * problem, sw_hllc) where it runs towards the step */
+  real m_wall, t_wall;
+  (void)sw_hllc(h_lo, -u_lo, (real)0, h_lo, u_lo, (real)0, g, &m_wall, &t_wall);
+  const real m_lo = u_lo < (real)0 ? m_wall : p_lo;
+  const real jet = q_out * u_out; /* the momentum flux of the spilling film */
+  /* in the face's orientation (positive from a to b): the mass and the normal momentum change
+   * sign where b is the high side; the pressure terms do not */
+  const real s = a_high ? (real)1 : (real)-1;
+  const real fh_step = s * q_out;
+  const real fn_hi = jet + p_hi, fn_lo = jet + m_lo;
+  const real ft_step = s * q_out * t_hi;
+  *f_n_a = step ? (a_high ? fn_hi : fn_lo) : fn;
+  *f_n_b = step ? (a_high ? fn_lo : fn_hi) : fn;
+  *f_t_a = step ? ft_step : ft;
+  *f_t_b = step ? ft_step : ft;
+  *h_a_f = step ? h_a : ha_f;
+  *h_b_f = step ? h_b : hb_f;
+  *z_f = step ? (real)0.5 * (z_a + z_b) : zf;
+  return step ? fh_step : fh;
 }
 
 /* The shallow-water step of padded cell i of row y, its neighbours' kinds k_* and indices i_*
@@ -126,7 +176,7 @@ ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, r
  * ghost gives to its active neighbours; other ghosts give nothing) and, for an active cell, its new
  * unit discharges:
  *
- *   q' = q - dt / A (sum over faces of L F_q - S),  then  q'' = q' / (1 + dt g n^2 |q'| / h'^(7/3))
+ *   q' = q - dt / A (sum over faces of L F_q - S),  then  q'' = q' - dt g n^2 |q''| q'' / h'^(7/3)
  *
  * with the bed-slope source of Chen & Noelle (2017) on the reconstructed depths of the cell's
  * sides of its faces, S_x = -g (h_E + h_W) / 2 (z_E - z_W) L_x, and in y the same over the
@@ -149,24 +199,29 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   const real u = sw_velocity(q_x[i], h, eps), v = sw_velocity(q_y[i], h, eps);
   /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
   const real l_x = dy[y], l_n = face_y_width(dx, y_n), l_s = face_y_width(dx, y_s);
-  real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n;
+  /* each face's momentum fluxes on this cell's side: leaving it at its east and south faces
+   * (it is a there), entering it at its west and north faces (it is b); the other side's
+   * are the neighbour's */
+  real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n, other_n, other_t;
   real he_a, he_b, ze, hw_a, hw_b, zw, hs_a, hs_b, zs, hn_a, hn_b, zn;
   /* east face: a = this cell, b = east; normal east, tangent north */
   const real f_e =
       sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
-              sw_velocity(q_y[i_e], depth[i_e], eps), g, &fn_e, &ft_e, &he_a, &he_b, &ze);
+              sw_velocity(q_y[i_e], depth[i_e], eps), g, eps, &fn_e, &ft_e, &other_n, &other_t,
+              &he_a, &he_b, &ze);
   /* west face: a = west, b = this cell */
   const real f_w = sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
-                           sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, &fn_w, &ft_w,
-                           &hw_a, &hw_b, &zw);
+                           sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, eps, &other_n,
+                           &other_t, &fn_w, &ft_w, &hw_a, &hw_b, &zw);
   /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
   const real f_s =
       sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
-              sw_velocity(q_x[i_s], depth[i_s], eps), g, &fn_s, &ft_s, &hs_a, &hs_b, &zs);
+              sw_velocity(q_x[i_s], depth[i_s], eps), g, eps, &fn_s, &ft_s, &other_n, &other_t,
+              &hs_a, &hs_b, &zs);
   /* north face: a = north, b = this cell */
   const real f_n = sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
-                           sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, &fn_n, &ft_n,
-                           &hn_a, &hn_b, &zn);
+                           sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps, &other_n,
+                           &other_t, &fn_n, &ft_n, &hn_a, &hn_b, &zn);
   /* outflows: what leaves through each face (m^3/s); a fixed-level ghost gives only to active
    * cells (sw_face gives no flux between ghosts) */
   const real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
@@ -197,10 +252,15 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   const real h_f = h1 > eps ? h1 : eps;
   const real q_mag = sqrt(qx1 * qx1 + qy1 * qy1);
   const real h_7_3 = h_f * h_f * erodem_cbrt_positive(h_f);
-  const real den = (real)1 + dt * g * n * n * q_mag / h_7_3;
+  /* implicit in |q|: q = q' - dt k |q| q with k = g n^2 / h'^(7/3) is the root of
+   * dt k |q|^2 + |q| - |q'| = 0, |q| = 2 |q'| / (1 + sqrt(1 + 4 dt k |q'|)): no overshoot, and
+   * its fixed point is Manning's discharge whatever dt (the semi-implicit q' / (1 + dt k |q'|)
+   * caps |q| at 1 / (dt k): a film of 2 mm on a slope of 0.3 at a tenth of Manning's speed) */
+  const real dtk = dt * g * n * n / h_7_3;
+  const real factor = (real)2 / ((real)1 + sqrt((real)1 + (real)4 * dtk * q_mag));
   const int wet = h1 > eps;
-  q_x_new[i] = active ? (wet ? qx1 / den : (real)0) : q_x[i];
-  q_y_new[i] = active ? (wet ? qy1 / den : (real)0) : q_y[i];
+  q_x_new[i] = active ? (wet ? qx1 * factor : (real)0) : q_x[i];
+  q_y_new[i] = active ? (wet ? qy1 * factor : (real)0) : q_y[i];
 }
 
 /* shallow_water_cell_at for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices
