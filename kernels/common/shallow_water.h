@@ -144,11 +144,11 @@ ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, r
   const real u_out = u_hi > (real)0 ? u_hi : (real)0;
   const real q_out = h_hi * u_out; /* the film's discharge over the step (m^2/s) */
   const real p_hi = (real)0.5 * g * h_hi * h_hi, p_lo = (real)0.5 * g * h_lo * h_lo;
-  /* the low side against the step: its pressure, or a wall's reflection (mirror Riemann
-   * problem, sw_hllc) where it runs towards the step */
-  real m_wall, t_wall;
-  (void)sw_hllc(h_lo, -u_lo, (real)0, h_lo, u_lo, (real)0, g, &m_wall, &t_wall);
-  const real m_lo = u_lo < (real)0 ? m_wall : p_lo;
+  /* the low side against the step: its pressure, or where it runs towards the step at w > 0 a
+   * wall's reflection, the HLLC flux of the mirrored states (h, w | h, -w): with the wave
+   * speeds -+(c + w/2) it is g h^2 / 2 + h w^2 + (c + w/2) h w */
+  const real w = u_lo < (real)0 ? -u_lo : (real)0;
+  const real m_lo = p_lo + h_lo * w * (w + sqrt(g * h_lo) + (real)0.5 * w);
   const real jet = q_out * u_out; /* the momentum flux of the spilling film */
   /* in the face's orientation (positive from a to b): the mass and the normal momentum change
    * sign where b is the high side; the pressure terms do not */
