@@ -102,3 +102,23 @@ def test_sweep_on_dask_local_cluster(erodem, tujunga, tmp_path):
     assert len(workers) == 2
     assert (table["error"] == "").all(), table["error"].tolist()
     assert_same_tables(serial, table)
+
+
+def test_sweep_over_flow_schemes(erodem, tujunga, tmp_path):
+    # flow.scheme as a swept key (issue 16): the three schemes on one storm, each closing its
+    # water and material ledgers to rounding; the shallow-water member's unit discharges are
+    # stored with its state (restart/momentum_x) and are 0 for the other schemes
+    cfg, _ = sweep_args(tujunga)
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    table = erodem.sweep(dem, grid={"flow.scheme": ["pipes", "local_inertial", "shallow_water"]},
+                         config=cfg, workers=1, threads=1, output_dir=tmp_path)
+    print(table[["member", "flow.scheme"] + METRICS].to_string())
+    assert (table["error"] == "").all(), table["error"].tolist()
+    assert list(table["flow.scheme"]) == ["pipes", "local_inertial", "shallow_water"]
+    assert (table["closure_error"].abs() < 1e-4).all()
+    assert (table["material_closure_error"].abs() < 1e-4).all()
+    assert (table["eroded_volume"] > 0).all()
+    for scheme, path in zip(table["flow.scheme"], table["output"]):
+        with h5py.File(path, "r") as f:
+            q = np.abs(f["restart/momentum_x"][-1]).max()
+        assert (q > 0) == (scheme == "shallow_water"), (scheme, q)
