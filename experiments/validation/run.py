@@ -5,7 +5,8 @@ one figure per case (docs/images/validation/*.png) and the table of every measur
 
 The cases are the gtest cases themselves (tests/test_analytical.cpp, test_validation.cpp,
 test_runoff.cpp, test_waves.cpp, test_physics.cpp, test_sources.cpp,
-test_boundaries_rasters.cpp, test_lake.cpp, test_precision.cpp): this script builds nothing; it runs the built test
+test_boundaries_rasters.cpp, test_lake.cpp, test_snow.cpp, test_shallow_water.cpp,
+test_precision.cpp): this script builds nothing; it runs the built test
 binary with ERODEM_VALIDATION_DIR (each case appends its figures to records.jsonl and writes its
 profiles as CSV, tests/validation_record.hpp) and ERODEM_VALIDATION_LADDER=full. A failing case
 is recorded and shown failing; the script runs them all, writes the report, then exits 1 if any
