@@ -105,7 +105,7 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
 ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b,
                                real z_b, real u_b, real t_b, real g, real eps, real* f_n_a,
                                real* f_t_a, real* f_n_b, real* f_t_b, real* h_a_f, real* h_b_f,
-                               real* z_f) {
+                               real* z_f, int* step_side, real* f_n_low, real* z_mean) {
   /* the ghost side's state selected, both sides computed, a face between two ghosts masked to
    * 0 at the end */
   const int active_a = k_a == ERODEM_CELL_ACTIVE, active_b = k_b == ERODEM_CELL_ACTIVE;
@@ -156,21 +156,27 @@ ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, r
   const real fh_step = s * q_out;
   const real fn_hi = jet + p_hi, fn_lo = jet + m_lo;
   const real ft_step = s * q_out * t_hi;
-  /* The treatment is for water on a slope: it fades out as the low side's water deepens to
-   * half the step (wt from 1 for a film to 0), and a pool below a step is a pool against a wall,
-   * Chen & Noelle's case (with the full treatment a 23 m pit below wetted 40 m steps on Big
-   * Tujunga gathered the steps' bed-slope force and ran at 89 m/s). */
-  const real dz = a_high ? z_a - z_b : z_b - z_a;
-  const real fade = (real)1 - (real)2 * h_lo / (dz > (real)0 ? dz : (real)1);
-  const real wt = step ? (fade > (real)0 ? fade : (real)0) : (real)0, c = (real)1 - wt;
-  *f_n_a = wt * (a_high ? fn_hi : fn_lo) + c * fn;
-  *f_n_b = wt * (a_high ? fn_lo : fn_hi) + c * fn;
-  *f_t_a = wt * ft_step + c * ft;
-  *f_t_b = wt * ft_step + c * ft;
-  *h_a_f = wt * h_a + c * ha_f;
-  *h_b_f = wt * h_b + c * hb_f;
-  *z_f = wt * ((real)0.5 * (z_a + z_b)) + c * zf;
-  return wt * fh_step + c * fh;
+  /* the low side: the jet, and a wall where it runs at the bank (below); its depth at the face
+   * and the face bed stay Chen & Noelle's, so a pool below a wetted step stays at rest */
+  const int bank_a = active_a & (h_a > eps) & (eta_a <= z_b);
+  const int bank_b = active_b & (h_b > eps) & (eta_b <= z_a);
+  const real w_a = u_a > (real)0 ? u_a : (real)0, w_b = u_b < (real)0 ? -u_b : (real)0;
+  const real dyn_a = bank_a ? h_a * w_a * (sqrt(g * h_a) + (real)1.5 * w_a) : (real)0;
+  const real dyn_b = bank_b ? h_b * w_b * (sqrt(g * h_b) + (real)1.5 * w_b) : (real)0;
+  *f_n_a = step ? (a_high ? fn_hi : jet + dyn_a) : fn + dyn_a;
+  *f_n_b = step ? (a_high ? jet + dyn_b : fn_hi) : fn + dyn_b;
+  *f_t_a = step ? ft_step : ft;
+  *f_t_b = step ? ft_step : ft;
+  *h_a_f = ha_f;
+  *h_b_f = hb_f;
+  *z_f = zf;
+  /* for a cell on a staircase (shallow_water_cell_at): which side is high, the low side's
+   * momentum flux against the step (the jet and its own pressure, or a wall's reflection), and
+   * the mean of the two beds */
+  *step_side = step ? (a_high ? 1 : -1) : 0;
+  *f_n_low = fn_lo;
+  *z_mean = (real)0.5 * (z_a + z_b);
+  return step ? fh_step : fh;
 }
 
 /* The shallow-water step of padded cell i of row y, its neighbours' kinds k_* and indices i_*
@@ -210,25 +216,27 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
    * (it is a there), entering it at its west and north faces (it is b); the other side's
    * are the neighbour's */
   real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n, other_n, other_t;
+  int st_e, st_w, st_s, st_n;
+  real lo_e, lo_w, lo_s, lo_n, zm_e, zm_w, zm_s, zm_n;
   real he_a, he_b, ze, hw_a, hw_b, zw, hs_a, hs_b, zs, hn_a, hn_b, zn;
   /* east face: a = this cell, b = east; normal east, tangent north */
   const real f_e =
       sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
               sw_velocity(q_y[i_e], depth[i_e], eps), g, eps, &fn_e, &ft_e, &other_n, &other_t,
-              &he_a, &he_b, &ze);
+              &he_a, &he_b, &ze, &st_e, &lo_e, &zm_e);
   /* west face: a = west, b = this cell */
   const real f_w = sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
                            sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, eps, &other_n,
-                           &other_t, &fn_w, &ft_w, &hw_a, &hw_b, &zw);
+                           &other_t, &fn_w, &ft_w, &hw_a, &hw_b, &zw, &st_w, &lo_w, &zm_w);
   /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
   const real f_s =
       sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
               sw_velocity(q_x[i_s], depth[i_s], eps), g, eps, &fn_s, &ft_s, &other_n, &other_t,
-              &hs_a, &hs_b, &zs);
+              &hs_a, &hs_b, &zs, &st_s, &lo_s, &zm_s);
   /* north face: a = north, b = this cell */
   const real f_n = sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
                            sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps, &other_n,
-                           &other_t, &fn_n, &ft_n, &hn_a, &hn_b, &zn);
+                           &other_t, &fn_n, &ft_n, &hn_a, &hn_b, &zn, &st_n, &lo_n, &zm_n);
   /* outflows: what leaves through each face (m^3/s); a fixed-level ghost gives only to active
    * cells (sw_face gives no flux between ghosts) */
   const real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
@@ -241,15 +249,34 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   out_right[i] = gives ? o_r * K : (real)0;
   out_top[i] = gives ? o_t * K : (real)0;
   out_bottom[i] = gives ? o_b * K : (real)0;
+  /* A cell on a staircase, a film that a step drops onto and that drops over the next one in
+   * the same direction (its uphill face a step with it low, its downhill one with it high):
+   * the film on a slope, not a pool below a wall. Its bed-slope source takes its own depth at
+   * both faces and the mean beds as the face beds, so it feels the whole g h S of the ramp the
+   * steps stand for, and its uphill face pushes with its own pressure (balancing the downhill
+   * face's); elsewhere Chen & Noelle's values (half of it on such a step, and a pool below a
+   * step stays at rest). */
+  const int stair_x = ((st_e == 1) & (st_w == 1)) | ((st_e == -1) & (st_w == -1));
+  const int stair_y = ((st_s == 1) & (st_n == 1)) | ((st_s == -1) & (st_n == -1));
+  /* the low side's flux on a staircase: at the east and south faces the cell is a, low where
+   * b is high (-1); at the west and north faces it is b, low where a is high (+1) */
+  const real fne = stair_x & (st_e == -1) ? lo_e : fn_e;
+  const real fnw = stair_x & (st_w == 1) ? lo_w : fn_w;
+  const real fns = stair_y & (st_s == -1) ? lo_s : fn_s;
+  const real fnn = stair_y & (st_n == 1) ? lo_n : fn_n;
+  const real hE = stair_x ? h : he_a, hW = stair_x ? h : hw_b;
+  const real hS = stair_y ? h : hs_a, hN = stair_y ? h : hn_b;
+  const real zE = stair_x ? zm_e : ze, zW = stair_x ? zm_w : zw;
+  const real zS = stair_y ? zm_s : zs, zN = stair_y ? zm_n : zn;
   /* the outward fluxes of q_x and of q_y (north) through the four faces (m^4/s^2): a y-face's
    * normal momentum is southward, so q_y takes its negative */
-  const real phi_x = (fn_e - fn_w) * l_x + ft_s * l_s - ft_n * l_n;
-  const real phi_y = (ft_e - ft_w) * l_x - fn_s * l_s + fn_n * l_n;
+  const real phi_x = (fne - fnw) * l_x + ft_s * l_s - ft_n * l_n;
+  const real phi_y = (ft_e - ft_w) * l_x - fns * l_s + fnn * l_n;
   /* the bed-slope and side-pressure sources (m^4/s^2) on this cell's reconstructed depths */
   const real l_mean = (real)0.5 * (l_n + l_s);
-  const real s_x = -g * (real)0.5 * (he_a + hw_b) * (ze - zw) * l_x;
-  const real s_y = -g * (real)0.5 * (hn_b + hs_a) * (zn - zs) * l_mean -
-                   g * (real)0.25 * (hs_a * hs_a + hn_b * hn_b) * (l_s - l_n);
+  const real s_x = -g * (real)0.5 * (hE + hW) * (zE - zW) * l_x;
+  const real s_y = -g * (real)0.5 * (hN + hS) * (zN - zS) * l_mean -
+                   g * (real)0.25 * (hS * hS + hN * hN) * (l_s - l_n);
   const real qx1 = q_x[i] - dt / a * (phi_x - s_x);
   const real qy1 = q_y[i] - dt / a * (phi_y - s_y);
   /* the depth after the fluxes (this cell's mass balance) for the friction */
