@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """The three flow schemes on a real DEM (issue 16): pipes, local inertial and shallow water on
-the same storm, at the DEM's resolution and coarsened twice (dem.resample = 2), with
+the same storm (erosion off: with Mei's capacity law and its defaults the shallow-water and the
+pipes runs dig runaway pits thousands of metres deep at open edges, a problem of that law, issue
+17, not of the flow), at the DEM's resolution and coarsened twice (dem.resample = 2), with
 the shallow-water run as the reference. For each run: wall time, steps, water out through the
 edges and its peak rate, flooded area (depth > 0.1 m), largest depth and speed, eroded and
 deposited volumes (the final erosion field), and against the shallow-water run the depth
@@ -26,7 +28,7 @@ STORM = [
     "rain.rate=50 mm/h",
     "time.duration=1 h",
     "time.adaptive=true",
-    "erosion.enabled=true",
+    "erosion.enabled=false",
     "flow.manning_n=0.035",
 ] + ["boundary.%s=open" % e for e in ("north", "south", "east", "west")]
 
@@ -50,7 +52,7 @@ def read(path):
         dy = abs(float(f["y"][1] - f["y"][0]))
         d = f["diagnostics"]
         t = d["time"][...]
-        out = d["boundary_out"][...] if "boundary_out" in d else None
+        out = d["boundary_outflow_volume"][...]
     return h, e, np.hypot(u, v), dx * dy, t, out
 
 
@@ -91,10 +93,14 @@ def summary(path, wall, steps):
         "eroded": float(e[e > 0].sum() * area),
         "deposited": float(-e[e < 0].sum() * area),
     }
-    if out is not None and len(out) > 1:
-        rate = np.diff(out) / np.maximum(np.diff(t), 1e-12)
+    if len(out) > 1:
+        # the outflow rate over 60 s windows (steps differ between the schemes)
+        grid = np.arange(0.0, t[-1] + 1e-9, 60.0)
+        cum = np.interp(grid, t, out)
+        rate = np.diff(cum) / 60.0
         row["out"] = float(out[-1])
         row["peak_out"] = float(rate.max())
+        row["t_half"] = float(grid[1:][np.argmax(rate >= 0.5 * rate.max())])
     return row, h
 
 
@@ -114,10 +120,10 @@ def main():
             rows[scheme], depths[scheme] = summary(*r)
         ref = depths.get("shallow_water")
         print("\n%s, resample factor %d, %s:" % (a.case, factor, a.backend))
-        print("| scheme | wall (s) | steps | water out (m^3) | peak outflow (m^3/s) | flooded > 0.1 m "
-              "(km^2) | max depth (m) | max speed (m/s) | eroded (m^3) | deposited (m^3) | "
-              "RMS depth - sw (m) | 95th pct \\|depth - sw\\| (m) | sw flooded area also flooded |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        print("| scheme | wall (s) | steps | water out (m^3) | peak outflow (m^3/s) | outflow at half "
+              "its peak (s) | flooded > 0.1 m (km^2) | max depth (m) | max speed (m/s) | RMS depth - "
+              "sw (m) | 95th pct \\|depth - sw\\| (m) | sw flooded area also flooded |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|")
         for scheme, r in rows.items():
             cmp = ("", "", "")
             if ref is not None:
@@ -127,10 +133,10 @@ def main():
                 both = ((h > FLOODED) & (ref > FLOODED)).sum() / max(1, (ref > FLOODED).sum())
                 cmp = ("%.3f" % np.sqrt(np.mean(dh ** 2)), "%.3f" % np.percentile(dh, 95),
                        "%.3f" % both)
-            print("| %s | %.0f | %s | %.4g | %.4g | %.3f | %.2f | %.2f | %.4g | %.4g | %s | %s | %s |"
+            print("| %s | %.0f | %s | %.4g | %.4g | %.0f | %.3f | %.2f | %.2f | %s | %s | %s |"
                   % (scheme, r["wall"], r["steps"], r.get("out", float("nan")),
-                     r.get("peak_out", float("nan")), r["flooded_km2"], r["max_depth"],
-                     r["max_speed"], r["eroded"], r["deposited"], *cmp), flush=True)
+                     r.get("peak_out", float("nan")), r.get("t_half", float("nan")),
+                     r["flooded_km2"], r["max_depth"], r["max_speed"], *cmp), flush=True)
 
 
 if __name__ == "__main__":
