@@ -8,7 +8,7 @@ foreach(t IN LISTS erodem_tests_TESTS)
      OR t MATCHES
      "Physics\\.(SemiLagrangianLossIsMeasured|BedrockLevelIsNeverCut|LakeAtRestStaysAtRest|ClosedBoxConservesWaterAndMaterial)/"
      OR t MATCHES
-     "Sources\\.(FixedLevelEdgeFillsADryChannelAtRittersSpeed|LargeInflowHydrographIntoADryBasin|LineInflowOnAPlainStaysSmoothAndSymmetric|HunterFloodFrontOnAFrictionalBed)/"
+     "Sources\\.(FixedLevelEdgeFillsADryChannelAtRittersSpeed|LargeInflowHydrographIntoADryBasin|LineInflowOnAPlainStaysSmoothAndSymmetric|HunterFloodFrontOnAFrictionalBed|HunterFloodFrontShallowWater)/"
      OR t MATCHES "^Precision\\.Float32")
     set_tests_properties("${t}" PROPERTIES LABELS validation)
   endif()
