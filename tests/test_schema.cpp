@@ -262,7 +262,8 @@ TEST(Schema, TypeErrors) {
   msg = config_error_message([] { from_text("[time]\nadaptive = 1\n"); });
   EXPECT_NE(msg.find("'time.adaptive': expected a boolean"), std::string::npos) << msg;
   msg = config_error_message([] { from_text("[flow]\nscheme = \"pipe\"\n"); });
-  EXPECT_NE(msg.find("expected one of pipes | local_inertial | shallow_water, got \"pipe\""), std::string::npos)
+  EXPECT_NE(msg.find("expected one of pipes | local_inertial | shallow_water, got \"pipe\""),
+            std::string::npos)
       << msg;
   msg = config_error_message([] { from_text("[time]\ndt = \"5 mm\"\n"); });
   EXPECT_NE(msg.find("'time.dt': unit 'mm'"), std::string::npos) << msg;
