@@ -201,6 +201,101 @@ TEST_P(ShallowWater, LakeAtRestOnAGeographicDem) {
   vr::report(fig("max speed (m/s)"), m[1]);
 }
 
+/// Thacker's planar surface in a paraboloid (Thacker 1981; SWASHES 4.2.2): bed
+/// z = -h0 (1 - r^2 / a^2) about the centre of an L x L square, a tilted plane of water that
+/// turns round the basin at omega = sqrt(2 g h0) / a without changing shape: the water's centre
+/// moves on a circle, its x coordinate eta/2 cos(omega t) (by symmetry of the wet disc, radius a).
+/// Returns the measured period (s) from the zero crossings of sum (x - L/2) h, and the ratio of the
+/// last to the first extremum of that sum (1: no decay).
+struct ThackerRun {
+  double period, exact, decay;
+  int wet_across;
+};
+ThackerRun run_thacker(int n, double periods, const Target& target) {
+  const double a = 1.0, h0 = 0.1, eta = 0.5, L = 4.0, g = kG;
+  const double omega = std::sqrt(2 * g * h0) / a, T = 2 * M_PI / omega, dx = L / n;
+  Terrain t = flat_terrain(n, n, dx);
+  t.water_depth.assign(t.grid.cells(), 0.0);
+  std::vector<double> qy(t.grid.cells(), 0.0);
+  int wet_across = 0;
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      const std::size_t i = static_cast<std::size_t>(r) * n + c;
+      // x east, y north: row 0 is the north edge
+      const double x = (c + 0.5) * dx - L / 2, y = L / 2 - (r + 0.5) * dx;
+      const double z = -h0 * (1 - (x * x + y * y) / (a * a));
+      t.bed[i] = z;
+      const double h = eta * h0 / (a * a) * (2 * x - eta) - z;
+      t.water_depth[i] = std::max(0.0, h);
+      qy[i] = t.water_depth[i] * eta * omega;  // v = eta omega at t = 0, u = 0
+      if (r == n / 2 && h > 0) ++wet_across;
+    }
+  Params p = sw_params(0.0);
+  p.time.adaptive = true;
+  p.time.cfl = 0.5;
+  p.time.dt_max = 0.01;
+  auto sim = make_simulation(t, p, target);
+  sim.backend().set_field(FieldId::momentum_y, qy);
+  std::vector<double> times, moments;
+  while (sim.time() < periods * T) {
+    sim.step();
+    const auto h = sim.field(FieldId::water_depth);
+    double m = 0;
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c)
+        m += ((c + 0.5) * dx - L / 2) * h[static_cast<std::size_t>(r) * n + c];
+    times.push_back(sim.time());
+    moments.push_back(m);
+  }
+  // zero crossings of the moment, linearly interpolated; extrema between them
+  std::vector<double> crossings, extrema;
+  double extreme = 0;
+  for (std::size_t k = 1; k < moments.size(); ++k) {
+    if (std::abs(moments[k]) > std::abs(extreme)) extreme = moments[k];
+    if ((moments[k - 1] < 0) != (moments[k] < 0)) {
+      const double f = moments[k - 1] / (moments[k - 1] - moments[k]);
+      crossings.push_back(times[k - 1] + f * (times[k] - times[k - 1]));
+      extrema.push_back(extreme);
+      extreme = 0;
+    }
+  }
+  ThackerRun out{0, T, 0, wet_across};
+  if (crossings.size() >= 3)
+    out.period = 2 * (crossings.back() - crossings.front()) / (crossings.size() - 1);
+  if (extrema.size() >= 3) out.decay = std::abs(extrema.back() / extrema[1]);
+  return out;
+}
+
+TEST_P(ShallowWater, ThackerPlanarOscillation) {
+  // Thacker's planar surface in a paraboloid (a = 1 m, h0 = 0.1 m, eta = 0.5 m, 4 m basin,
+  // frictionless, adaptive steps at CFL 0.5), three periods (T = 4.486 s): the period from the
+  // zero crossings of the water's first moment in x, and the decay of its amplitude. Issue 16:
+  // within 1 % at a stated resolution, first order needing about 200 wet cells across. ctest
+  // runs 100 cells across the 4 m (49 wet across the disc): bound 5 % (an idle solver's moment
+  // never crosses zero). The report adds 200 and 400 cells across (100 and 200 wet): the error
+  // falls at first order (+3.7, +1.9, +1.0 %), and at 200 wet cells the issue's 1 % holds.
+  std::vector<int> sizes{100};
+  if (vr::full_ladder()) {
+    sizes.push_back(200);
+    sizes.push_back(400);
+  }
+  for (int n : sizes) {
+    const ThackerRun r = run_thacker(n, 3.0, target());
+    const double err = r.period / r.exact - 1;
+    std::printf(
+        "[sw Thacker] %s %d cells across (%d wet): period %.4f s, exact %.4f s (%+.2f %%, "
+        "bound 5 %%); amplitude after 3 periods %.3f of the first\n",
+        target().label().c_str(), n, r.wet_across, r.period, r.exact, 100 * err, r.decay);
+    auto fig = [&](const char* q) {
+      return figure("sw_thacker", "shallow_water", q, 4.0 / n, "Thacker (1981); SWASHES 4.2.2");
+    };
+    const double bound = r.wet_across >= 190 ? 0.01 : 0.05;
+    vr::expect_between(fig("period / exact - 1"), err, -bound, bound);
+    vr::report(fig("amplitude after 3 periods / first"), r.decay);
+    EXPECT_GT(r.decay, 0.2) << "the oscillation survives three periods";
+  }
+}
+
 ERODEM_INSTANTIATE_TARGETS(ShallowWater);
 
 }  // namespace
