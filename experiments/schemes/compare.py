@@ -14,6 +14,7 @@ Usage (from the repository root, after `bash scripts/setup.sh`):
 Results go to out/schemes/<case>_<scheme>_r<factor>.h5 (replaced).
 """
 import argparse
+import importlib.util
 import os
 import subprocess
 import time
@@ -22,15 +23,26 @@ import h5py
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-ERODEM = os.environ.get("ERODEM", os.path.join(ROOT, "build", "cli", "erodem"))
 
-STORM = [
-    "rain.rate=50 mm/h",
-    "time.duration=1 h",
-    "time.adaptive=true",
+
+def _precision():
+    """experiments/precision/compare.py: its binary path and storm, which this comparison
+    shares."""
+    spec = importlib.util.spec_from_file_location(
+        "precision_compare", os.path.join(ROOT, "experiments", "precision", "compare.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+_P = _precision()
+ERODEM = _P.ERODEM
+# the precision experiment's storm (50 mm/h for 1 h, adaptive steps, open edges) with erosion
+# and thermal collapse off and a rougher bed
+STORM = [s for s in _P.STORM if not s.startswith(("erosion.", "thermal."))] + [
     "erosion.enabled=false",
     "flow.manning_n=0.035",
-] + ["boundary.%s=open" % e for e in ("north", "south", "east", "west")]
+]
 
 CASES = {
     # one hour of 50 mm/h over the whole Big Tujunga tile (the precision experiment's storm)

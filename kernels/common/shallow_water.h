@@ -98,14 +98,15 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
  * against the step, g h_low^2 / 2, or a wall's reflection where it runs towards the step. Mass
  * is conserved (one mass flux); momentum is not, as the step takes the force.
  *
- * Returns the mass flux (m^2/s, positive from a to b); writes the normal and tangential
- * momentum fluxes that leave a (f_n_a, f_t_a) and that enter b (f_n_b, f_t_b), positive from a
- * to b and equal at a face where the water meets, the two sides' depths at the face for the
- * source and the face bed. No flux between two ghosts. Branch-free. */
+ * Returns the mass flux (m^2/s, positive from a to b); writes the normal momentum fluxes that
+ * leave a (f_n_a) and that enter b (f_n_b), positive from a to b and equal at a face where the
+ * water meets, the tangential one (f_t, the same for both sides: it rides on the one mass
+ * flux), the two sides' depths at the face for the source and the face bed. No flux between
+ * two ghosts. Branch-free. */
 ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b,
                                real z_b, real u_b, real t_b, real g, real eps, real* f_n_a,
-                               real* f_t_a, real* f_n_b, real* f_t_b, real* h_a_f, real* h_b_f,
-                               real* z_f, int* step_side, real* f_n_low, real* z_mean) {
+                               real* f_n_b, real* f_t, real* h_a_f, real* h_b_f, real* z_f,
+                               int* step_side, real* f_n_low, real* z_mean) {
   /* the ghost side's state selected, both sides computed, a face between two ghosts masked to
    * 0 at the end */
   const int active_a = k_a == ERODEM_CELL_ACTIVE, active_b = k_b == ERODEM_CELL_ACTIVE;
@@ -165,8 +166,7 @@ ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, r
   const real dyn_b = bank_b ? h_b * w_b * (sqrt(g * h_b) + (real)1.5 * w_b) : (real)0;
   *f_n_a = step ? (a_high ? fn_hi : jet + dyn_a) : fn + dyn_a;
   *f_n_b = step ? (a_high ? jet + dyn_b : fn_hi) : fn + dyn_b;
-  *f_t_a = step ? ft_step : ft;
-  *f_t_b = step ? ft_step : ft;
+  *f_t = step ? ft_step : ft;
   *h_a_f = ha_f;
   *h_b_f = hb_f;
   *z_f = zf;
@@ -215,28 +215,28 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   /* each face's momentum fluxes on this cell's side: leaving it at its east and south faces
    * (it is a there), entering it at its west and north faces (it is b); the other side's
    * are the neighbour's */
-  real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n, other_n, other_t;
+  real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n, other_n;
   int st_e, st_w, st_s, st_n;
   real lo_e, lo_w, lo_s, lo_n, zm_e, zm_w, zm_s, zm_n;
   real he_a, he_b, ze, hw_a, hw_b, zw, hs_a, hs_b, zs, hn_a, hn_b, zn;
   /* east face: a = this cell, b = east; normal east, tangent north */
   const real f_e =
       sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
-              sw_velocity(q_y[i_e], depth[i_e], eps), g, eps, &fn_e, &ft_e, &other_n, &other_t,
-              &he_a, &he_b, &ze, &st_e, &lo_e, &zm_e);
+              sw_velocity(q_y[i_e], depth[i_e], eps), g, eps, &fn_e, &other_n, &ft_e, &he_a, &he_b,
+              &ze, &st_e, &lo_e, &zm_e);
   /* west face: a = west, b = this cell */
   const real f_w = sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
                            sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, eps, &other_n,
-                           &other_t, &fn_w, &ft_w, &hw_a, &hw_b, &zw, &st_w, &lo_w, &zm_w);
+                           &fn_w, &ft_w, &hw_a, &hw_b, &zw, &st_w, &lo_w, &zm_w);
   /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
   const real f_s =
       sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
-              sw_velocity(q_x[i_s], depth[i_s], eps), g, eps, &fn_s, &ft_s, &other_n, &other_t,
-              &hs_a, &hs_b, &zs, &st_s, &lo_s, &zm_s);
+              sw_velocity(q_x[i_s], depth[i_s], eps), g, eps, &fn_s, &other_n, &ft_s, &hs_a, &hs_b,
+              &zs, &st_s, &lo_s, &zm_s);
   /* north face: a = north, b = this cell */
   const real f_n = sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
                            sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps, &other_n,
-                           &other_t, &fn_n, &ft_n, &hn_a, &hn_b, &zn, &st_n, &lo_n, &zm_n);
+                           &fn_n, &ft_n, &hn_a, &hn_b, &zn, &st_n, &lo_n, &zm_n);
   /* outflows: what leaves through each face (m^3/s); a fixed-level ghost gives only to active
    * cells (sw_face gives no flux between ghosts) */
   const real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
