@@ -10,7 +10,8 @@ tests/scenarios.hpp `tujunga_storm` on the 256^2 Big Tujunga crop (local inertia
 conservative transport with adaptive steps; pipes + semi-Lagrangian with fixed steps) and the
 two runs of tests/test_restart.cpp (a synthetic valley with rain series, erosion, thermal
 collapse, evaporation, open and fixed-level edges; a hill with pipes, a point inflow
-hydrograph and semi-Lagrangian transport), each with gauges.
+hydrograph and semi-Lagrangian transport), each with gauges; and the storm and the valley with
+the shallow-water scheme.
 
 Usage (from the repository root, after building build/cli/erodem):
   python3 scripts/digests.py --write digests.json    # record the digests before a change
@@ -146,6 +147,11 @@ SCENARIOS = {
                                     transport="semi_lagrangian"),
     "valley_inertial": VALLEY,
     "hill_pipes": HILL,
+    # the shallow-water scheme (issue 16) on the same two: the storm with adaptive steps and
+    # conservative transport, the valley with its open and fixed-level edges
+    "tujunga_shallow_water": TUJUNGA.format(root=ROOT, adaptive="true", dt=2.0,
+                                            flow="shallow_water", transport="conservative"),
+    "valley_shallow_water": VALLEY.replace('scheme = "local_inertial"', 'scheme = "shallow_water"'),
 }
 TARGETS = {
     "cpu_float32": ["--backend", "cpu", "--set", "numerics.precision=float32"],

@@ -83,6 +83,20 @@ typedef std::uint8_t erodem_kind_t;
 #define ERODEM_P(Name) ::erodem::cell_params::Name<real>
 #endif
 
+/* A small struct of values that cell functions pass between them (a face's fluxes, a cell's
+ * results), members of type `real` or `int`: ERODEM_STRUCT(Name, {members}) declares it inside
+ * ERODEM_BEGIN_NAMESPACE, ERODEM_S(Name) names it in a cell function. In C++ it is a template
+ * on `real`, as the functions are. */
+#ifdef __OPENCL_C_VERSION__
+#define ERODEM_STRUCT(Name, ...) typedef struct __VA_ARGS__ Name;
+#define ERODEM_S(Name) Name
+#else
+#define ERODEM_STRUCT(Name, ...) \
+  template <class real>          \
+  struct Name __VA_ARGS__;
+#define ERODEM_S(Name) Name<real>
+#endif
+
 /* Cube root with the same bits on the CPU and every OpenCL device (float32). The C library's
  * cbrtf and OpenCL's cbrt may differ by an ulp, and the thresholds of the flow schemes (dry
  * faces, clipping) turn one ulp into visible differences after many steps. This one uses
@@ -167,16 +181,18 @@ inline double erodem_cbrt_positive(double x) {
 }  // namespace erodem
 #endif
 
-/* The larger of two numbers that are not NaN (for NaN the two languages differ: fmax gives
- * the other number, the comparison gives b). The same value everywhere else, bit for bit; the
+/* The larger (smaller) of two numbers that are not NaN (for NaN the two languages differ: fmax
+ * gives the other number, the comparison gives b). The same value everywhere else, bit for bit; the
  * spelling is per compiler: in the local-inertial face loops PoCL vectorises fmax across
  * work-items but not the comparison (27 instead of 33 loops 8 wide on AVX2,
  * tests/pocl_vectorisation.sh), and GCC the comparison but not fmax (the two face loops of
  * kernels/cpu/flow.cpp stay scalar: fmax must keep NaN semantics). */
 #ifdef __OPENCL_C_VERSION__
 #define erodem_max(a, b) fmax(a, b)
+#define erodem_min(a, b) fmin(a, b)
 #else
 #define erodem_max(a, b) ((a) > (b) ? (a) : (b))
+#define erodem_min(a, b) ((a) < (b) ? (a) : (b))
 #endif
 
 /* Cell kinds (the `kind` field). */

@@ -50,9 +50,9 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
   const real u_star = (real)0.5 * (u_l + u_r) + c_l - c_r;
   const real c_star = (real)0.5 * (c_l + c_r) + (real)0.25 * (u_l - u_r);
   const real s_l =
-      wet_l ? (wet_r ? fmin(u_l - c_l, u_star - c_star) : u_l - c_l) : u_r - (real)2 * c_r;
+      wet_l ? (wet_r ? erodem_min(u_l - c_l, u_star - c_star) : u_l - c_l) : u_r - (real)2 * c_r;
   const real s_r =
-      wet_l ? (wet_r ? fmax(u_r + c_r, u_star + c_star) : u_l + (real)2 * c_l) : u_r + c_r;
+      wet_l ? (wet_r ? erodem_max(u_r + c_r, u_star + c_star) : u_l + (real)2 * c_l) : u_r + c_r;
   const real span = s_r - s_l;
   const real inv = (real)1 / (span > (real)0 ? span : (real)1);
   const real h_hll = (s_r * q_l - s_l * q_r + s_l * s_r * (h_r - h_l)) * inv;
@@ -69,6 +69,21 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
   *f_t = f_h * (s_star >= (real)0 ? t_l : t_r);
   return f_h;
 }
+
+/* What a face gives the two cells beside it (sw_face): a west or north of the face, b east or
+ * south of it. */
+ERODEM_STRUCT(SwFace, {
+  real mass;    /* mass flux (m^2/s, positive from a to b) */
+  real mom_a;   /* normal momentum flux leaving a (m^3/s^2, positive from a to b) */
+  real mom_b;   /* normal momentum flux entering b (equal to mom_a where the water meets) */
+  real mom_t;   /* tangential momentum flux (m^3/s^2; the same for both sides) */
+  real h_a;     /* a's depth at the face (m) */
+  real h_b;     /* b's depth at the face (m) */
+  real z;       /* the face bed (m) */
+  real mom_low; /* a step's low side: its normal momentum flux against the step */
+  real z_mean;  /* the mean of the two beds (m) */
+  int step;     /* a step: 1 where a is the high side, -1 where b is, 0 where the water meets */
+})
 
 /* The face between padded cells a (west or north of it) and b (east or south), the normal
  * from a to b: kinds k_a, k_b; each side's depth h (m), bed z (m), velocity u normal to the
@@ -98,15 +113,12 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
  * against the step, g h_low^2 / 2, or a wall's reflection where it runs towards the step. Mass
  * is conserved (one mass flux); momentum is not, as the step takes the force.
  *
- * Returns the mass flux (m^2/s, positive from a to b); writes the normal momentum fluxes that
- * leave a (f_n_a) and that enter b (f_n_b), positive from a to b and equal at a face where the
- * water meets, the tangential one (f_t, the same for both sides: it rides on the one mass
- * flux), the two sides' depths at the face for the source and the face bed. No flux between
- * two ghosts. Branch-free. */
-ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b,
-                               real z_b, real u_b, real t_b, real g, real eps, real* f_n_a,
-                               real* f_n_b, real* f_t, real* h_a_f, real* h_b_f, real* z_f,
-                               int* step_side, real* f_n_low, real* z_mean) {
+ * Returns the face's fluxes, the two sides' depths at it and its bed for the bed-slope source,
+ * and for a step which side is high, the low side's flux against it and the mean bed (SwFace).
+ * No flux between two ghosts. Branch-free. */
+ERODEM_FN_INLINED ERODEM_S(SwFace)
+    sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, real t_a, real h_b, real z_b, real u_b,
+            real t_b, real g, real eps) {
   /* the ghost side's state selected, both sides computed, a face between two ghosts masked to
    * 0 at the end */
   const int active_a = k_a == ERODEM_CELL_ACTIVE, active_b = k_b == ERODEM_CELL_ACTIVE;
@@ -164,32 +176,40 @@ ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, r
   const real w_a = u_a > (real)0 ? u_a : (real)0, w_b = u_b < (real)0 ? -u_b : (real)0;
   const real dyn_a = bank_a ? h_a * w_a * (sqrt(g * h_a) + (real)1.5 * w_a) : (real)0;
   const real dyn_b = bank_b ? h_b * w_b * (sqrt(g * h_b) + (real)1.5 * w_b) : (real)0;
-  *f_n_a = step ? (a_high ? fn_hi : jet + dyn_a) : fn + dyn_a;
-  *f_n_b = step ? (a_high ? jet + dyn_b : fn_hi) : fn + dyn_b;
-  *f_t = step ? ft_step : ft;
-  *h_a_f = ha_f;
-  *h_b_f = hb_f;
-  *z_f = zf;
-  /* for a cell on a staircase (shallow_water_cell_at): which side is high, the low side's
+  ERODEM_S(SwFace) r;
+  r.mass = step ? fh_step : fh;
+  r.mom_a = step ? (a_high ? fn_hi : jet + dyn_a) : fn + dyn_a;
+  r.mom_b = step ? (a_high ? jet + dyn_b : fn_hi) : fn + dyn_b;
+  r.mom_t = step ? ft_step : ft;
+  r.h_a = ha_f;
+  r.h_b = hb_f;
+  r.z = zf;
+  /* for a cell on a staircase (shallow_water_cell_update): which side is high, the low side's
    * momentum flux against the step (the jet and its own pressure, or a wall's reflection), and
    * the mean of the two beds */
-  *step_side = step ? (a_high ? 1 : -1) : 0;
-  *f_n_low = fn_lo;
-  *z_mean = (real)0.5 * (z_a + z_b);
-  return step ? fh_step : fh;
+  r.step = step ? (a_high ? 1 : -1) : 0;
+  r.mom_low = fn_lo;
+  r.z_mean = (real)0.5 * (z_a + z_b);
+  return r;
 }
 
-/* The shallow-water step of padded cell i of row y, its neighbours' kinds k_* and indices i_*
- * (west, east, north, south) and the rows y_n, y_s of its north and south faces (the faces
- * between rows y_n and y_n + 1, y_s and y_s + 1), from the state at the start of the step: depth,
- * bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n (s m^-1/3), the rows' dx, dy (m)
- * and cell areas (m^2); dt (s); p.gravity (m/s^2) and p.dry_depth (m: velocities are desingularised
- * below it, and a cell left shallower has no discharge). Writes the cell's outflows (m^3/s; an
- * active cell's scaled like the other schemes' so it gives no more than it holds; a fixed-level
- * ghost gives to its active neighbours; other ghosts give nothing) and, for an active cell, its new
- * unit discharges:
+/* What the shallow-water step gives a cell: its outflows (m^3/s) and unit discharges (m^2/s). */
+ERODEM_STRUCT(SwCell, {
+  real left, right, top, bottom; /* outflows through the west, east, north and south faces */
+  real q_x, q_y;                 /* the new unit discharges, eastwards and northwards */
+})
+
+/* The shallow-water step of a padded cell of kind k from its four faces (sw_face: e the face east
+ * of it, where it is a; w west, where it is b; s south, where it is a; n north, where it is b;
+ * the y-faces' normal pointing south), its state at the start of the step: depth h (m), unit
+ * discharges q_x (east), q_y (north) (m^2/s), Manning n (s m^-1/3); the lengths of its x-faces
+ * l_x and of its north and south faces l_n, l_s (m), its area a (m^2); dt (s); p.gravity (m/s^2)
+ * and p.dry_depth (m: a cell left shallower has no discharge). Its outflows: an active cell's
+ * scaled like the other schemes' so it gives no more than it holds; a fixed-level ghost gives to
+ * its active neighbours (sw_face gives no flux between ghosts); other ghosts give nothing. An
+ * active cell's new unit discharges:
  *
- *   q' = q - dt / A (sum over faces of L F_q - S),  then  q'' = q' - dt g n^2 |q''| q'' / h'^(7/3)
+ *   q' = q - dt / a (sum over faces of L F_q - S),  then  q'' = q' - dt g n^2 |q''| q'' / h'^(7/3)
  *
  * with the bed-slope source of Chen & Noelle (2017) on the reconstructed depths of the cell's
  * sides of its faces, S_x = -g (h_E + h_W) / 2 (z_E - z_W) L_x, and in y the same over the
@@ -197,58 +217,24 @@ ERODEM_FN_INLINED real sw_face(int k_a, int k_b, real h_a, real z_a, real u_a, r
  * differ in length (geographic grids), -g (h_N^2 + h_S^2) / 4 (L_S - L_N) (model.md section
  * 3.10: together they balance the fluxes of a lake at rest exactly); h' the depth after the
  * fluxes. Other cells keep their discharges. */
-ERODEM_FN_INLINED void shallow_water_cell_at(
-    int i, int y, int k_w, int k_e, int k_n, int k_s, int i_w, int i_e, int i_n, int i_s, int y_n,
-    int y_s, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed, GLOBAL const real* depth,
-    GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* manning,
-    GLOBAL const real* dx, GLOBAL const real* dy, GLOBAL const real* area, real dt,
-    ERODEM_P(FlowParams) p, GLOBAL real* out_left, GLOBAL real* out_right, GLOBAL real* out_top,
-    GLOBAL real* out_bottom, GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
+ERODEM_FN_INLINED ERODEM_S(SwCell)
+    shallow_water_cell_update(int k, real h, real q_x, real q_y, real n, real l_x, real l_n,
+                              real l_s, real a, real dt, ERODEM_P(FlowParams) p, ERODEM_S(SwFace) e,
+                              ERODEM_S(SwFace) w, ERODEM_S(SwFace) s, ERODEM_S(SwFace) nf) {
   /* branch-free: everything computed for every cell, the results selected by its kind */
-  const int k = kind[i];
   const real g = p.gravity, eps = p.dry_depth;
   const int active = k == ERODEM_CELL_ACTIVE, gives = active | (k == ERODEM_CELL_FIXED);
-  const real h = depth[i], z = bed[i];
-  const real u = sw_velocity(q_x[i], h, eps), v = sw_velocity(q_y[i], h, eps);
-  /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
-  const real l_x = dy[y], l_n = face_y_width(dx, y_n), l_s = face_y_width(dx, y_s);
-  /* each face's momentum fluxes on this cell's side: leaving it at its east and south faces
-   * (it is a there), entering it at its west and north faces (it is b); the other side's
-   * are the neighbour's */
-  real fn_e, ft_e, fn_w, ft_w, fn_s, ft_s, fn_n, ft_n, other_n;
-  int st_e, st_w, st_s, st_n;
-  real lo_e, lo_w, lo_s, lo_n, zm_e, zm_w, zm_s, zm_n;
-  real he_a, he_b, ze, hw_a, hw_b, zw, hs_a, hs_b, zs, hn_a, hn_b, zn;
-  /* east face: a = this cell, b = east; normal east, tangent north */
-  const real f_e =
-      sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
-              sw_velocity(q_y[i_e], depth[i_e], eps), g, eps, &fn_e, &other_n, &ft_e, &he_a, &he_b,
-              &ze, &st_e, &lo_e, &zm_e);
-  /* west face: a = west, b = this cell */
-  const real f_w = sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
-                           sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, eps, &other_n,
-                           &fn_w, &ft_w, &hw_a, &hw_b, &zw, &st_w, &lo_w, &zm_w);
-  /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
-  const real f_s =
-      sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
-              sw_velocity(q_x[i_s], depth[i_s], eps), g, eps, &fn_s, &other_n, &ft_s, &hs_a, &hs_b,
-              &zs, &st_s, &lo_s, &zm_s);
-  /* north face: a = north, b = this cell */
-  const real f_n = sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
-                           sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps, &other_n,
-                           &fn_n, &ft_n, &hn_a, &hn_b, &zn, &st_n, &lo_n, &zm_n);
-  /* outflows: what leaves through each face (m^3/s); a fixed-level ghost gives only to active
-   * cells (sw_face gives no flux between ghosts) */
-  const real o_r = (f_e > (real)0 ? f_e : (real)0) * l_x;
-  const real o_l = (f_w < (real)0 ? -f_w : (real)0) * l_x;
-  const real o_b = (f_s > (real)0 ? f_s : (real)0) * l_s;
-  const real o_t = (f_n < (real)0 ? -f_n : (real)0) * l_n;
-  const real a = area[y];
+  /* outflows: what leaves through each face (m^3/s) */
+  const real o_r = (e.mass > (real)0 ? e.mass : (real)0) * l_x;
+  const real o_l = (w.mass < (real)0 ? -w.mass : (real)0) * l_x;
+  const real o_b = (s.mass > (real)0 ? s.mass : (real)0) * l_s;
+  const real o_t = (nf.mass < (real)0 ? -nf.mass : (real)0) * l_n;
   const real K = active ? outflow_limit(h, a, o_l + o_r + o_t + o_b, dt) : (real)1;
-  out_left[i] = gives ? o_l * K : (real)0;
-  out_right[i] = gives ? o_r * K : (real)0;
-  out_top[i] = gives ? o_t * K : (real)0;
-  out_bottom[i] = gives ? o_b * K : (real)0;
+  ERODEM_S(SwCell) out;
+  out.left = gives ? o_l * K : (real)0;
+  out.right = gives ? o_r * K : (real)0;
+  out.top = gives ? o_t * K : (real)0;
+  out.bottom = gives ? o_b * K : (real)0;
   /* A cell on a staircase, a film that a step drops onto and that drops over the next one in
    * the same direction (its uphill face a step with it low, its downhill one with it high):
    * the film on a slope, not a pool below a wall. Its bed-slope source takes its own depth at
@@ -256,33 +242,34 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
    * steps stand for, and its uphill face pushes with its own pressure (balancing the downhill
    * face's); elsewhere Chen & Noelle's values (half of it on such a step, and a pool below a
    * step stays at rest). */
-  const int stair_x = ((st_e == 1) & (st_w == 1)) | ((st_e == -1) & (st_w == -1));
-  const int stair_y = ((st_s == 1) & (st_n == 1)) | ((st_s == -1) & (st_n == -1));
-  /* the low side's flux on a staircase: at the east and south faces the cell is a, low where
-   * b is high (-1); at the west and north faces it is b, low where a is high (+1) */
-  const real fne = stair_x & (st_e == -1) ? lo_e : fn_e;
-  const real fnw = stair_x & (st_w == 1) ? lo_w : fn_w;
-  const real fns = stair_y & (st_s == -1) ? lo_s : fn_s;
-  const real fnn = stair_y & (st_n == 1) ? lo_n : fn_n;
-  const real hE = stair_x ? h : he_a, hW = stair_x ? h : hw_b;
-  const real hS = stair_y ? h : hs_a, hN = stair_y ? h : hn_b;
-  const real zE = stair_x ? zm_e : ze, zW = stair_x ? zm_w : zw;
-  const real zS = stair_y ? zm_s : zs, zN = stair_y ? zm_n : zn;
+  const int stair_x = ((e.step == 1) & (w.step == 1)) | ((e.step == -1) & (w.step == -1));
+  const int stair_y = ((s.step == 1) & (nf.step == 1)) | ((s.step == -1) & (nf.step == -1));
+  /* each face's normal momentum flux on this cell's side (leaving it at its east and south
+   * faces, entering it at its west and north faces), or on a staircase the low side's against
+   * the step: at the east and south faces the cell is a, low where b is high (-1); at the west
+   * and north faces it is b, low where a is high (+1) */
+  const real fne = stair_x & (e.step == -1) ? e.mom_low : e.mom_a;
+  const real fnw = stair_x & (w.step == 1) ? w.mom_low : w.mom_b;
+  const real fns = stair_y & (s.step == -1) ? s.mom_low : s.mom_a;
+  const real fnn = stair_y & (nf.step == 1) ? nf.mom_low : nf.mom_b;
+  const real hE = stair_x ? h : e.h_a, hW = stair_x ? h : w.h_b;
+  const real hS = stair_y ? h : s.h_a, hN = stair_y ? h : nf.h_b;
+  const real zE = stair_x ? e.z_mean : e.z, zW = stair_x ? w.z_mean : w.z;
+  const real zS = stair_y ? s.z_mean : s.z, zN = stair_y ? nf.z_mean : nf.z;
   /* the outward fluxes of q_x and of q_y (north) through the four faces (m^4/s^2): a y-face's
    * normal momentum is southward, so q_y takes its negative */
-  const real phi_x = (fne - fnw) * l_x + ft_s * l_s - ft_n * l_n;
-  const real phi_y = (ft_e - ft_w) * l_x - fns * l_s + fnn * l_n;
+  const real phi_x = (fne - fnw) * l_x + s.mom_t * l_s - nf.mom_t * l_n;
+  const real phi_y = (e.mom_t - w.mom_t) * l_x - fns * l_s + fnn * l_n;
   /* the bed-slope and side-pressure sources (m^4/s^2) on this cell's reconstructed depths */
   const real l_mean = (real)0.5 * (l_n + l_s);
   const real s_x = -g * (real)0.5 * (hE + hW) * (zE - zW) * l_x;
   const real s_y = -g * (real)0.5 * (hN + hS) * (zN - zS) * l_mean -
                    g * (real)0.25 * (hS * hS + hN * hN) * (l_s - l_n);
-  const real qx1 = q_x[i] - dt / a * (phi_x - s_x);
-  const real qy1 = q_y[i] - dt / a * (phi_y - s_y);
+  const real qx1 = q_x - dt / a * (phi_x - s_x);
+  const real qy1 = q_y - dt / a * (phi_y - s_y);
   /* the depth after the fluxes (this cell's mass balance) for the friction */
-  const real mass = (f_e - f_w) * l_x + f_s * l_s - f_n * l_n;
+  const real mass = (e.mass - w.mass) * l_x + s.mass * l_s - nf.mass * l_n;
   const real h1 = h - dt / a * mass;
-  const real n = manning[i];
   const real h_f = h1 > eps ? h1 : eps;
   const real q_mag = sqrt(qx1 * qx1 + qy1 * qy1);
   const real h_7_3 = h_f * h_f * erodem_cbrt_positive(h_f);
@@ -293,8 +280,57 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   const real dtk = dt * g * n * n / h_7_3;
   const real factor = (real)2 / ((real)1 + sqrt((real)1 + (real)4 * dtk * q_mag));
   const int wet = h1 > eps;
-  q_x_new[i] = active ? (wet ? qx1 * factor : (real)0) : q_x[i];
-  q_y_new[i] = active ? (wet ? qy1 * factor : (real)0) : q_y[i];
+  out.q_x = active ? (wet ? qx1 * factor : (real)0) : q_x;
+  out.q_y = active ? (wet ? qy1 * factor : (real)0) : q_y;
+  return out;
+}
+
+/* The shallow-water step of padded cell i of row y (shallow_water_cell_update), its neighbours'
+ * kinds k_* and indices i_* (west, east, north, south) and the rows y_n, y_s of its north and
+ * south faces (the faces between rows y_n and y_n + 1, y_s and y_s + 1), from the state at the
+ * start of the step: depth, bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n
+ * (s m^-1/3), the rows' dx, dy (m) and cell areas (m^2); dt (s); p.gravity (m/s^2) and
+ * p.dry_depth (m: velocities are desingularised below it). Writes the cell's outflows (m^3/s)
+ * and unit discharges into the second buffers. Each cell computes the four faces around it
+ * (every face twice over the grid, by the same function with the same arguments, so both sides
+ * see the same bits; the CPU loop computes each once, with those arguments). */
+ERODEM_FN_INLINED void shallow_water_cell_at(
+    int i, int y, int k_w, int k_e, int k_n, int k_s, int i_w, int i_e, int i_n, int i_s, int y_n,
+    int y_s, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed, GLOBAL const real* depth,
+    GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* manning,
+    GLOBAL const real* dx, GLOBAL const real* dy, GLOBAL const real* area, real dt,
+    ERODEM_P(FlowParams) p, GLOBAL real* out_left, GLOBAL real* out_right, GLOBAL real* out_top,
+    GLOBAL real* out_bottom, GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
+  const int k = kind[i];
+  const real g = p.gravity, eps = p.dry_depth;
+  const real h = depth[i], z = bed[i];
+  const real u = sw_velocity(q_x[i], h, eps), v = sw_velocity(q_y[i], h, eps);
+  /* east face: a = this cell, b = east; normal east, tangent north */
+  const ERODEM_S(SwFace) e =
+      sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
+              sw_velocity(q_y[i_e], depth[i_e], eps), g, eps);
+  /* west face: a = west, b = this cell */
+  const ERODEM_S(SwFace) w =
+      sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
+              sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, eps);
+  /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
+  const ERODEM_S(SwFace) s =
+      sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
+              sw_velocity(q_x[i_s], depth[i_s], eps), g, eps);
+  /* north face: a = north, b = this cell */
+  const ERODEM_S(SwFace) nf =
+      sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
+              sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps);
+  /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
+  const ERODEM_S(SwCell) c =
+      shallow_water_cell_update(k, h, q_x[i], q_y[i], manning[i], dy[y], face_y_width(dx, y_n),
+                                face_y_width(dx, y_s), area[y], dt, p, e, w, s, nf);
+  out_left[i] = c.left;
+  out_right[i] = c.right;
+  out_top[i] = c.top;
+  out_bottom[i] = c.bottom;
+  q_x_new[i] = c.q_x;
+  q_y_new[i] = c.q_y;
 }
 
 /* shallow_water_cell_at for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices

@@ -88,6 +88,23 @@ class CpuBackend final : public Backend {
 #pragma omp parallel for schedule(static) num_threads(threads_)
     for (int y = y0; y < y1; ++y) f(y);
   }
+  /// Calls f(y0, y1) once on each of the backend's threads with its block of the padded rows
+  /// [0, H), the static blocks schedule(static) gives; for loops that walk their block top to
+  /// bottom, carrying rows of faces from one row to the next.
+  template <class F>
+  void for_row_blocks(int H, const F& f) const {
+#pragma omp parallel num_threads(threads_)
+    {
+#ifdef _OPENMP
+      const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+#else
+      const int t = 0, nt = 1;
+#endif
+      const int y0 = static_cast<int>(static_cast<long>(H) * t / nt);
+      const int y1 = static_cast<int>(static_cast<long>(H) * (t + 1) / nt);
+      if (y0 < y1) f(y0, y1);
+    }
+  }
   /// Sums per-row partial sums in row order (deterministic for any thread count).
   static double sum_rows(const std::vector<double>& rows);
   /// Sums a row of per-cell values in double in a fixed order: four interleaved partial
