@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "erodem/io/setup.hpp"
@@ -199,6 +200,84 @@ TEST_P(ShallowWater, LakeAtRestOnAGeographicDem) {
   };
   vr::expect_below(fig("max |q| (m^2/s)"), m[0], bound_q);
   vr::report(fig("max speed (m/s)"), m[1]);
+}
+
+/// A wave leaving through an edge of kind `east`: a channel of 1000 m at dx = 2 m (3 rows, bed
+/// 0, still water 1 m, sea level 1 m), a hump of 1 cm (Gaussian, 20 m) at x = 800 m that splits
+/// into two waves of 5 mm at c0 = 3.13 m/s; the west edge a wall. After 150 s the westward wave
+/// is centred at 330 m, and a reflection of the eastward one, which reached the east edge at
+/// 64 s, would be centred at 730 m. Returns the largest surface departure east of 530 m over the
+/// westward wave's, and the westward wave's velocity at its crest over the simple wave's
+/// u = -c0 eta / h0.
+struct EdgeWave {
+  double reflection, velocity;
+};
+EdgeWave edge_wave(BoundaryKind east, const Target& target) {
+  const int n = 500;
+  const double dx = 2.0, h0 = 1.0, a = 0.01, x0 = 800.0, sigma = 20.0, t_end = 150.0;
+  Terrain t = flat_terrain(n, 3, dx);
+  t.water_depth.assign(t.grid.cells(), h0);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < n; ++c) {
+      const double x = (c + 0.5) * dx;
+      t.water_depth[static_cast<std::size_t>(r) * n + c] =
+          h0 + a * std::exp(-(x - x0) * (x - x0) / (sigma * sigma));
+    }
+  // steps of 0.15 s: unsplit Courant number c0 dt (1 / dx + 1 / dy) = 0.47
+  Params p = sw_params(0.15);
+  p.boundary.east = east;
+  p.boundary.sea_level = h0;
+  auto sim = make_simulation(t, p, target);
+  sim.step(std::lround(t_end / 0.15));
+  const auto h = middle_row(sim, FieldId::water_depth);
+  const auto u = middle_row(sim, FieldId::velocity_x);
+  double west = 0, east_max = 0, u_crest = 0;
+  for (int c = 0; c < n; ++c) {
+    const double eta = std::abs(h[static_cast<std::size_t>(c)] - h0);
+    if ((c + 0.5) * dx >= 530.0) {
+      east_max = std::max(east_max, eta);
+    } else if (eta > west) {
+      west = eta;
+      u_crest = u[static_cast<std::size_t>(c)] / (-std::sqrt(kG * h0) * eta / h0);
+    }
+  }
+  return {east_max / west, u_crest};
+}
+
+TEST_P(ShallowWater, WavesLeaveThroughOpenAndFixedLevelEdges) {
+  // A fixed level is still water at the level beyond the edge, and the face between it and the
+  // edge cell is a Riemann problem (sw_face): the outgoing characteristic comes from the
+  // domain, the incoming one from water at rest at the level, so a small wave leaves as into an
+  // endless sea (linear theory: no reflection). An open edge copies the edge cell's depth and
+  // outward velocity: a transmissive edge, also without reflection. Bounds: reflection below 5
+  // % of the wave that stays (first-order diffusion spreads both alike); a wall reflects it
+  // whole (printed, and above 0.5: the measure sees a reflection), and an edge that held the
+  // level at the face would reflect it whole with the sign reversed; an idle solver leaves the
+  // hump east of 530 m (reflection 1 / 0). The westward wave's crest velocity within 10 % of
+  // the simple wave's -c0 eta / h0 (a scheme that moved the depth but not the momentum fails).
+  const std::pair<BoundaryKind, const char*> kinds[] = {{BoundaryKind::fixed_level, "fixed_level"},
+                                                        {BoundaryKind::open, "open"},
+                                                        {BoundaryKind::closed, "closed"}};
+  for (const auto& [kind, name] : kinds) {
+    const EdgeWave w = edge_wave(kind, target());
+    const bool wall = kind == BoundaryKind::closed;
+    std::printf(
+        "[sw edge wave] %s east edge %s: reflection %.4f of the wave that stays (bound %s), its "
+        "crest velocity %.4f of the simple wave's (bound 0.9 .. 1.1)\n",
+        target().label().c_str(), name, w.reflection, wall ? "> 0.5" : "< 0.05", w.velocity);
+    auto fig = [&](const char* q) {
+      return figure("sw_edge_wave", "shallow_water", q, 2.0,
+                    "linear waves: no reflection at an open or sea edge");
+    };
+    if (wall) {
+      EXPECT_GT(w.reflection, 0.5) << "a wall reflects the wave: the measure sees it";
+      continue;
+    }
+    vr::expect_below(fig((std::string("reflection at a ") + name + " edge").c_str()), w.reflection,
+                     0.05);
+    vr::expect_between(fig((std::string("crest velocity / simple wave's, ") + name).c_str()),
+                       w.velocity, 0.9, 1.1);
+  }
 }
 
 /// Thacker's planar surface in a paraboloid (Thacker 1981; SWASHES 4.2.2): bed

@@ -96,6 +96,14 @@ CASES = {
         "The side-pressure source balances the north and south faces' different lengths: "
         "|q| stays at rounding (float64 1e-12 m^2/s).",
     ),
+    "sw_edge_wave": (
+        "Shallow water: a wave leaving through an open and a fixed-level edge",
+        "1000 m channel at dx = 2 m, still water 1 m, a 1 cm Gaussian hump (20 m) at 800 m, "
+        "frictionless, 150 s; the east edge open, fixed at the level 1 m, or a wall.",
+        "Riemann-invariant edges: the outgoing characteristic from the cell, the incoming one "
+        "from water at rest at the level, so a small wave leaves as into open water (linear "
+        "theory: no reflection; a wall reflects it whole).",
+    ),
     "snow_flat": (
         "Snow: a flat pack melting at the degree-day rate",
         "8 x 8 cells of 1 km, 0.1 m of snow at 4 degrees C, DDF 5 mm/d/K, t* = 5 d.",
