@@ -152,6 +152,9 @@ SCENARIOS = {
     "tujunga_shallow_water": TUJUNGA.format(root=ROOT, adaptive="true", dt=2.0,
                                             flow="shallow_water", transport="conservative"),
     "valley_shallow_water": VALLEY.replace('scheme = "local_inertial"', 'scheme = "shallow_water"'),
+    # and its second order (flow.order = 2) on the valley
+    "valley_shallow_water_order2": VALLEY.replace('scheme = "local_inertial"',
+                                                  'scheme = "shallow_water"\norder = 2'),
 }
 TARGETS = {
     "cpu_float32": ["--backend", "cpu", "--set", "numerics.precision=float32"],

@@ -27,11 +27,14 @@ struct AgreementCase {
   FlowScheme flow;
   TransportScheme transport;
   bool adaptive;
-  double dt;  ///< s: the fixed step, or the upper bound of the adaptive one
+  double dt;      ///< s: the fixed step, or the upper bound of the adaptive one
+  int order = 1;  ///< flow.order (shallow water)
 };
 
 Params agreement_params(const AgreementCase& c) {
-  return tujunga_storm(c.flow, c.transport, c.adaptive, c.dt, Precision::float32);
+  Params p = tujunga_storm(c.flow, c.transport, c.adaptive, c.dt, Precision::float32);
+  p.flow.order = c.order;
+  return p;
 }
 
 class Agreement : public ::testing::TestWithParam<AgreementCase> {};
@@ -250,7 +253,9 @@ INSTANTIATE_TEST_SUITE_P(
                       AgreementCase{"pipes_semi_lagrangian", FlowScheme::pipes,
                                     TransportScheme::semi_lagrangian, false, 0.5},
                       AgreementCase{"shallow_water_conservative", FlowScheme::shallow_water,
-                                    TransportScheme::conservative, true, 2.0}),
+                                    TransportScheme::conservative, true, 2.0},
+                      AgreementCase{"shallow_water_order2_conservative", FlowScheme::shallow_water,
+                                    TransportScheme::conservative, true, 2.0, 2}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
 
 }  // namespace

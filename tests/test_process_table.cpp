@@ -181,7 +181,8 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
 
 TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // the cell kernels whose work-group the OpenCL backend queried from its own list (before
-  // 2026-11-26) and the snow pack's (added through the table), as a set; the program in step order
+  // 2026-11-26), the snow pack's and the shallow-water second order's (added through the
+  // table), as a set; the program in step order
   // (flow before sources since they run after it; before, the files were listed in the enum's
   // order)
   const auto k = opencl_cell_kernels();
@@ -203,10 +204,12 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "evaporation",
                                    "snow",
                                    "flow_shallow_water",
+                                   "flow_shallow_water_muscl",
+                                   "flow_shallow_water_stage_depth",
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 20u) << "a kernel listed twice";
+  EXPECT_EQ(k.size(), 22u) << "a kernel listed twice";
   EXPECT_EQ(opencl_program_order(),
             (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl",
                                       "water.cl", "erosion.cl", "transport.cl", "thermal.cl",

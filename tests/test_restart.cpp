@@ -78,6 +78,14 @@ const std::string kShallowWater = [] {
   return c;
 }();
 
+/// The same with the shallow-water scheme's second order (Heun's two stages in one step).
+const std::string kShallowWater2 = [] {
+  std::string c = kShallowWater;
+  const std::string from = "scheme = \"shallow_water\"";
+  c.replace(c.find(from), from.size(), "scheme = \"shallow_water\"\norder = 2");
+  return c;
+}();
+
 /// Pipes, semi-Lagrangian transport, a point inflow hydrograph and fixed steps.
 const char* kPipes = R"([dem]
 synthetic = "hill"
@@ -225,6 +233,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"shallow_water", kShallowWater.c_str(), "cpu", "float32"},
                       Case{"shallow_water", kShallowWater.c_str(), "cpu", "float64"},
                       Case{"shallow_water", kShallowWater.c_str(), "opencl", "float32"},
+                      Case{"shallow_water_order2", kShallowWater2.c_str(), "cpu", "float32"},
+                      Case{"shallow_water_order2", kShallowWater2.c_str(), "cpu", "float64"},
+                      Case{"shallow_water_order2", kShallowWater2.c_str(), "opencl", "float32"},
                       Case{"pipes", kPipes, "cpu", "float32"},
                       Case{"pipes", kPipes, "opencl", "float32"}),
     [](const ::testing::TestParamInfo<Case>& p) {

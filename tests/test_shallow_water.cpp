@@ -31,8 +31,10 @@ class ShallowWater : public TargetTest {};
 constexpr double kMargin = 20.0;  // m on each side of the region the wave reached
 
 /// Frictionless, closed, fixed steps of dt: the dam-break set-up of test_analytical.cpp.
-Params sw_params(double dt) {
-  return quiet_params(FlowScheme::shallow_water, dt);
+Params sw_params(double dt, int order = 1) {
+  Params p = quiet_params(FlowScheme::shallow_water, dt);
+  p.flow.order = order;
+  return p;
 }
 
 /// One rung of a dam-break ladder: the errors over [lo, hi] relative to an idle solver's.
@@ -47,14 +49,14 @@ struct Rung {
 /// finds the front or shock on both profiles.
 template <class Exact>
 std::vector<Rung> ladder(const Target& target, const Exact& exact, double h_up, double h_down,
-                         double t_end, double lo, double hi, double front_depth) {
+                         double t_end, double lo, double hi, double front_depth, int order = 1) {
   std::vector<double> sizes{2.0, 1.0, 0.5};
   if (vr::full_ladder()) sizes.push_back(0.25);
   std::vector<Rung> out;
   for (double dx : sizes) {
     const int n = static_cast<int>(std::lround(1000.0 / dx));
     const DamBreak db{n, dx, 500.0, h_up, h_down};
-    auto sim = make_simulation(db.terrain(), sw_params(0.08 * dx), target);
+    auto sim = make_simulation(db.terrain(), sw_params(0.08 * dx, order), target);
     sim.step(std::lround(t_end / (0.08 * dx)));
     const Row row = db.row();
     const auto h = middle_row(sim, FieldId::water_depth);
@@ -143,6 +145,65 @@ TEST_P(ShallowWater, RitterDryDamBreakConverges) {
   }
   vr::expect_between(fig("front position / Ritter's at the finest dx", rungs.back().dx),
                      rungs.back().front, 0.9, 1.02);
+}
+
+TEST_P(ShallowWater, SecondOrderDamBreaks) {
+  // Stoker's and Ritter's dam breaks (the ladders above) with flow.order = 2 (MUSCL-minmod and
+  // Heun) against the first order on the same rungs. A shock or a dry front limits any scheme
+  // to first order in L1, so the gain is in the constant: bounds, at every dx, a depth error
+  // below half the first order's (measured 0.34, 0.30, 0.25 for Stoker, 0.33, 0.26, 0.22 for
+  // Ritter), orders >= 0.7 in depth and discharge, Stoker's shock within 3 %, and Ritter's 1 mm
+  // front at >= 0.93 of Ritter's at the finest dx (measured 0.951; first order 0.903). A
+  // second order that reconstructed nothing would score the first order's errors (ratio 1).
+  const Stoker stoker(2.0, 1.0);
+  const Ritter ritter{2.0};
+  const double ts = 40.0, tr = 30.0;
+  struct Case {
+    const char* name;
+    std::vector<Rung> first, second;
+  };
+  const double s_lo = stoker.head(ts) - kMargin, s_hi = stoker.shock * ts + kMargin;
+  const double r_lo = ritter.head(tr) - kMargin, r_hi = ritter.front(tr) + kMargin;
+  const double s_front = 0.5 * (stoker.h1 + stoker.h2);
+  Case cases[] = {{"Stoker", ladder(target(), stoker, 2.0, 1.0, ts, s_lo, s_hi, s_front, 1),
+                   ladder(target(), stoker, 2.0, 1.0, ts, s_lo, s_hi, s_front, 2)},
+                  {"Ritter", ladder(target(), ritter, 2.0, 0.0, tr, r_lo, r_hi, 1e-3, 1),
+                   ladder(target(), ritter, 2.0, 0.0, tr, r_lo, r_hi, 1e-3, 2)}};
+  for (const Case& c : cases) {
+    const bool is_stoker = std::string(c.name) == "Stoker";
+    auto fig = [&](const char* q, double dx) {
+      return figure(is_stoker ? "sw_stoker" : "sw_ritter", "shallow_water", q, dx,
+                    is_stoker ? "Stoker (1957)" : "Ritter (1892)");
+    };
+    for (std::size_t k = 0; k < c.second.size(); ++k) {
+      const Rung &r = c.second[k], &f = c.first[k];
+      const double ratio = r.depth / f.depth;
+      std::printf(
+          "[sw second order] %s %s dx = %.1f m: depth error %.4f (first order %.4f, ratio %.2f, "
+          "bound < 0.5), discharge %.4f, velocity %.4f, front %.4f\n",
+          target().label().c_str(), c.name, r.dx, r.depth, f.depth, ratio, r.discharge, r.velocity,
+          r.front);
+      vr::report(fig("second order: depth error (relative L1)", r.dx), r.depth);
+      vr::report(fig("second order: discharge error (relative L1)", r.dx), r.discharge);
+      vr::expect_below(fig("second order: depth error / first order's", r.dx), ratio, 0.5);
+      if (is_stoker)
+        vr::expect_between(fig("second order: shock position / Stoker's", r.dx), r.front, 0.97,
+                           1.03);
+      if (k == 0) continue;
+      const double p_h = observed_order(c.second[k - 1].depth, r.depth);
+      const double p_q = observed_order(c.second[k - 1].discharge, r.discharge);
+      std::printf(
+          "[sw second order] %s %s dx %.1f -> %.1f m: observed order depth %.2f, "
+          "discharge %.2f (bound >= 0.7)\n",
+          target().label().c_str(), c.name, c.second[k - 1].dx, r.dx, p_h, p_q);
+      vr::expect_above(fig("second order: observed order, depth", r.dx), p_h, 0.7);
+      vr::expect_above(fig("second order: observed order, discharge", r.dx), p_q, 0.7);
+    }
+    if (!is_stoker)
+      vr::expect_between(
+          fig("second order: front position / Ritter's at the finest dx", c.second.back().dx),
+          c.second.back().front, 0.93, 1.02);
+  }
 }
 
 /// The radial dam break (RadialDamBreakConverges): a square basin 64 m across between walls,
@@ -442,19 +503,185 @@ TEST_P(ShallowWater, LakeAtRestOnAGeographicDem) {
   ASSERT_NE(dx_n, dx_s) << "a geographic grid: per-row cell widths";
   ASSERT_GT(wet, 200);
   ASSERT_GT(dry, 200);
-  auto sim = make_simulation(terrain, p, target());
-  sim.step(2000);
-  const auto m = max_discharge_and_speed(sim);
-  const double bound_q = bound(1e-10, 2e-3);
-  std::printf(
-      "[sw lake at rest, Rhine] %s: after 2000 steps of 5 s max |q| %.3e m^2/s (bound "
-      "%.0e), max speed %.3e m/s\n",
-      target().label().c_str(), m[0], bound_q, m[1]);
-  auto fig = [&](const char* q) {
-    return figure("sw_lake_geographic", "shallow_water", q, g.dy[0], "at rest: q = 0");
+  // both orders: the second order's reconstructed faces keep the level too (its slopes of the
+  // surface are 0, and it reconstructs the bed as surface minus depth), the same bounds
+  for (int order : {1, 2}) {
+    p.flow.order = order;
+    auto sim = make_simulation(terrain, p, target());
+    sim.step(2000);
+    const auto m = max_discharge_and_speed(sim);
+    const double bound_q = bound(1e-10, 2e-3);
+    std::printf(
+        "[sw lake at rest, Rhine] %s order %d: after 2000 steps of 5 s max |q| %.3e m^2/s "
+        "(bound %.0e), max speed %.3e m/s\n",
+        target().label().c_str(), order, m[0], bound_q, m[1]);
+    auto fig = [&](const char* q) {
+      return figure("sw_lake_geographic", "shallow_water", q, g.dy[0], "at rest: q = 0");
+    };
+    vr::expect_below(fig(order == 1 ? "max |q| (m^2/s)" : "second order: max |q| (m^2/s)"), m[0],
+                     bound_q);
+    vr::report(fig(order == 1 ? "max speed (m/s)" : "second order: max speed (m/s)"), m[1]);
+  }
+}
+
+/// A smooth supercritical steady flow built as MacDonald et al. (1997) and SWASHES build theirs
+/// (choose the depth, derive the bed that makes it steady): a 1000 m channel, q = 2 m^2/s,
+/// Manning n = 0.033, the depth h(x) = hc (0.75 - 0.15 exp(-36 (x/1000 - 1/2)^2)), hc =
+/// (q^2/g)^(1/3) the critical depth (Froude number 1.54 at the ends, 2.15 at the middle), and
+/// z' = -(1 - q^2 / (g h^3)) h' - n^2 q^2 / h^(10/3), integrated from z(1000) = 0 (Simpson, 64
+/// panels per cell) at the cell centres: a bed of slope 0.016 to 0.055. (SWASHES' own
+/// supercritical case, hc (1 - exp(...) / 5), tends to the critical depth at both ends, where
+/// the slow wave stalls: there the scheme's end state depended on the start, from the exact
+/// state or from q = 1.6 m^2/s, and the order measured 1.9 or 0.4.) Supercritical flow takes
+/// both of its conditions upstream: the first three cells are held at the exact state (h, q)
+/// every step (Dirichlet data; three, so the first free cell's faces are reconstructed from
+/// exact data); the east edge is open (transmissive). The run starts from the exact depth with
+/// q = 1.6 m^2/s (an idle solver's discharge error: 0.2) and runs 1000 s (the water crosses the
+/// channel in about 300 s).
+struct MacDonald {
+  static constexpr double L = 1000.0, q = 2.0, n = 0.033;
+  static double critical() { return std::cbrt(q * q / kG); }
+  static double depth(double x) {
+    const double xi = x / L - 0.5;
+    return critical() * (0.75 - 0.15 * std::exp(-36.0 * xi * xi));
+  }
+  /// dz/dx at x
+  static double slope(double x) {
+    const double xi = x / L - 0.5, h = depth(x);
+    const double dh = critical() * 0.15 * std::exp(-36.0 * xi * xi) * 72.0 * xi / L;
+    return -(1.0 - q * q / (kG * h * h * h)) * dh - n * n * q * q / std::pow(h, 10.0 / 3.0);
+  }
+};
+
+/// The relative L1 errors of depth (over the exact depth's sum) and unit discharge (over q)
+/// after the run, over 100 m <= x <= 900 m and over all free cells, and the largest relative
+/// change of the depth over the run's last 10 % (0 at a steady state).
+struct MacDonaldRun {
+  double depth, discharge, depth_all, discharge_all, unsteady;
+};
+MacDonaldRun run_macdonald(int cells, int order, const Target& target) {
+  using M = MacDonald;
+  const double dx = M::L / cells, t_end = 1000.0;
+  const int held = 3;
+  Terrain t = flat_terrain(cells, 3, dx);
+  std::vector<double> z(static_cast<std::size_t>(cells)), h(z.size());
+  double acc = 0;  // z(x) = -int_x^L z'(s) ds, from the outlet
+  for (int c = cells - 1; c >= 0; --c) {
+    const double a = (c + 0.5) * dx, b = c == cells - 1 ? M::L : (c + 1.5) * dx;
+    const int panels = 64;
+    const double step = (b - a) / panels;
+    double sum = M::slope(a) + M::slope(b);
+    for (int k = 1; k < panels; ++k) sum += (k % 2 ? 4 : 2) * M::slope(a + k * step);
+    acc -= sum * step / 3;
+    z[static_cast<std::size_t>(c)] = acc;
+    h[static_cast<std::size_t>(c)] = M::depth(a);
+  }
+  t.water_depth.assign(t.grid.cells(), 0.0);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < cells; ++c) {
+      t.bed[static_cast<std::size_t>(r) * cells + c] = z[c];
+      t.water_depth[static_cast<std::size_t>(r) * cells + c] = h[c];
+    }
+  // steps of 0.05 dx s: (|u| + c) dt / dx + c dt / dy <= 0.46 with u <= 3.4 m/s, c <= 2.7 m/s
+  const double dt = 0.05 * dx;
+  Params p = sw_params(dt, order);
+  p.flow.manning_n.value = M::n;
+  p.boundary.east = BoundaryKind::open;
+  auto sim = make_simulation(t, p, target);
+  sim.backend().set_field(FieldId::momentum_x, std::vector<double>(t.grid.cells(), 0.8 * M::q));
+  const long steps = std::lround(t_end / dt), tail = steps / 10;
+  std::vector<double> before;
+  for (long s = 0; s < steps; ++s) {
+    sim.step();
+    auto hf = sim.field(FieldId::water_depth);
+    auto qf = sim.field(FieldId::momentum_x);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < held; ++c) {
+        const std::size_t i = static_cast<std::size_t>(r) * cells + c;
+        hf[i] = h[static_cast<std::size_t>(c)];
+        qf[i] = M::q;
+      }
+    sim.backend().set_field(FieldId::water_depth, hf);
+    sim.backend().set_field(FieldId::momentum_x, qf);
+    if (s == steps - tail) before = middle_row(sim, FieldId::water_depth);
+  }
+  const auto hn = middle_row(sim, FieldId::water_depth);
+  const auto qn = middle_row(sim, FieldId::momentum_x);
+  MacDonaldRun out{};
+  double eh = 0, eq = 0, sh = 0, eh_all = 0, eq_all = 0, sh_all = 0;
+  int n_mid = 0, n_all = 0;
+  for (int c = held; c < cells; ++c) {
+    const std::size_t i = static_cast<std::size_t>(c);
+    const double dh = std::abs(hn[i] - h[i]), dq = std::abs(qn[i] - M::q), x = (c + 0.5) * dx;
+    eh_all += dh;
+    eq_all += dq;
+    sh_all += h[i];
+    ++n_all;
+    if (x >= 100.0 && x <= 900.0) {
+      eh += dh;
+      eq += dq;
+      sh += h[i];
+      ++n_mid;
+    }
+    out.unsteady = std::max(out.unsteady, std::abs(hn[i] - before[i]) / h[i]);
+  }
+  out.depth = eh / sh;
+  out.discharge = eq / (n_mid * M::q);
+  out.depth_all = eh_all / sh_all;
+  out.discharge_all = eq_all / (n_all * M::q);
+  return out;
+}
+
+TEST_P(ShallowWater, MacDonaldSupercriticalSecondOrder) {
+  // The second order's order on a smooth steady flow (issue 16): between each pair of rungs of
+  // 50, 100, 200 cells (the report adds 400) the depth and discharge errors over 100 .. 900 m
+  // fall at order >= 1.7 (measured 2.01, 2.01 in depth; 2.2 in discharge), and at 200 cells the
+  // second order's depth error is below a fifth of the first order's. The first order is
+  // printed, not bounded: where the bed drops by a good part of the depth per cell (0.3 m on
+  // 0.55 m at 10 m cells) the first-order hydrostatic reconstruction keeps only part of the bed
+  // force (depth errors 0.10, 0.066 at 100, 200 cells), and at 20 m cells the step treatment
+  // (film over a step, model.md 3.10) takes over. An idle solver keeps q = 1.6 (discharge error
+  // 0.2). The second order's end state carries a small oscillation, the minmod limiter switching
+  // on the steep bed (the largest change of the depth over the last 100 s: 2.4e-3, 5.7e-4, 6e-5
+  // of itself at 50, 100, 200 cells, falling faster than the error); bound 1e-2.
+  std::vector<int> sizes{50, 100, 200};
+  if (vr::full_ladder()) sizes.push_back(400);
+  auto fig = [&](const std::string& q, double dx) {
+    return figure("sw_macdonald", "shallow_water", q.c_str(), dx,
+                  "MacDonald et al. (1997) construction, SWASHES");
   };
-  vr::expect_below(fig("max |q| (m^2/s)"), m[0], bound_q);
-  vr::report(fig("max speed (m/s)"), m[1]);
+  std::vector<MacDonaldRun> first, second;
+  for (int n : sizes) {
+    const double dx = MacDonald::L / n;
+    for (int order : {1, 2}) {
+      const MacDonaldRun r = run_macdonald(n, order, target());
+      std::printf(
+          "[sw MacDonald] %s order %d, %d cells (dx %.2f m): depth error %.3e, discharge error "
+          "%.3e over 100 .. 900 m (whole channel %.3e, %.3e); end-state change %.1e%s\n",
+          target().label().c_str(), order, n, dx, r.depth, r.discharge, r.depth_all,
+          r.discharge_all, r.unsteady, order == 2 ? " (bound 1e-2)" : "");
+      const std::string o = order == 1 ? "first order: " : "second order: ";
+      vr::report(fig(o + "depth error (relative L1, 100-900 m)", dx), r.depth);
+      vr::report(fig(o + "discharge error (relative L1, 100-900 m)", dx), r.discharge);
+      (order == 1 ? first : second).push_back(r);
+      if (order == 1) continue;
+      vr::expect_below(fig(o + "end-state change (relative)", dx), r.unsteady, 1e-2);
+      if (second.size() < 2) continue;
+      const double p_h = observed_order(second[second.size() - 2].depth, r.depth);
+      const double p_q = observed_order(second[second.size() - 2].discharge, r.discharge);
+      std::printf(
+          "[sw MacDonald] %s second order, %d -> %d cells: observed order depth %.2f, discharge "
+          "%.2f (bound >= 1.7)\n",
+          target().label().c_str(), n / 2, n, p_h, p_q);
+      vr::expect_above(fig(o + "observed order, depth", dx), p_h, 1.7);
+      vr::expect_above(fig(o + "observed order, discharge", dx), p_q, 1.7);
+    }
+  }
+  const double ratio = second[2].depth / first[2].depth;
+  std::printf(
+      "[sw MacDonald] %s 200 cells: second-order depth error / first-order %.4f (bound < 0.2)\n",
+      target().label().c_str(), ratio);
+  vr::expect_below(fig("depth error, second / first order", 5.0), ratio, 0.2);
 }
 
 /// A wave leaving through an edge of kind `east`: a channel of 1000 m at dx = 2 m (3 rows, bed

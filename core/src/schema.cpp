@@ -159,6 +159,9 @@ void check_cross_fields(const Params& p, const std::string& source) {
     throw fail("rain.rate", "give rain.rate or rain.series, not both");
   }
   if (p.output.path.empty()) throw fail("output.path", "must not be empty");
+  if (p.flow.order == 2 && p.flow.scheme != FlowScheme::shallow_water)
+    throw fail("flow.order",
+               "order 2 is the shallow_water scheme's (flow.scheme = \"shallow_water\")");
 }
 
 }  // namespace

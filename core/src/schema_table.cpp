@@ -81,6 +81,10 @@ const std::vector<Descriptor>& descriptor_table() {
                              "pipes: pipe length l (m), or \"cell\" for the cell size"),
       number(ERODEM_FIELD(flow.gravity), D::acceleration, above(0),
              "gravitational acceleration g (m/s^2)"),
+      integer(
+          ERODEM_FIELD(flow.order), closed(1, 2),
+          "shallow_water: order of accuracy, 1 (first-order Godunov) or 2 (MUSCL reconstruction "
+          "with the minmod limiter and Heun's method)"),
 
       number(ERODEM_FIELD(rain.rate), D::speed, at_least(0),
              "uniform rain rate (m/s), used when rain.series is empty"),

@@ -333,6 +333,199 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   q_y_new[i] = c.q_y;
 }
 
+/* ---- second order (flow.order = 2): MUSCL reconstruction and Heun's method ---------------- */
+
+/* minmod(a, b): the one of a and b nearer 0 where they have the same sign, else 0. */
+ERODEM_FN real sw_minmod(real a, real b) {
+  const real m = fabs(a) < fabs(b) ? a : b;
+  return a * b > (real)0 ? m : (real)0;
+}
+
+/* A cell's limited slopes in one direction (the change per cell towards its next neighbour)
+ * of its surface eta = z + h, depth h, the velocity normal to the faces u and along them t
+ * (m/s); `on` 0 where the cell is reconstructed at first order. */
+ERODEM_STRUCT(SwSlopes, {
+  real eta, h, u, t;
+  int on;
+})
+
+/* The slopes of a cell (kind k, depth h, bed z, velocities u, t) from its previous (_m) and next
+ * (_p) neighbours in one direction: minmod of the two one-sided differences (Van Leer's MUSCL
+ * with the minmod limiter); none (first order) unless the three cells are active and wet (above
+ * eps (m)): at edges, ghosts and shores the first-order faces stay, which keeps a lake at rest
+ * against a dry bank at rest and every reconstructed depth positive (h +- s_h / 2 lies between
+ * the cell's and a neighbour's depth). */
+ERODEM_FN ERODEM_S(SwSlopes)
+    sw_slopes(int k_m, int k, int k_p, real h_m, real h, real h_p, real z_m, real z, real z_p,
+              real u_m, real u, real u_p, real t_m, real t, real t_p, real eps) {
+  ERODEM_S(SwSlopes) s;
+  s.on = (k_m == ERODEM_CELL_ACTIVE) & (k == ERODEM_CELL_ACTIVE) & (k_p == ERODEM_CELL_ACTIVE) &
+         (h_m > eps) & (h > eps) & (h_p > eps);
+  const real e_m = z_m + h_m, e = z + h, e_p = z_p + h_p;
+  s.eta = s.on ? sw_minmod(e - e_m, e_p - e) : (real)0;
+  s.h = s.on ? sw_minmod(h - h_m, h_p - h) : (real)0;
+  s.u = s.on ? sw_minmod(u - u_m, u_p - u) : (real)0;
+  s.t = s.on ? sw_minmod(t - t_m, t_p - t) : (real)0;
+  return s;
+}
+
+/* A cell's state at one of its faces. */
+ERODEM_STRUCT(SwSide, {
+  real h, z, u, t; /* depth (m), bed (m), velocities normal to and along the face (m/s) */
+})
+
+/* The state of a cell (depth h, bed z, velocities u, t) at its face half a cell along its slopes
+ * s (d = 0.5 towards the next neighbour, -0.5 towards the previous): surface and depth
+ * reconstructed, the bed their difference (so a lake at rest keeps a level surface), the
+ * velocities reconstructed; the cell's own values where it has no slopes. */
+ERODEM_FN ERODEM_S(SwSide) sw_side(real h, real z, real u, real t, ERODEM_S(SwSlopes) s, real d) {
+  ERODEM_S(SwSide) r;
+  const real h_f = h + d * s.h, eta_f = (z + h) + d * s.eta;
+  r.h = s.on ? h_f : h;
+  r.z = s.on ? eta_f - h_f : z;
+  r.u = s.on ? u + d * s.u : u;
+  r.t = s.on ? t + d * s.t : t;
+  return r;
+}
+
+/* Heun's method (flow.order = 2): a first stage from the state at the start of the step (depth
+ * h, unit discharges q) gives outflows o1 and unit discharges q1; the depth it leaves,
+ * h1 = h + dt (inflow - outflow) / A (this function, for an active cell; other cells keep h), and
+ * q1 give a second stage's o2 and q2; the step's outflows are (o1 + o2) / 2 and its unit
+ * discharges (q + q2) / 2. The water update then takes the averaged outflows as from any
+ * scheme: h' = h + dt (mean inflow - mean outflow) / A = (h + h2) / 2, Heun's depth, and
+ * sediment moves with those mean fluxes. Each stage's outflows are limited to what the cell
+ * holds at its start, so h' >= h / 2 >= 0. */
+ERODEM_FN void shallow_water_stage_depth_cell(int x, int y, int W, int H,
+                                              GLOBAL const erodem_kind_t* kind,
+                                              GLOBAL const real* depth, GLOBAL const real* f_left,
+                                              GLOBAL const real* f_right, GLOBAL const real* f_top,
+                                              GLOBAL const real* f_bottom, GLOBAL const real* area,
+                                              real dt, GLOBAL real* depth_stage) {
+  const int i = x + y * W;
+  const int inside = (x >= 1) & (x <= W - 2) & (y >= 1) & (y <= H - 2);
+  /* active cells lie inside the halo; the others' neighbours are not read */
+  const int active = inside & (kind[i] == ERODEM_CELL_ACTIVE);
+  const int l = inside ? i - 1 : i, r = inside ? i + 1 : i;
+  const int t = inside ? i - W : i, b = inside ? i + W : i;
+  const real inflow = f_right[l] + f_left[r] + f_bottom[t] + f_top[b];
+  const real outflow = f_left[i] + f_right[i] + f_top[i] + f_bottom[i];
+  const real h1 = depth_after_fluxes(depth[i], inflow, outflow, dt, area[y]);
+  depth_stage[i] = active ? (h1 > (real)0 ? h1 : (real)0) : depth[i];
+}
+
+/* Stores a stage's results for padded cell i: as they are (combine 0), or averaged with what
+ * the arrays hold (combine 1: the first stage's outflows, the unit discharges at the start of the
+ * step), Heun's second stage. */
+ERODEM_FN void shallow_water_stage_store(int i, int combine, ERODEM_S(SwCell) r,
+                                         GLOBAL real* out_left, GLOBAL real* out_right,
+                                         GLOBAL real* out_top, GLOBAL real* out_bottom,
+                                         GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
+  const real h = (real)0.5;
+  out_left[i] = combine ? h * (out_left[i] + r.left) : r.left;
+  out_right[i] = combine ? h * (out_right[i] + r.right) : r.right;
+  out_top[i] = combine ? h * (out_top[i] + r.top) : r.top;
+  out_bottom[i] = combine ? h * (out_bottom[i] + r.bottom) : r.bottom;
+  q_x_new[i] = combine ? h * (q_x_new[i] + r.q_x) : r.q_x;
+  q_y_new[i] = combine ? h * (q_y_new[i] + r.q_y) : r.q_y;
+}
+
+/* One cell's state for the second-order faces: kind, depth (m), bed (m), velocities east and
+ * north (m/s). */
+ERODEM_STRUCT(SwCellState, {
+  real h, z, u, v;
+  int k;
+})
+
+/* The state of padded cell (x, y) (sw_velocity with h_eps = eps); outside the raster a wall
+ * standing on the nearest cell's state (as shallow_water_cell clamps). */
+ERODEM_FN ERODEM_S(SwCellState)
+    sw_state_at(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
+                GLOBAL const real* bed, GLOBAL const real* depth, GLOBAL const real* q_x,
+                GLOBAL const real* q_y, real eps) {
+  const int xc = x < 0 ? 0 : (x >= W ? W - 1 : x), yc = y < 0 ? 0 : (y >= H ? H - 1 : y);
+  const int i = xc + yc * W;
+  ERODEM_S(SwCellState) c;
+  c.k = kind_at(kind, x, y, W, H);
+  c.h = depth[i];
+  c.z = bed[i];
+  c.u = sw_velocity(q_x[i], c.h, eps);
+  c.v = sw_velocity(q_y[i], c.h, eps);
+  return c;
+}
+
+/* x-direction slopes of cell c from its west (m) and east (p) neighbours: u normal, v along. */
+ERODEM_FN ERODEM_S(SwSlopes) sw_slopes_x(ERODEM_S(SwCellState) m, ERODEM_S(SwCellState) c,
+                                         ERODEM_S(SwCellState) p, real eps) {
+  return sw_slopes(m.k, c.k, p.k, m.h, c.h, p.h, m.z, c.z, p.z, m.u, c.u, p.u, m.v, c.v, p.v, eps);
+}
+
+/* y-direction slopes of cell c from its north (m) and south (p) neighbours (towards the south:
+ * rows grow southwards): v "normal", u along. */
+ERODEM_FN ERODEM_S(SwSlopes) sw_slopes_y(ERODEM_S(SwCellState) m, ERODEM_S(SwCellState) c,
+                                         ERODEM_S(SwCellState) p, real eps) {
+  return sw_slopes(m.k, c.k, p.k, m.h, c.h, p.h, m.z, c.z, p.z, m.v, c.v, p.v, m.u, c.u, p.u, eps);
+}
+
+/* The x-face between cells a (west) and b (east) with their x-slopes (sw_face on the
+ * reconstructed sides). */
+ERODEM_FN_INLINED ERODEM_S(SwFace)
+    sw_face_x2(ERODEM_S(SwCellState) a, ERODEM_S(SwSlopes) sa, ERODEM_S(SwCellState) b,
+               ERODEM_S(SwSlopes) sb, real g, real eps) {
+  const ERODEM_S(SwSide) l = sw_side(a.h, a.z, a.u, a.v, sa, (real)0.5);
+  const ERODEM_S(SwSide) r = sw_side(b.h, b.z, b.u, b.v, sb, (real)-0.5);
+  return sw_face(a.k, b.k, l.h, l.z, l.u, l.t, r.h, r.z, r.u, r.t, g, eps);
+}
+
+/* The y-face between cells a (north) and b (south) with their y-slopes: normal southwards
+ * (the velocity -v), tangent east (u). */
+ERODEM_FN_INLINED ERODEM_S(SwFace)
+    sw_face_y2(ERODEM_S(SwCellState) a, ERODEM_S(SwSlopes) sa, ERODEM_S(SwCellState) b,
+               ERODEM_S(SwSlopes) sb, real g, real eps) {
+  const ERODEM_S(SwSide) l = sw_side(a.h, a.z, a.v, a.u, sa, (real)0.5);
+  const ERODEM_S(SwSide) r = sw_side(b.h, b.z, b.v, b.u, sb, (real)-0.5);
+  return sw_face(a.k, b.k, l.h, l.z, -l.u, l.t, r.h, r.z, -r.u, r.t, g, eps);
+}
+
+/* A stage of the second-order step of padded cell (x, y) (any row): its four faces from the
+ * MUSCL-reconstructed states of the cells around it (two cells each way), then
+ * shallow_water_cell_update on the stage's depth and unit discharges (depth, q_x, q_y). The
+ * first stage (combine 0) writes the outflows and unit discharges as the first-order step does;
+ * the second (combine 1) writes the step's: the mean of the first stage's outflows (read from
+ * out_*, where it left them) and its own, and the mean of the unit discharges at the start of
+ * the step (q_x_new, q_y_new on entry) and its own. */
+ERODEM_FN_INLINED void shallow_water_muscl_cell(
+    int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
+    GLOBAL const real* depth, GLOBAL const real* q_x, GLOBAL const real* q_y,
+    GLOBAL const real* manning, GLOBAL const real* dx, GLOBAL const real* dy,
+    GLOBAL const real* area, real dt, ERODEM_P(FlowParams) p, int combine, GLOBAL real* out_left,
+    GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+    GLOBAL real* q_y_new) {
+  const int i = x + y * W;
+  const real g = p.gravity, eps = p.dry_depth;
+  const ERODEM_S(SwCellState) c = sw_state_at(x, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) w1 = sw_state_at(x - 1, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) w2 = sw_state_at(x - 2, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) e1 = sw_state_at(x + 1, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) e2 = sw_state_at(x + 2, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) n1 = sw_state_at(x, y - 1, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) n2 = sw_state_at(x, y - 2, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) s1 = sw_state_at(x, y + 1, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) s2 = sw_state_at(x, y + 2, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwSlopes) sx_c = sw_slopes_x(w1, c, e1, eps);
+  const ERODEM_S(SwSlopes) sy_c = sw_slopes_y(n1, c, s1, eps);
+  const ERODEM_S(SwFace) fe = sw_face_x2(c, sx_c, e1, sw_slopes_x(c, e1, e2, eps), g, eps);
+  const ERODEM_S(SwFace) fw = sw_face_x2(w1, sw_slopes_x(w2, w1, c, eps), c, sx_c, g, eps);
+  const ERODEM_S(SwFace) fs = sw_face_y2(c, sy_c, s1, sw_slopes_y(c, s1, s2, eps), g, eps);
+  const ERODEM_S(SwFace) fn = sw_face_y2(n1, sw_slopes_y(n2, n1, c, eps), c, sy_c, g, eps);
+  const int y_n = y >= 1 ? y - 1 : y, y_s = y + 1 < H ? y : (y >= 1 ? y - 1 : y);
+  const ERODEM_S(SwCell) r =
+      shallow_water_cell_update(c.k, c.h, q_x[i], q_y[i], manning[i], dy[y], face_y_width(dx, y_n),
+                                face_y_width(dx, y_s), area[y], dt, p, fe, fw, fs, fn);
+  shallow_water_stage_store(i, combine, r, out_left, out_right, out_top, out_bottom, q_x_new,
+                            q_y_new);
+}
+
 /* shallow_water_cell_at for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices
  * clamped into the raster, their kinds outside it walls. */
 ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,

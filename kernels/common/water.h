@@ -44,6 +44,12 @@ ERODEM_FN real water_exchange_cell(int i, int W, GLOBAL const erodem_kind_t* kin
          (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] - f_top[i + W] : (real)0);
 }
 
+/* The depth (m) of a cell of depth d (m) and area (m^2) after dt (s) of inflow and outflow
+ * (m^3/s). */
+ERODEM_FN real depth_after_fluxes(real d, real inflow, real outflow, real dt, real area) {
+  return d + dt * (inflow - outflow) / area;
+}
+
 /* Water update of padded cell (x, y) (active cells change; others keep their depth):
  *   d <- d + dt (sum inflow - sum outflow) / area,
  * velocity_x (eastwards) and velocity_y (northwards) from the fluxes and the faces' flow depths
@@ -71,7 +77,7 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   const real inflow = in_left + in_right + in_top + in_bottom;
   const real outflow = f_left[i] + f_right[i] + f_top[i] + f_bottom[i];
   const real d_old = depth[i];
-  const real d_raw = d_old + dt * (inflow - outflow) / area[y];
+  const real d_raw = depth_after_fluxes(d_old, inflow, outflow, dt, area[y]);
   /* The outflow limit keeps d_raw >= 0 up to rounding: lift such a rounding-level negative
    * to 0 and book the volume; anything deeper is left for the stability check to stop. */
   const real rounding = (real)64 * ERODEM_EPSILON(real) * (d_old + dt * inflow / area[y]);

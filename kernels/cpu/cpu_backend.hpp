@@ -160,6 +160,7 @@ class CpuBackend final : public Backend {
   std::array<Field, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
   Field velocity_x_, velocity_y_;
   Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
+  Field stage_depth_;  // shallow water, second order: the depth after Heun's first stage
   // Every field's storage by FieldId: the members above, and an array (zeros) for any other
   // field of ERODEM_FIELDS (field_registry.hpp).
   FieldRegistry<Field> fields_;

@@ -193,42 +193,219 @@ struct SwFaceRef {
   }
 };
 
+/// Slopes of one row in one direction (cell::SwSlopes), member by member.
+template <class Real>
+struct SwSlopeRow {
+  std::vector<Real> eta, h, u, t;
+  std::vector<int> on;
+  explicit SwSlopeRow(std::size_t n) : eta(n), h(n), u(n), t(n), on(n) {}
+  void store(int x, const cell::SwSlopes<Real>& s) {
+    eta[x] = s.eta;
+    h[x] = s.h;
+    u[x] = s.u;
+    t[x] = s.t;
+    on[x] = s.on;
+  }
+  cell::SwSlopes<Real> load(int x) const {
+    cell::SwSlopes<Real> s;
+    s.eta = eta[x];
+    s.h = h[x];
+    s.u = u[x];
+    s.t = t[x];
+    s.on = on[x];
+    return s;
+  }
+};
+
 /// A padded row as the shallow-water faces read it: kinds (as int; walls for the rows beyond
 /// the raster, which stand on the nearest row's state, as shallow_water_cell clamps), depth,
-/// bed and velocities (cell::sw_velocity).
+/// bed and velocities (cell::sw_velocity); for the second order its slopes along x and y (none
+/// for the rows beyond the raster).
 template <class Real>
 struct SwRow {
   const int* kind;
   const Real *depth, *bed, *u, *v;
+  const SwSlopeRow<Real>*slope_x, *slope_y;
+  cell::SwCellState<Real> state(int x) const {
+    cell::SwCellState<Real> c;
+    c.h = depth[x];
+    c.z = bed[x];
+    c.u = u[x];
+    c.v = v[x];
+    c.k = kind[x];
+    return c;
+  }
 };
 
-/// The faces south of row `a` (north of row `b`), all x, into `out`.
-template <class Real>
+/// The faces south of row `a` (north of row `b`), all x, into `out`; second order (Muscl) from
+/// the rows' y-slopes.
+template <bool Muscl, class Real>
 void sw_faces_y(int W, const SwRow<Real>& a, const SwRow<Real>& b, Real g, Real eps,
                 const SwFaceRef<Real>& out) {
-  const int* __restrict ka = a.kind, * __restrict kb = b.kind;
-  const Real* __restrict ha = a.depth, * __restrict za = a.bed, * __restrict ua = a.u, * __restrict va = a.v;
-  const Real* __restrict hb = b.depth, * __restrict zb = b.bed, * __restrict ub = b.u, * __restrict vb = b.v;
-  ERODEM_IVDEP
-  for (int x = 0; x < W; ++x)
-    out.store(x, cell::sw_face(ka[x], kb[x], ha[x], za[x], -va[x], ua[x], hb[x], zb[x], -vb[x],
-                               ub[x], g, eps));
+  if constexpr (Muscl) {
+    ERODEM_IVDEP
+    for (int x = 0; x < W; ++x)
+      out.store(x, cell::sw_face_y2(a.state(x), a.slope_y->load(x), b.state(x), b.slope_y->load(x),
+                                    g, eps));
+  } else {
+    const int* __restrict ka = a.kind, * __restrict kb = b.kind;
+    const Real* __restrict ha = a.depth, * __restrict za = a.bed, * __restrict ua = a.u, * __restrict va = a.v;
+    const Real* __restrict hb = b.depth, * __restrict zb = b.bed, * __restrict ub = b.u, * __restrict vb = b.v;
+    ERODEM_IVDEP
+    for (int x = 0; x < W; ++x)
+      out.store(x, cell::sw_face(ka[x], kb[x], ha[x], za[x], -va[x], ua[x], hb[x], zb[x], -vb[x],
+                                 ub[x], g, eps));
+  }
 }
 
 /// The faces of row r: face x (0 <= x <= W) west of cell x, faces 0 and W against the cell
-/// itself as a wall (as shallow_water_cell clamps), into `out`.
-template <class Real>
+/// itself as a wall (as shallow_water_cell clamps), into `out`; second order from the row's
+/// x-slopes (none at the two walls: those faces are the first order's).
+template <bool Muscl, class Real>
 void sw_faces_x(int W, const SwRow<Real>& r, Real g, Real eps, const SwFaceRef<Real>& out) {
   const int* __restrict k = r.kind;
   const Real* __restrict h = r.depth, * __restrict z = r.bed, * __restrict u = r.u, * __restrict v = r.v;
   out.store(0, cell::sw_face(ERODEM_CELL_WALL, k[0], h[0], z[0], u[0], v[0], h[0], z[0], u[0], v[0],
                              g, eps));
-  ERODEM_IVDEP
-  for (int x = 1; x < W; ++x)
-    out.store(x, cell::sw_face(k[x - 1], k[x], h[x - 1], z[x - 1], u[x - 1], v[x - 1], h[x], z[x],
-                               u[x], v[x], g, eps));
+  if constexpr (Muscl) {
+    ERODEM_IVDEP
+    for (int x = 1; x < W; ++x)
+      out.store(x, cell::sw_face_x2(r.state(x - 1), r.slope_x->load(x - 1), r.state(x),
+                                    r.slope_x->load(x), g, eps));
+  } else {
+    ERODEM_IVDEP
+    for (int x = 1; x < W; ++x)
+      out.store(x, cell::sw_face(k[x - 1], k[x], h[x - 1], z[x - 1], u[x - 1], v[x - 1], h[x], z[x],
+                                 u[x], v[x], g, eps));
+  }
   out.store(W, cell::sw_face(k[W - 1], ERODEM_CELL_WALL, h[W - 1], z[W - 1], u[W - 1], v[W - 1],
                              h[W - 1], z[W - 1], u[W - 1], v[W - 1], g, eps));
+}
+
+/// What a stage of the shallow-water step reads and writes (cell::shallow_water_muscl_cell's
+/// arguments): the stage's depth and unit discharges, the outflows and unit discharges it
+/// writes, and whether it averages them with what those arrays hold (Heun's second stage).
+template <class Real>
+struct SwStage {
+  int W, H;
+  const cell::erodem_kind_t* kind;
+  const Real *bed, *depth, *q_x, *q_y, *manning, *dx, *dy, *area;
+  Real dt;
+  cell_params::FlowParams<Real> params;
+  int combine;
+  Real *out_left, *out_right, *out_top, *out_bottom, *q_x_new, *q_y_new;
+};
+
+/// One stage over the padded rows [y0, y1) (a thread's block), walked top to bottom: per row y
+/// the state of the rows it needs next (velocities, slopes), the faces south of row y and those
+/// of row y, then row y's cells from their four faces (cell::shallow_water_cell_update), each
+/// face computed once (the faces between two blocks twice) with the arguments the OpenCL cell
+/// gives it (cell::shallow_water_cell, shallow_water_muscl_cell), so the two agree bit for bit.
+template <bool Muscl, class Real>
+void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
+  const int W = st.W, H = st.H;
+  const Real g = st.params.gravity, eps = st.params.dry_depth;
+  const std::size_t w = static_cast<std::size_t>(W);
+  constexpr int kSlots = 5;  // rows y - 2 .. y + 2 at most
+  // rings: kinds, velocities and slopes of rows j (slot j mod 5), faces south of rows j (slot
+  // j mod 2); walls for the kinds of the rows beyond the raster, and no slopes
+  std::vector<int> kinds(kSlots * w), walls(w, ERODEM_CELL_WALL);
+  std::vector<Real> us(kSlots * w), vs(kSlots * w);
+  std::vector<SwSlopeRow<Real>> slope_x, slope_y;
+  for (int k = 0; k < (Muscl ? kSlots : 0); ++k) {
+    slope_x.emplace_back(w);
+    slope_y.emplace_back(w);
+  }
+  SwSlopeRow<Real> flat(Muscl ? w : 0);
+  for (std::size_t x = 0; x < flat.on.size(); ++x) flat.store(static_cast<int>(x), {});
+  SwFaceRow<Real> fy0(w), fy1(w), fx(w + 1);
+  const SwFaceRef<Real> face_y[2] = {SwFaceRef<Real>(fy0), SwFaceRef<Real>(fy1)};
+  const SwFaceRef<Real> face_x(fx);
+  const Real *d = st.depth, *b = st.bed;
+  auto slot_of = [&](int j) { return static_cast<std::size_t>(j % kSlots); };
+  auto row_of = [&](int j) {  // -1 <= j <= H
+    const int c = j < 0 ? 0 : (j >= H ? H - 1 : j);
+    const std::size_t slot = slot_of(c) * w, row = static_cast<std::size_t>(c) * w;
+    SwRow<Real> r{c == j ? kinds.data() + slot : walls.data(),
+                  d + row,
+                  b + row,
+                  us.data() + slot,
+                  vs.data() + slot,
+                  nullptr,
+                  nullptr};
+    if constexpr (Muscl) {
+      r.slope_x = &slope_x[slot_of(c)];
+      r.slope_y = c == j && j >= 1 && j <= H - 2 ? &slope_y[slot_of(c)] : &flat;
+    }
+    return r;
+  };
+  auto load_row = [&](int j) {  // 0 <= j < H: kinds, velocities, x-slopes
+    const std::size_t slot = slot_of(j) * w, row = static_cast<std::size_t>(j) * w;
+    int* __restrict k = kinds.data() + slot;
+    Real* __restrict u = us.data() + slot, * __restrict v = vs.data() + slot;
+    const cell::erodem_kind_t* __restrict src = st.kind + row;
+    const Real* __restrict h = d + row, * __restrict qxr = st.q_x + row, * __restrict qyr = st.q_y + row;
+    for (int x = 0; x < W; ++x) {
+      k[x] = src[x];
+      u[x] = cell::sw_velocity(qxr[x], h[x], eps);
+      v[x] = cell::sw_velocity(qyr[x], h[x], eps);
+    }
+    if constexpr (Muscl) {
+      const SwRow<Real> r = row_of(j);
+      SwSlopeRow<Real>& s = slope_x[slot_of(j)];
+      s.store(0, {});
+      ERODEM_IVDEP
+      for (int x = 1; x < W - 1; ++x)
+        s.store(x, cell::sw_slopes_x(r.state(x - 1), r.state(x), r.state(x + 1), eps));
+      s.store(W - 1, {});
+    }
+  };
+  auto slopes_y = [&](int j) {  // 1 <= j <= H - 2, rows j - 1 .. j + 1 loaded
+    const SwRow<Real> m = row_of(j - 1), c = row_of(j), p = row_of(j + 1);
+    SwSlopeRow<Real>& s = slope_y[slot_of(j)];
+    ERODEM_IVDEP
+    for (int x = 0; x < W; ++x)
+      s.store(x, cell::sw_slopes_y(m.state(x), c.state(x), p.state(x), eps));
+  };
+  auto faces_south_of = [&](int j) {  // -1 <= j <= H - 1
+    sw_faces_y<Muscl>(W, row_of(j), row_of(j + 1), g, eps, face_y[(j + 2) % 2]);
+  };
+  // rows y0 - 2 (second order) .. y0 + 1 loaded and the slopes of y0 - 1 and y0 known before
+  // the faces north of row y0
+  for (int j = y0 - (Muscl ? 2 : 1); j <= y0 + (Muscl ? 1 : 0); ++j)
+    if (j >= 0 && j < H) load_row(j);
+  if constexpr (Muscl)
+    for (int j = y0 - 1; j <= y0; ++j)
+      if (j >= 1 && j <= H - 2) slopes_y(j);
+  faces_south_of(y0 - 1);
+  for (int y = y0; y < y1; ++y) {
+    const int next = y + (Muscl ? 2 : 1);
+    if (next < H) load_row(next);
+    if constexpr (Muscl)
+      if (y + 1 <= H - 2) slopes_y(y + 1);
+    faces_south_of(y);
+    sw_faces_x<Muscl>(W, row_of(y), g, eps, face_x);
+    const SwFaceRef<Real>&north = face_y[(y + 1) % 2], &south = face_y[(y + 2) % 2];
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
+    const int* __restrict k = row_of(y).kind;
+    const Real* __restrict h = d + row, * __restrict qxr = st.q_x + row, * __restrict qyr = st.q_y + row, * __restrict n = st.manning + row;
+    Real* __restrict o_l = st.out_left + row, * __restrict o_r = st.out_right + row, * __restrict o_t = st.out_top + row, * __restrict o_b = st.out_bottom + row, * __restrict qx_out = st.q_x_new + row, * __restrict qy_out = st.q_y_new + row;
+    // face lengths: x-faces the row's dy; y-faces the mean dx of their two rows (the rows
+    // beyond the raster: the nearest face's, as shallow_water_cell clamps)
+    const Real l_x = st.dy[y];
+    const Real l_n = cell::face_y_width(st.dx, y >= 1 ? y - 1 : y);
+    const Real l_s = cell::face_y_width(st.dx, y + 1 < H ? y : (y >= 1 ? y - 1 : y));
+    const Real a = st.area[y], step = st.dt;
+    const cell_params::FlowParams<Real> fp = st.params;
+    const int combine = st.combine;
+    ERODEM_IVDEP
+    for (int x = 0; x < W; ++x) {
+      const cell::SwCell<Real> c = cell::shallow_water_cell_update(
+          k[x], h[x], qxr[x], qyr[x], n[x], l_x, l_n, l_s, a, step, fp, face_x.load(x + 1),
+          face_x.load(x), south.load(x), north.load(x));
+      cell::shallow_water_stage_store(x, combine, c, o_l, o_r, o_t, o_b, qx_out, qy_out);
+    }
+  }
 }
 
 }  // namespace
@@ -247,85 +424,37 @@ void CpuBackend<Real>::run_flow(Real dt) {
   const int W = W_, H = H_;
   if (params_.flow.scheme == FlowScheme::shallow_water) {
     // Every padded cell: its four faces, its outflows and (active) its new unit discharges
-    // into the second buffers, swapped below.
+    // into the second buffers. First order: one stage, the buffers swapped. Second order
+    // (Heun): the first stage into the second buffers, the depth it leaves, and the second stage
+    // from that depth and those unit discharges, averaged into the outflows of the first and
+    // the unit discharges at the start of the step (which stay the current ones).
     Field &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Field &qx_next = *fields_.twin(FieldId::momentum_x),
           &qy_next = *fields_.twin(FieldId::momentum_y);
-    const Real *q_x = qx.data(), *q_y = qy.data(), *manning = manning_.data();
-    Real *q_x_new = qx_next.data(), *q_y_new = qy_next.data();
-    // Each thread a block of rows, walked top to bottom: per row y the velocities of row
-    // y + 1, the faces south of row y and those of row y, then row y's cells from their four
-    // faces (cell::shallow_water_cell_update), each face computed once (the faces between two
-    // blocks twice) with the arguments shallow_water_cell gives it: the same bits as the
-    // OpenCL kernel, which computes every face from both sides.
-    const Real eps = f.dry_depth;
-    for_row_blocks(H, [&](int y0, int y1) {
-      const std::size_t w = static_cast<std::size_t>(W);
-      // rings: kinds and velocities of rows j (slot j mod 3), faces south of rows j (slot j
-      // mod 2); walls for the kinds of the rows beyond the raster
-      std::vector<int> kinds(3 * w), walls(w, ERODEM_CELL_WALL);
-      std::vector<Real> us(3 * w), vs(3 * w);
-      SwFaceRow<Real> fy0(w), fy1(w), fx(w + 1);
-      const SwFaceRef<Real> face_y[2] = {SwFaceRef<Real>(fy0), SwFaceRef<Real>(fy1)};
-      const SwFaceRef<Real> face_x(fx);
-      auto load_row = [&](int j) {  // 0 <= j < H
-        const std::size_t slot = static_cast<std::size_t>(j % 3) * w;
-        const std::size_t row = static_cast<std::size_t>(j) * w;
-        int* __restrict k = kinds.data() + slot;
-        Real* __restrict u = us.data() + slot, * __restrict v = vs.data() + slot;
-        const Kind* __restrict src = kind + row;
-        const Real* __restrict h = d + row, * __restrict qxr = q_x + row, * __restrict qyr = q_y + row;
-        for (int x = 0; x < W; ++x) {
-          k[x] = src[x];
-          u[x] = cell::sw_velocity(qxr[x], h[x], eps);
-          v[x] = cell::sw_velocity(qyr[x], h[x], eps);
-        }
-      };
-      auto row_of = [&](int j) {  // -1 <= j <= H
-        const int c = j < 0 ? 0 : (j >= H ? H - 1 : j);
-        const std::size_t slot = static_cast<std::size_t>(c % 3) * w;
-        const std::size_t row = static_cast<std::size_t>(c) * w;
-        return SwRow<Real>{c == j ? kinds.data() + slot : walls.data(), d + row, b + row,
-                           us.data() + slot, vs.data() + slot};
-      };
-      auto faces_south_of = [&](int j) {  // -1 <= j <= H - 1
-        sw_faces_y(W, row_of(j), row_of(j + 1), g, eps, face_y[(j + 2) % 2]);
-      };
-      if (y0 >= 1) load_row(y0 - 1);
-      load_row(y0);
-      faces_south_of(y0 - 1);
-      for (int y = y0; y < y1; ++y) {
-        if (y + 1 < H) load_row(y + 1);
-        faces_south_of(y);
-        sw_faces_x(W, row_of(y), g, eps, face_x);
-        const SwFaceRef<Real>&north = face_y[(y + 1) % 2], &south = face_y[(y + 2) % 2];
-        const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
-        const int* __restrict k = row_of(y).kind;
-        const Real* __restrict h = d + row, * __restrict qxr = q_x + row, * __restrict qyr = q_y + row, * __restrict n = manning + row;
-        Real* __restrict o_l = ol + row, * __restrict o_r = orr + row, * __restrict o_t = ot + row, * __restrict o_b = ob + row, * __restrict qx_out = q_x_new + row, * __restrict qy_out = q_y_new + row;
-        // face lengths: x-faces the row's dy; y-faces the mean dx of their two rows (the
-        // rows beyond the raster: the nearest face's, as shallow_water_cell clamps)
-        const Real l_x = dy[y];
-        const Real l_n = cell::face_y_width(dx, y >= 1 ? y - 1 : y);
-        const Real l_s = cell::face_y_width(dx, y + 1 < H ? y : (y >= 1 ? y - 1 : y));
-        const Real a = area[y], step = dt;
-        const cell_params::FlowParams<Real> fp = f;
-        ERODEM_IVDEP
-        for (int x = 0; x < W; ++x) {
-          const cell::SwCell<Real> c = cell::shallow_water_cell_update(
-              k[x], h[x], qxr[x], qyr[x], n[x], l_x, l_n, l_s, a, step, fp, face_x.load(x + 1),
-              face_x.load(x), south.load(x), north.load(x));
-          o_l[x] = c.left;
-          o_r[x] = c.right;
-          o_t[x] = c.top;
-          o_b[x] = c.bottom;
-          qx_out[x] = c.q_x;
-          qy_out[x] = c.q_y;
-        }
-      }
-    });
-    std::swap(qx, qx_next);
-    std::swap(qy, qy_next);
+    SwStage<Real> st{
+        W, H, kind, b,   d,  qx.data(), qy.data(),      manning_.data(), dx, dy, area, dt,
+        f, 0, ol,   orr, ot, ob,        qx_next.data(), qy_next.data()};
+    if (params_.flow.order == 2) {
+      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true>(st, y0, y1); });
+      stage_depth_.resize(depth_.size());
+      Real* h1 = stage_depth_.data();
+      for_rows(0, H, [=](int y) {
+        for (int x = 0; x < W; ++x)
+          cell::shallow_water_stage_depth_cell(x, y, W, H, kind, d, ol, orr, ot, ob, area, dt, h1);
+      });
+      SwStage<Real> st2 = st;
+      st2.depth = h1;
+      st2.q_x = qx_next.data();
+      st2.q_y = qy_next.data();
+      st2.combine = 1;
+      st2.q_x_new = qx.data();
+      st2.q_y_new = qy.data();
+      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true>(st2, y0, y1); });
+    } else {
+      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<false>(st, y0, y1); });
+      std::swap(qx, qx_next);
+      std::swap(qy, qy_next);
+    }
     std::swap(flux_, flux_next_);
     return;
   }

@@ -141,3 +141,33 @@ __kernel void flow_shallow_water(
   shallow_water_cell(x, y, W, H, kind, bed, depth, q_x, q_y, manning, dx, dy, area, dt, p, out_left,
                      out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
+
+/* The shallow-water scheme's second order (flow.order = 2, shallow_water.h): a stage of Heun's
+ * method with MUSCL faces, one work-item per padded cell (rows 0 .. H - 1); `combine` 0 for the
+ * first stage, 1 for the second (averaged into what out_* and q_*_new hold). */
+__kernel void flow_shallow_water_muscl(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict q_x,
+    __global const real* restrict q_y, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict area, real dt, FlowParams p, int combine,
+    __global real* restrict out_left, __global real* restrict out_right,
+    __global real* restrict out_top, __global real* restrict out_bottom,
+    __global real* restrict q_x_new, __global real* restrict q_y_new) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
+  shallow_water_muscl_cell(x, y, W, H, kind, bed, depth, q_x, q_y, manning, dx, dy, area, dt, p,
+                           combine, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
+}
+
+/* The depth after Heun's first stage (shallow_water_stage_depth_cell), every padded cell. */
+__kernel void flow_shallow_water_stage_depth(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict depth,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global const real* restrict f_top, __global const real* restrict f_bottom,
+    __global const real* restrict area, real dt, __global real* restrict depth_stage) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
+  shallow_water_stage_depth_cell(x, y, W, H, kind, depth, f_left, f_right, f_top, f_bottom, area,
+                                 dt, depth_stage);
+}

@@ -97,6 +97,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   velocity_x_ = upload(zeros);
   velocity_y_ = upload(zeros);
   thermal_share_ = upload(zeros);
+  if (params_.flow.scheme == FlowScheme::shallow_water && params_.flow.order == 2)
+    stage_depth_ = upload(zeros);
   wetness_ = upload(depth_r);
   manning_ = upload(to_real(state.manning));
   hardness_ = upload(to_real(state.hardness));
@@ -291,6 +293,26 @@ void OpenClBackend::run_flow(Real dt) {
     Buffer &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Buffer &qx_next = *fields_.twin(FieldId::momentum_x),
            &qy_next = *fields_.twin(FieldId::momentum_y);
+    if (params_.flow.order == 2) {
+      // Heun (shallow_water.h): the first stage into the second buffers, the depth it leaves,
+      // the second stage from there averaged into the first's outflows and the unit discharges
+      // at the start of the step, which stay the current ones
+      cl_kernel k = kernel("flow_shallow_water_muscl");
+      set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_,
+               dt, cell_.flow, cl_int{0}, flux_next_[0], flux_next_[1], flux_next_[2],
+               flux_next_[3], qx_next, qy_next);
+      launch_rows(k, 0, H_);
+      cl_kernel s = kernel("flow_shallow_water_stage_depth");
+      set_args(s, cl_int{W_}, cl_int{H_}, kind_, depth_, flux_next_[0], flux_next_[1],
+               flux_next_[2], flux_next_[3], area_, dt, stage_depth_);
+      launch_rows(s, 0, H_);
+      set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, stage_depth_, qx_next, qy_next, manning_,
+               dx_, dy_, area_, dt, cell_.flow, cl_int{1}, flux_next_[0], flux_next_[1],
+               flux_next_[2], flux_next_[3], qx, qy);
+      launch_rows(k, 0, H_);
+      std::swap(flux_, flux_next_);
+      return;
+    }
     cl_kernel k = kernel("flow_shallow_water");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_, dt,
              cell_.flow, flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], qx_next,

@@ -242,6 +242,7 @@ class OpenClBackend final : public Backend {
   std::array<Buffer, 4> flux_, flux_next_;
   Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
+  Buffer stage_depth_;  // shallow water, second order: the depth after Heun's first stage
   // Every field's buffer by FieldId: the members above, and a buffer (zeros) for any other
   // field of ERODEM_FIELDS (field_registry.hpp).
   FieldRegistry<Buffer> fields_;
