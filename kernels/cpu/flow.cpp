@@ -199,7 +199,17 @@ struct SwSlopeRow {
   std::vector<Real> eta, h, u, t;
   std::vector<int> on;
   explicit SwSlopeRow(std::size_t n) : eta(n), h(n), u(n), t(n), on(n) {}
-  void store(int x, const cell::SwSlopes<Real>& s) {
+};
+
+/// Pointers into a SwSlopeRow (restrict: the loops store through them).
+template <class Real>
+struct SwSlopeRef {
+  Real* __restrict eta = nullptr, * __restrict h = nullptr, * __restrict u = nullptr, * __restrict t = nullptr;
+  int* __restrict on = nullptr;
+  SwSlopeRef() = default;
+  explicit SwSlopeRef(SwSlopeRow<Real>& r)
+      : eta(r.eta.data()), h(r.h.data()), u(r.u.data()), t(r.t.data()), on(r.on.data()) {}
+  void store(int x, const cell::SwSlopes<Real>& s) const {
     eta[x] = s.eta;
     h[x] = s.h;
     u[x] = s.u;
@@ -225,7 +235,7 @@ template <class Real>
 struct SwRow {
   const int* kind;
   const Real *depth, *bed, *u, *v;
-  const SwSlopeRow<Real>*slope_x, *slope_y;
+  SwSlopeRef<Real> slope_x, slope_y;
   cell::SwCellState<Real> state(int x) const {
     cell::SwCellState<Real> c;
     c.h = depth[x];
@@ -245,8 +255,8 @@ void sw_faces_y(int W, const SwRow<Real>& a, const SwRow<Real>& b, Real g, Real 
   if constexpr (Muscl) {
     ERODEM_IVDEP
     for (int x = 0; x < W; ++x)
-      out.store(x, cell::sw_face_y2(a.state(x), a.slope_y->load(x), b.state(x), b.slope_y->load(x),
-                                    g, eps));
+      out.store(x, cell::sw_face_y2(a.state(x), a.slope_y.load(x), b.state(x), b.slope_y.load(x), g,
+                                    eps));
   } else {
     const int* __restrict ka = a.kind, * __restrict kb = b.kind;
     const Real* __restrict ha = a.depth, * __restrict za = a.bed, * __restrict ua = a.u, * __restrict va = a.v;
@@ -270,8 +280,8 @@ void sw_faces_x(int W, const SwRow<Real>& r, Real g, Real eps, const SwFaceRef<R
   if constexpr (Muscl) {
     ERODEM_IVDEP
     for (int x = 1; x < W; ++x)
-      out.store(x, cell::sw_face_x2(r.state(x - 1), r.slope_x->load(x - 1), r.state(x),
-                                    r.slope_x->load(x), g, eps));
+      out.store(x, cell::sw_face_x2(r.state(x - 1), r.slope_x.load(x - 1), r.state(x),
+                                    r.slope_x.load(x), g, eps));
   } else {
     ERODEM_IVDEP
     for (int x = 1; x < W; ++x)
@@ -311,13 +321,18 @@ void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
   // j mod 2); walls for the kinds of the rows beyond the raster, and no slopes
   std::vector<int> kinds(kSlots * w), walls(w, ERODEM_CELL_WALL);
   std::vector<Real> us(kSlots * w), vs(kSlots * w);
-  std::vector<SwSlopeRow<Real>> slope_x, slope_y;
+  std::vector<SwSlopeRow<Real>> slope_x_rows, slope_y_rows;
+  std::vector<SwSlopeRef<Real>> slope_x, slope_y;
   for (int k = 0; k < (Muscl ? kSlots : 0); ++k) {
-    slope_x.emplace_back(w);
-    slope_y.emplace_back(w);
+    slope_x_rows.emplace_back(w);
+    slope_y_rows.emplace_back(w);
   }
-  SwSlopeRow<Real> flat(Muscl ? w : 0);
-  for (std::size_t x = 0; x < flat.on.size(); ++x) flat.store(static_cast<int>(x), {});
+  for (int k = 0; k < (Muscl ? kSlots : 0); ++k) {
+    slope_x.emplace_back(slope_x_rows[static_cast<std::size_t>(k)]);
+    slope_y.emplace_back(slope_y_rows[static_cast<std::size_t>(k)]);
+  }
+  SwSlopeRow<Real> flat_row(Muscl ? w : 0);  // zeros: no slopes
+  const SwSlopeRef<Real> flat(flat_row);
   SwFaceRow<Real> fy0(w), fy1(w), fx(w + 1);
   const SwFaceRef<Real> face_y[2] = {SwFaceRef<Real>(fy0), SwFaceRef<Real>(fy1)};
   const SwFaceRef<Real> face_x(fx);
@@ -331,41 +346,45 @@ void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
                   b + row,
                   us.data() + slot,
                   vs.data() + slot,
-                  nullptr,
-                  nullptr};
+                  {},
+                  {}};
     if constexpr (Muscl) {
-      r.slope_x = &slope_x[slot_of(c)];
-      r.slope_y = c == j && j >= 1 && j <= H - 2 ? &slope_y[slot_of(c)] : &flat;
+      r.slope_x = slope_x[slot_of(c)];
+      r.slope_y = c == j && j >= 1 && j <= H - 2 ? slope_y[slot_of(c)] : flat;
     }
     return r;
   };
   auto load_row = [&](int j) {  // 0 <= j < H: kinds, velocities, x-slopes
+    const int n = W;  // locals: the loop bounds and constants must not be read through the closure
+    const Real e = eps;
     const std::size_t slot = slot_of(j) * w, row = static_cast<std::size_t>(j) * w;
     int* __restrict k = kinds.data() + slot;
     Real* __restrict u = us.data() + slot, * __restrict v = vs.data() + slot;
     const cell::erodem_kind_t* __restrict src = st.kind + row;
     const Real* __restrict h = d + row, * __restrict qxr = st.q_x + row, * __restrict qyr = st.q_y + row;
-    for (int x = 0; x < W; ++x) {
-      k[x] = src[x];
-      u[x] = cell::sw_velocity(qxr[x], h[x], eps);
-      v[x] = cell::sw_velocity(qyr[x], h[x], eps);
+    for (int x = 0; x < n; ++x) k[x] = src[x];  // (bytes and floats in one loop: scalar)
+    for (int x = 0; x < n; ++x) {
+      u[x] = cell::sw_velocity(qxr[x], h[x], e);
+      v[x] = cell::sw_velocity(qyr[x], h[x], e);
     }
     if constexpr (Muscl) {
       const SwRow<Real> r = row_of(j);
-      SwSlopeRow<Real>& s = slope_x[slot_of(j)];
+      const SwSlopeRef<Real> s = slope_x[slot_of(j)];
       s.store(0, {});
       ERODEM_IVDEP
-      for (int x = 1; x < W - 1; ++x)
-        s.store(x, cell::sw_slopes_x(r.state(x - 1), r.state(x), r.state(x + 1), eps));
-      s.store(W - 1, {});
+      for (int x = 1; x < n - 1; ++x)
+        s.store(x, cell::sw_slopes_x(r.state(x - 1), r.state(x), r.state(x + 1), e));
+      s.store(n - 1, {});
     }
   };
   auto slopes_y = [&](int j) {  // 1 <= j <= H - 2, rows j - 1 .. j + 1 loaded
+    const int n = W;
+    const Real e = eps;
     const SwRow<Real> m = row_of(j - 1), c = row_of(j), p = row_of(j + 1);
-    SwSlopeRow<Real>& s = slope_y[slot_of(j)];
+    const SwSlopeRef<Real> s = slope_y[slot_of(j)];
     ERODEM_IVDEP
-    for (int x = 0; x < W; ++x)
-      s.store(x, cell::sw_slopes_y(m.state(x), c.state(x), p.state(x), eps));
+    for (int x = 0; x < n; ++x)
+      s.store(x, cell::sw_slopes_y(m.state(x), c.state(x), p.state(x), e));
   };
   auto faces_south_of = [&](int j) {  // -1 <= j <= H - 1
     sw_faces_y<Muscl>(W, row_of(j), row_of(j + 1), g, eps, face_y[(j + 2) % 2]);
