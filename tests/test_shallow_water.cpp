@@ -635,7 +635,8 @@ MacDonaldRun run_macdonald(int cells, int order, const Target& target) {
 TEST_P(ShallowWater, MacDonaldSupercriticalSecondOrder) {
   // The second order's order on a smooth steady flow (issue 16): between each pair of rungs of
   // 50, 100, 200 cells (the report adds 400) the depth and discharge errors over 100 .. 900 m
-  // fall at order >= 1.7 (measured 2.01, 2.01 in depth; 2.2 in discharge), and at 200 cells the
+  // fall at order >= 1.7 (measured 2.01, 2.01, 2.00 in depth; 2.2, 2.2, 2.06 in discharge; at
+  // 400 cells float32's discharge error meets its rounding floor, below), and at 200 cells the
   // second order's depth error is below a fifth of the first order's. The first order is
   // printed, not bounded: where the bed drops by a good part of the depth per cell (0.3 m on
   // 0.55 m at 10 m cells) the first-order hydrostatic reconstruction keeps only part of the bed
@@ -674,7 +675,13 @@ TEST_P(ShallowWater, MacDonaldSupercriticalSecondOrder) {
           "%.2f (bound >= 1.7)\n",
           target().label().c_str(), n / 2, n, p_h, p_q);
       vr::expect_above(fig(o + "observed order, depth", dx), p_h, 1.7);
-      vr::expect_above(fig(o + "observed order, discharge", dx), p_q, 1.7);
+      // float32: at 400 cells (the report's rung) the discharge error, 5e-6 of q in float64,
+      // meets its rounding floor (the momentum fluxes of about 7 m^3/s^2 rounded to 6e-8 of
+      // themselves every step: 7.4e-6 measured), so its order there is reported, not bounded
+      if (!target().f64() && n >= 400)
+        vr::report(fig(o + "observed order, discharge (float32 at its rounding floor)", dx), p_q);
+      else
+        vr::expect_above(fig(o + "observed order, discharge", dx), p_q, 1.7);
     }
   }
   const double ratio = second[2].depth / first[2].depth;

@@ -7,6 +7,11 @@
 // east of every cell of row y, and splits them into row y's outflows. Every face is
 // computed once per thread (the faces between two blocks twice), and every inner loop runs
 // over x with values, not calls through pointers, so GCC vectorises it.
+//
+// Shallow water (common/shallow_water.h): the same walk (shallow_water_rows): per row the
+// velocities (and for the second order the slopes) of the rows it needs next, the faces south
+// of the row and those of the row, each once, then the row's cells from their four faces; the
+// second order runs it twice a step (Heun), with the depth after the first stage in between.
 #include "common/flow.h"
 
 #include <vector>
