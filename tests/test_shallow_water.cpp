@@ -582,7 +582,7 @@ MacDonaldRun run_macdonald(int cells, int order, const Target& target) {
       t.bed[static_cast<std::size_t>(r) * cells + c] = z[c];
       t.water_depth[static_cast<std::size_t>(r) * cells + c] = h[c];
     }
-  // steps of 0.05 dx s: (|u| + c) dt / dx + c dt / dy <= 0.46 with u <= 3.4 m/s, c <= 2.7 m/s
+  // steps of 0.05 dx s: (|u| + c) dt / dx + c dt / dy <= 0.46 with u <= 4.5 m/s, c <= 2.3 m/s
   const double dt = 0.05 * dx;
   Params p = sw_params(dt, order);
   p.flow.manning_n.value = M::n;
