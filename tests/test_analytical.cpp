@@ -281,6 +281,22 @@ TEST_P(Analytical, ManningPlaneNormalDepth) {
   vr::profile(fig, "depth", {"x", "depth", "normal_depth"},
               {row.sample([](double x) { return x; }), d, std::vector<double>(n, normal)});
   vr::expect_below(fig, worst, 0.02);
+  // The bed shear stress (the output field shear_stress, rho g n^2 |u|^2 / h^(1/3)): in uniform
+  // flow the bed carries the weight's downslope component, rho g h S. Bound 5 % on the middle
+  // half's mean: tau goes as q^2 / h^(7/3), so the depth's 2 % becomes 4.7 %; an idle solver
+  // (no velocity) scores 0.
+  const auto tau = middle_row(sim, FieldId::shear_stress);
+  double tau_mean = 0;
+  for (int c = n / 4; c < 3 * n / 4; ++c) tau_mean += tau[c] / (n / 2);
+  const double tau_exact = p.flow.water_density * p.flow.gravity * normal * plane.slope;
+  std::printf(
+      "[Manning plane] %s: bed shear stress %.4f Pa, rho g h S %.4f Pa (ratio %.4f, "
+      "bound 0.95 .. 1.05)\n",
+      target().label().c_str(), tau_mean, tau_exact, tau_mean / tau_exact);
+  vr::expect_between(
+      figure("manning_plane", "local_inertial", "bed shear stress / rho g h S (middle half)", dx,
+             "uniform flow: tau = rho g h S"),
+      tau_mean / tau_exact, 0.95, 1.05);
 }
 
 TEST_P(Analytical, RainOnTiltedPlaneReachesEquilibrium) {

@@ -159,17 +159,18 @@ TEST(ProcessTable, BedChangesWithErosionOrThermal) {
 TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
   // state_fields() and output.fields' choices as written by hand before the table
   // (simulation.cpp and schema.cpp of 2026-11-25) with the snow pack and the shallow-water
-  // scheme's unit discharges added, as sets: the order is the table's now.
+  // scheme's unit discharges added, and the bed shear stress as an output, as sets: the order
+  // is the table's now.
   std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
   for (FieldId id : state_fields()) state.insert(field_info(id).name);
   EXPECT_EQ(state, (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment",
                                           "velocity_x", "velocity_y", "flux_left", "flux_right",
                                           "flux_top", "flux_bottom", "wetness", "bed_residual",
                                           "snow", "momentum_x", "momentum_y"}));
-  EXPECT_EQ(output,
-            (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x", "velocity_y",
-                                   "erosion", "wetness", "hardness", "flux_left", "flux_right",
-                                   "flux_top", "flux_bottom", "snow", "momentum_x", "momentum_y"}));
+  EXPECT_EQ(output, (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x",
+                                           "velocity_y", "erosion", "wetness", "hardness",
+                                           "flux_left", "flux_right", "flux_top", "flux_bottom",
+                                           "snow", "momentum_x", "momentum_y", "shear_stress"}));
   // a field restored from files that lack it starts at 0: the bed residual and the snow pack,
   // added later
   for (const auto& f : field_table())

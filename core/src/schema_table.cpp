@@ -81,6 +81,8 @@ const std::vector<Descriptor>& descriptor_table() {
                              "pipes: pipe length l (m), or \"cell\" for the cell size"),
       number(ERODEM_FIELD(flow.gravity), D::acceleration, above(0),
              "gravitational acceleration g (m/s^2)"),
+      number(ERODEM_FIELD(flow.water_density), D::density, above(0),
+             "water density rho (kg/m^3), for the bed shear stress"),
       integer(
           ERODEM_FIELD(flow.order), closed(1, 2),
           "shallow_water: order of accuracy, 1 (first-order Godunov) or 2 (MUSCL reconstruction "

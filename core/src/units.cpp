@@ -50,6 +50,8 @@ const std::vector<Unit>& unit_table() {
       {"m/s^2", Dimension::acceleration, 1.0},
       {"m^3/s", Dimension::discharge, 1.0},
       {"l/s", Dimension::discharge, 0.001},
+      {"kg/m^3", Dimension::density, 1.0},
+      {"g/cm^3", Dimension::density, 1000.0},
   };
   return units;
 }
@@ -115,6 +117,8 @@ std::string si_unit(Dimension dim) {
       return "m^3/s";
     case Dimension::manning:
       return "s m^-1/3";
+    case Dimension::density:
+      return "kg/m^3";
   }
   return "1";
 }
@@ -141,6 +145,8 @@ std::string dimension_noun(Dimension dim) {
       return "a discharge";
     case Dimension::manning:
       return "a Manning coefficient";
+    case Dimension::density:
+      return "a density";
   }
   return "a number";
 }
@@ -173,6 +179,8 @@ std::string unit_example(Dimension dim) {
       return "9.81 m/s^2";
     case Dimension::discharge:
       return "20 m^3/s";
+    case Dimension::density:
+      return "1000 kg/m^3";
     case Dimension::dimensionless:
     case Dimension::manning:
       return "";

@@ -18,6 +18,17 @@ ERODEM_PARAMS(ErosionParams, {
 
 ERODEM_BEGIN_NAMESPACE
 
+/* Bed shear stress (Pa) of a cell with depth h (m), velocities u, v (m/s) and Manning n
+ * (s m^-1/3): the friction term of the flow schemes, tau_b = rho g n^2 |u|^2 / h^(1/3), with water
+ * density rho (kg/m^3) and gravity g (m/s^2). Thin films: the depth in h^(1/3) is at least h_min
+ * (m, numerics.velocity_min_depth: the velocities are 0 or desingularised below it), so tau_b
+ * stays bounded as h -> 0; 0 on a dry cell (h <= 0). */
+ERODEM_FN real bed_shear_stress(real h, real u, real v, real n, real rho, real g, real h_min) {
+  const real h_f = h > h_min ? h : h_min;
+  const real tau = rho * g * n * n * (u * u + v * v) / erodem_cbrt_positive(h_f);
+  return h > (real)0 ? tau : (real)0;
+}
+
 /* Sine of the local bed tilt from central differences of the bed over active neighbours
  * (one-sided at the edge of the active area). */
 ERODEM_FN real bed_tilt_sin(int x, int y, int W, GLOBAL const erodem_kind_t* kind,

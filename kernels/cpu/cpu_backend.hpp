@@ -14,6 +14,7 @@
 
 #include "cell_params.hpp"
 #include "common/compat.h"
+#include "common/erosion.h"
 #include "erodem/backend.hpp"
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
@@ -136,8 +137,13 @@ class CpuBackend final : public Backend {
   }
   friend class FieldRegistry<Field>;
   /// Field `id` (stored in `src`, from field_storage) at padded cell `p`, as field() gives
-  /// it: the bed with its residual, the erosion from the bed pair and the initial bed.
+  /// it: the bed with its residual, the erosion from the bed pair and the initial bed, the bed
+  /// shear stress from the depth, the velocities and Manning n (in double, as OpenCL's host).
   double value_at(FieldId id, const Field* src, std::size_t p) const {
+    if (id == FieldId::shear_stress)
+      return cell::bed_shear_stress<double>(depth_[p], velocity_x_[p], velocity_y_[p], manning_[p],
+                                            params_.flow.water_density, params_.flow.gravity,
+                                            params_.numerics.velocity_min_depth);
     // the bed and the erosion include the bed's residual (exact in double)
     const double lo = static_cast<double>(bed_residual_[p]);
     return !src ? (static_cast<double>(bed0_[p]) - static_cast<double>(bed_[p])) - lo

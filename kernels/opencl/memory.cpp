@@ -8,6 +8,7 @@
 #include <array>
 
 #include "common/compat.h"
+#include "common/erosion.h"
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
 #include "opencl/launch.hpp"
@@ -90,21 +91,28 @@ void write_interior(cl_command_queue q, cl_mem b, int nx, int ny, const std::vec
 std::vector<const Buffer*> OpenClBackend::field_parts(FieldId id) {
   if (id == FieldId::bed) return {&bed_, &bed_residual_};
   if (id == FieldId::erosion) return {&bed0_, &bed_, &bed_residual_};
+  if (id == FieldId::shear_stress) return {&depth_, &velocity_x_, &velocity_y_, &manning_};
   return {field_buffer(id)};
 }
 
 std::size_t OpenClBackend::part_count(const std::vector<FieldId>& fields) {
   std::size_t n = 0;
-  for (const FieldId id : fields) n += id == FieldId::bed ? 2 : id == FieldId::erosion ? 3 : 1;
+  for (const FieldId id : fields)
+    n += id == FieldId::bed ? 2 : id == FieldId::erosion ? 3 : id == FieldId::shear_stress ? 4 : 1;
   return n;
 }
 
-double OpenClBackend::compose(FieldId id, const float* parts, std::size_t stride) {
+double OpenClBackend::compose(FieldId id, const float* parts, std::size_t stride) const {
   // the bed and the erosion include the bed's residual (exact in double)
   if (id == FieldId::bed) return static_cast<double>(parts[0]) + static_cast<double>(parts[stride]);
   if (id == FieldId::erosion)
     return (static_cast<double>(parts[0]) - static_cast<double>(parts[stride])) -
            static_cast<double>(parts[2 * stride]);
+  // the bed shear stress from the depth, the velocities and Manning n, as the CPU's value_at
+  if (id == FieldId::shear_stress)
+    return cell::bed_shear_stress<double>(
+        parts[0], parts[stride], parts[2 * stride], parts[3 * stride], params_.flow.water_density,
+        params_.flow.gravity, params_.numerics.velocity_min_depth);
   return static_cast<double>(parts[0]);
 }
 
@@ -144,7 +152,8 @@ void OpenClBackend::enqueue_gather(const Buffer& cells, std::size_t n,
 }
 
 std::vector<double> OpenClBackend::compose_gathered(const std::vector<FieldId>& fields,
-                                                    const std::vector<float>& raw, std::size_t n) {
+                                                    const std::vector<float>& raw,
+                                                    std::size_t n) const {
   std::vector<double> out;
   out.reserve(fields.size() * n);
   std::size_t part = 0;

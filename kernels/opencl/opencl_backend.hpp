@@ -198,19 +198,19 @@ class OpenClBackend final : public Backend {
   Buffer* field_buffer(FieldId id) { return fields_.get(id); }
   friend class FieldRegistry<Buffer>;
   /// The buffers field `id` is composed from, as field() composes them (compose): the bed
-  /// and its residual; the initial bed, the bed and its residual for the erosion; else the
-  /// field's own buffer.
+  /// and its residual; the initial bed, the bed and its residual for the erosion; depth,
+  /// velocities and Manning n for the bed shear stress; else the field's own buffer.
   std::vector<const Buffer*> field_parts(FieldId id);
   /// Field `id`'s value from the floats of its parts (field_parts), `stride` apart, in double
   /// as field() gives it.
-  static double compose(FieldId id, const float* parts, std::size_t stride);
+  double compose(FieldId id, const float* parts, std::size_t stride) const;
   /// Enqueues gather_cells (stats.cl): out[k * n + j] = part k of `fields` (field_parts, in
   /// order) at the `n` padded cells of `cells`.
   void enqueue_gather(const Buffer& cells, std::size_t n, const std::vector<FieldId>& fields,
                       const Buffer& out);
   /// The fields' values from the gathered floats of enqueue_gather, [field][cell].
-  static std::vector<double> compose_gathered(const std::vector<FieldId>& fields,
-                                              const std::vector<float>& raw, std::size_t n);
+  std::vector<double> compose_gathered(const std::vector<FieldId>& fields,
+                                       const std::vector<float>& raw, std::size_t n) const;
   /// The number of parts `fields` are composed from (field_parts).
   static std::size_t part_count(const std::vector<FieldId>& fields);
   /// The statistics of the current state with one wait, the pending tallies read and

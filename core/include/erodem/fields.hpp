@@ -47,7 +47,9 @@ enum FieldFlag : unsigned {
   X(momentum_x, "m2 s-1", "depth-integrated eastward discharge per unit width",                    \
     kStateField | kOutputField | kRestartZero | kTwinField)                                        \
   X(momentum_y, "m2 s-1", "depth-integrated northward discharge per unit width",                   \
-    kStateField | kOutputField | kRestartZero | kTwinField)
+    kStateField | kOutputField | kRestartZero | kTwinField)                                        \
+  /* derived: the bed shear stress of the depth, velocities and Manning n (erosion.h) */           \
+  X(shear_stress, "Pa", "bed shear stress", kOutputField | kDerivedField)
 
 enum class FieldId {
 #define ERODEM_FIELD_ID(id, units, long_name, flags) id,

@@ -85,6 +85,7 @@ struct Params {
     double pipe_area = 1.0;              ///< pipes: cross-section A (m^2)
     double pipe_length = 0.0;            ///< pipes: length l (m); 0 = the cell size
     double gravity = 9.81;               ///< g (m/s^2)
+    double water_density = 1000.0;       ///< rho (kg/m^3): the bed shear stress
     int order = 1;  ///< shallow_water: 1 (first-order Godunov) or 2 (MUSCL-minmod + Heun)
   } flow;
 

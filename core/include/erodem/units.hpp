@@ -23,6 +23,7 @@ enum class Dimension {
   acceleration,   ///< m/s^2
   discharge,      ///< m^3/s, l/s
   manning,        ///< Manning n (s m^-1/3); numbers only
+  density,        ///< kg/m^3, g/cm^3
 };
 
 /// A configuration error from `source` (a file name or "--set") about parameter `key`:
