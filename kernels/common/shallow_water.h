@@ -285,6 +285,31 @@ ERODEM_FN_INLINED ERODEM_S(SwCell)
   return out;
 }
 
+/* Stores a stage's results for padded cell i: as they are (combine 0), or averaged with what
+ * the arrays hold (combine 1: the first stage's outflows, the unit discharges at the start of the
+ * step), Heun's second stage. */
+ERODEM_FN void shallow_water_stage_store(int i, int combine, ERODEM_S(SwCell) r,
+                                         GLOBAL real* out_left, GLOBAL real* out_right,
+                                         GLOBAL real* out_top, GLOBAL real* out_bottom,
+                                         GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
+  const real h = (real)0.5;
+  out_left[i] = combine ? h * (out_left[i] + r.left) : r.left;
+  out_right[i] = combine ? h * (out_right[i] + r.right) : r.right;
+  out_top[i] = combine ? h * (out_top[i] + r.top) : r.top;
+  out_bottom[i] = combine ? h * (out_bottom[i] + r.bottom) : r.bottom;
+  q_x_new[i] = combine ? h * (q_x_new[i] + r.q_x) : r.q_x;
+  q_y_new[i] = combine ? h * (q_y_new[i] + r.q_y) : r.q_y;
+}
+
+/* The rows of the faces north and south of padded row y (the faces between rows y_n and
+ * y_n + 1, y_s and y_s + 1), for their widths: beyond the raster the nearest face's. */
+ERODEM_INLINE int sw_north_face_row(int y) {
+  return y >= 1 ? y - 1 : y;
+}
+ERODEM_INLINE int sw_south_face_row(int y, int H) {
+  return y + 1 < H ? y : (y >= 1 ? y - 1 : y);
+}
+
 /* The shallow-water step of padded cell i of row y (shallow_water_cell_update), its neighbours'
  * kinds k_* and indices i_* (west, east, north, south) and the rows y_n, y_s of its north and
  * south faces (the faces between rows y_n and y_n + 1, y_s and y_s + 1), from the state at the
@@ -293,7 +318,8 @@ ERODEM_FN_INLINED ERODEM_S(SwCell)
  * p.dry_depth (m: velocities are desingularised below it). Writes the cell's outflows (m^3/s)
  * and unit discharges into the second buffers. Each cell computes the four faces around it
  * (every face twice over the grid, by the same function with the same arguments, so both sides
- * see the same bits; the CPU loop computes each once, with those arguments). */
+ * see the same bits; the CPU loop computes each once, with those arguments). Written through
+ * shallow_water_stage_store, as a first stage. */
 ERODEM_FN_INLINED void shallow_water_cell_at(
     int i, int y, int k_w, int k_e, int k_n, int k_s, int i_w, int i_e, int i_n, int i_s, int y_n,
     int y_s, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed, GLOBAL const real* depth,
@@ -325,12 +351,7 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
   const ERODEM_S(SwCell) c =
       shallow_water_cell_update(k, h, q_x[i], q_y[i], manning[i], dy[y], face_y_width(dx, y_n),
                                 face_y_width(dx, y_s), area[y], dt, p, e, w, s, nf);
-  out_left[i] = c.left;
-  out_right[i] = c.right;
-  out_top[i] = c.top;
-  out_bottom[i] = c.bottom;
-  q_x_new[i] = c.q_x;
-  q_y_new[i] = c.q_y;
+  shallow_water_stage_store(i, 0, c, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* ---- second order (flow.order = 2): MUSCL reconstruction and Heun's method ---------------- */
@@ -412,22 +433,6 @@ ERODEM_FN void shallow_water_stage_depth_cell(int x, int y, int W, int H,
   const real outflow = f_left[i] + f_right[i] + f_top[i] + f_bottom[i];
   const real h1 = depth_after_fluxes(depth[i], inflow, outflow, dt, area[y]);
   depth_stage[i] = active ? (h1 > (real)0 ? h1 : (real)0) : depth[i];
-}
-
-/* Stores a stage's results for padded cell i: as they are (combine 0), or averaged with what
- * the arrays hold (combine 1: the first stage's outflows, the unit discharges at the start of the
- * step), Heun's second stage. */
-ERODEM_FN void shallow_water_stage_store(int i, int combine, ERODEM_S(SwCell) r,
-                                         GLOBAL real* out_left, GLOBAL real* out_right,
-                                         GLOBAL real* out_top, GLOBAL real* out_bottom,
-                                         GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
-  const real h = (real)0.5;
-  out_left[i] = combine ? h * (out_left[i] + r.left) : r.left;
-  out_right[i] = combine ? h * (out_right[i] + r.right) : r.right;
-  out_top[i] = combine ? h * (out_top[i] + r.top) : r.top;
-  out_bottom[i] = combine ? h * (out_bottom[i] + r.bottom) : r.bottom;
-  q_x_new[i] = combine ? h * (q_x_new[i] + r.q_x) : r.q_x;
-  q_y_new[i] = combine ? h * (q_y_new[i] + r.q_y) : r.q_y;
 }
 
 /* One cell's state for the second-order faces: kind, depth (m), bed (m), velocities east and
@@ -518,7 +523,7 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell(
   const ERODEM_S(SwFace) fw = sw_face_x2(w1, sw_slopes_x(w2, w1, c, eps), c, sx_c, g, eps);
   const ERODEM_S(SwFace) fs = sw_face_y2(c, sy_c, s1, sw_slopes_y(c, s1, s2, eps), g, eps);
   const ERODEM_S(SwFace) fn = sw_face_y2(n1, sw_slopes_y(n2, n1, c, eps), c, sy_c, g, eps);
-  const int y_n = y >= 1 ? y - 1 : y, y_s = y + 1 < H ? y : (y >= 1 ? y - 1 : y);
+  const int y_n = sw_north_face_row(y), y_s = sw_south_face_row(y, H);
   const ERODEM_S(SwCell) r =
       shallow_water_cell_update(c.k, c.h, q_x[i], q_y[i], manning[i], dy[y], face_y_width(dx, y_n),
                                 face_y_width(dx, y_s), area[y], dt, p, fe, fw, fs, fn);
@@ -538,29 +543,12 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
                                   GLOBAL real* out_bottom, GLOBAL real* q_x_new,
                                   GLOBAL real* q_y_new) {
   const int i = x + y * W;
-  shallow_water_cell_at(
-      i, y, kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
-      kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H), x >= 1 ? i - 1 : i,
-      x + 1 < W ? i + 1 : i, y >= 1 ? i - W : i, y + 1 < H ? i + W : i, y >= 1 ? y - 1 : y,
-      y + 1 < H ? y : (y >= 1 ? y - 1 : y), kind, bed, depth, q_x, q_y, manning, dx, dy, area, dt,
-      p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
-}
-
-/* The same for a cell with four neighbours inside the raster (1 <= x <= W - 2, 1 <= y <= H - 2):
- * no clamping, so a loop over x vectorises. */
-ERODEM_FN void shallow_water_cell_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                                           GLOBAL const real* bed, GLOBAL const real* depth,
-                                           GLOBAL const real* q_x, GLOBAL const real* q_y,
-                                           GLOBAL const real* manning, GLOBAL const real* dx,
-                                           GLOBAL const real* dy, GLOBAL const real* area, real dt,
-                                           ERODEM_P(FlowParams) p, GLOBAL real* out_left,
-                                           GLOBAL real* out_right, GLOBAL real* out_top,
-                                           GLOBAL real* out_bottom, GLOBAL real* q_x_new,
-                                           GLOBAL real* q_y_new) {
-  const int i = x + y * W;
-  shallow_water_cell_at(i, y, kind[i - 1], kind[i + 1], kind[i - W], kind[i + W], i - 1, i + 1,
-                        i - W, i + W, y - 1, y, kind, bed, depth, q_x, q_y, manning, dx, dy, area,
-                        dt, p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
+  shallow_water_cell_at(i, y, kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
+                        kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H),
+                        x >= 1 ? i - 1 : i, x + 1 < W ? i + 1 : i, y >= 1 ? i - W : i,
+                        y + 1 < H ? i + W : i, sw_north_face_row(y), sw_south_face_row(y, H), kind,
+                        bed, depth, q_x, q_y, manning, dx, dy, area, dt, p, out_left, out_right,
+                        out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* The velocity of padded cell (x, y) from its unit discharges and its depth after the water

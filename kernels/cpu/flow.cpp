@@ -299,7 +299,8 @@ void sw_faces_x(int W, const SwRow<Real>& r, Real g, Real eps, const SwFaceRef<R
 
 /// What a stage of the shallow-water step reads and writes (cell::shallow_water_muscl_cell's
 /// arguments): the stage's depth and unit discharges, the outflows and unit discharges it
-/// writes, and whether it averages them with what those arrays hold (Heun's second stage).
+/// writes (whether it averages them with what those arrays hold, Heun's second stage, is
+/// shallow_water_rows' Combine).
 template <class Real>
 struct SwStage {
   int W, H;
@@ -307,7 +308,6 @@ struct SwStage {
   const Real *bed, *depth, *q_x, *q_y, *manning, *dx, *dy, *area;
   Real dt;
   cell_params::FlowParams<Real> params;
-  int combine;
   Real *out_left, *out_right, *out_top, *out_bottom, *q_x_new, *q_y_new;
 };
 
@@ -316,7 +316,9 @@ struct SwStage {
 /// of row y, then row y's cells from their four faces (cell::shallow_water_cell_update), each
 /// face computed once (the faces between two blocks twice) with the arguments the OpenCL cell
 /// gives it (cell::shallow_water_cell, shallow_water_muscl_cell), so the two agree bit for bit.
-template <bool Muscl, class Real>
+/// Combine: the second stage of Heun's method (cell::shallow_water_stage_store), a constant so
+/// the other stages do not read the arrays they write.
+template <bool Muscl, bool Combine, class Real>
 void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
   const int W = st.W, H = st.H;
   const Real g = st.params.gravity, eps = st.params.dry_depth;
@@ -417,17 +419,16 @@ void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
     // face lengths: x-faces the row's dy; y-faces the mean dx of their two rows (the rows
     // beyond the raster: the nearest face's, as shallow_water_cell clamps)
     const Real l_x = st.dy[y];
-    const Real l_n = cell::face_y_width(st.dx, y >= 1 ? y - 1 : y);
-    const Real l_s = cell::face_y_width(st.dx, y + 1 < H ? y : (y >= 1 ? y - 1 : y));
+    const Real l_n = cell::face_y_width(st.dx, cell::sw_north_face_row(y));
+    const Real l_s = cell::face_y_width(st.dx, cell::sw_south_face_row(y, H));
     const Real a = st.area[y], step = st.dt;
     const cell_params::FlowParams<Real> fp = st.params;
-    const int combine = st.combine;
     ERODEM_IVDEP
     for (int x = 0; x < W; ++x) {
       const cell::SwCell<Real> c = cell::shallow_water_cell_update(
           k[x], h[x], qxr[x], qyr[x], n[x], l_x, l_n, l_s, a, step, fp, face_x.load(x + 1),
           face_x.load(x), south.load(x), north.load(x));
-      cell::shallow_water_stage_store(x, combine, c, o_l, o_r, o_t, o_b, qx_out, qy_out);
+      cell::shallow_water_stage_store(x, Combine, c, o_l, o_r, o_t, o_b, qx_out, qy_out);
     }
   }
 }
@@ -455,11 +456,10 @@ void CpuBackend<Real>::run_flow(Real dt) {
     Field &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Field &qx_next = *fields_.twin(FieldId::momentum_x),
           &qy_next = *fields_.twin(FieldId::momentum_y);
-    SwStage<Real> st{
-        W, H, kind, b,   d,  qx.data(), qy.data(),      manning_.data(), dx, dy, area, dt,
-        f, 0, ol,   orr, ot, ob,        qx_next.data(), qy_next.data()};
+    SwStage<Real> st{W,  H, kind, b,   d,  qx.data(), qy.data(),      manning_.data(), dx, dy, area,
+                     dt, f, ol,   orr, ot, ob,        qx_next.data(), qy_next.data()};
     if (params_.flow.order == 2) {
-      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true>(st, y0, y1); });
+      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true, false>(st, y0, y1); });
       stage_depth_.resize(depth_.size());
       Real* h1 = stage_depth_.data();
       for_rows(0, H, [=](int y) {
@@ -470,12 +470,11 @@ void CpuBackend<Real>::run_flow(Real dt) {
       st2.depth = h1;
       st2.q_x = qx_next.data();
       st2.q_y = qy_next.data();
-      st2.combine = 1;
       st2.q_x_new = qx.data();
       st2.q_y_new = qy.data();
-      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true>(st2, y0, y1); });
+      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true, true>(st2, y0, y1); });
     } else {
-      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<false>(st, y0, y1); });
+      for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<false, false>(st, y0, y1); });
       std::swap(qx, qx_next);
       std::swap(qy, qy_next);
     }

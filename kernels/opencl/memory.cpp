@@ -95,10 +95,10 @@ std::vector<const Buffer*> OpenClBackend::field_parts(FieldId id) {
   return {field_buffer(id)};
 }
 
-std::size_t OpenClBackend::part_count(const std::vector<FieldId>& fields) {
+std::size_t OpenClBackend::part_count(const std::vector<FieldId>& fields) const {
+  auto* self = const_cast<OpenClBackend*>(this);
   std::size_t n = 0;
-  for (const FieldId id : fields)
-    n += id == FieldId::bed ? 2 : id == FieldId::erosion ? 3 : id == FieldId::shear_stress ? 4 : 1;
+  for (const FieldId id : fields) n += self->field_parts(id).size();
   return n;
 }
 

@@ -212,7 +212,7 @@ class OpenClBackend final : public Backend {
   std::vector<double> compose_gathered(const std::vector<FieldId>& fields,
                                        const std::vector<float>& raw, std::size_t n) const;
   /// The number of parts `fields` are composed from (field_parts).
-  static std::size_t part_count(const std::vector<FieldId>& fields);
+  std::size_t part_count(const std::vector<FieldId>& fields) const;
   /// The statistics of the current state with one wait, the pending tallies read and
   /// delivered with them (and, with `probes`, the probe samples into it).
   FieldStats collect(std::vector<double>* probes);
