@@ -384,6 +384,28 @@ TEST(Validate, CrossFieldChecks) {
   EXPECT_NO_THROW(erodem::validate(p));
   p.output.fields.push_back("bed");
   EXPECT_THROW(erodem::validate(p), Error);
+  // flow.order: 1 or 2, and 2 only with the shallow-water scheme
+  p = valid_params();
+  p.flow.order = 3;
+  msg = config_error_message([&] { erodem::validate(p, "x.toml"); });
+  EXPECT_EQ(msg.rfind("x.toml: 'flow.order': expected an integer in [1, 2]", 0), 0u) << msg;
+  p.flow.order = 2;
+  msg = config_error_message([&] { erodem::validate(p, "x.toml"); });
+  EXPECT_NE(msg.find("'flow.order': order 2 is the shallow_water scheme's"), std::string::npos)
+      << msg;
+  p.flow.scheme = erodem::FlowScheme::shallow_water;
+  EXPECT_NO_THROW(erodem::validate(p));
+}
+
+TEST(Units, DensityUnits) {
+  // flow.water_density (the bed shear stress): kg/m^3 or g/cm^3, and no other dimension
+  expect_quantity("1000 kg/m^3", Dimension::density, 1000.0);
+  expect_quantity("1.025 g/cm^3", Dimension::density, 1025.0);
+  const std::string msg =
+      config_error_message([] { from_text("[flow]\nwater_density = \"1 m\"\n"); });
+  EXPECT_NE(msg.find("'flow.water_density'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("kg/m^3, g/cm^3"), std::string::npos) << msg;
+  EXPECT_EQ(from_text("[flow]\nwater_density = \"1 g/cm^3\"\n").flow.water_density, 1000.0);
 }
 
 // ---- dump -------------------------------------------------------------------------------
