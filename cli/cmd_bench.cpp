@@ -56,6 +56,7 @@ Params bench_params(const BenchOptions& o) {
   p.initial.water_depth.value = 0.2;
   p.rain.rate = 20e-3 / 3600;
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   p.thermal.enabled = true;
   p.evaporation.rate = 1e-7;
   for (const auto& kv : o.sets) apply_setting(p, kv);  // each value checked as in a config

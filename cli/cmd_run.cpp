@@ -171,6 +171,21 @@ int run(const RunOptions& o) {
   std::printf("backend %s, device %s\n", sim.backend().name().c_str(),
               sim.backend().device().c_str());
   std::printf("%s", sim.ledger().format().c_str());
+  if (p.erosion.enabled && p.erosion.law == ErosionLaw::physical) {
+    // the solid volumes as masses, and the yield over the active area (docs/model.md 4.2)
+    const Terrain& t = sim.terrain();
+    double area = 0;
+    for (std::size_t i = 0; i < t.bed.size(); ++i)
+      if (t.active(i)) area += t.grid.area[i / static_cast<std::size_t>(t.grid.nx)];
+    const Ledger& L = sim.ledger();
+    const double tonnes = p.erosion.sediment_density / 1000.0;
+    std::printf(
+        "sediment (solid, rho_s %.0f kg/m^3): eroded %.4g t (%.4g t from bedrock), deposited "
+        "%.4g t, out %.4g t = %.4g t/km^2 over %.4g km^2\n",
+        p.erosion.sediment_density, L.eroded * tonnes, L.eroded_bedrock * tonnes,
+        L.deposited * tonnes, L.sediment_out * tonnes, L.sediment_out * tonnes / (area * 1e-6),
+        area * 1e-6);
+  }
   std::printf("ran %ld steps to t = %.6g s in %.3f s wall (%.3g cell-steps/s)\n", sim.steps_done(),
               sim.time(), wall, cells * sim.steps_done() / wall);
   std::printf("wrote %s (%zu snapshots of %zu fields, diagnostics of %ld steps) and %s\n",

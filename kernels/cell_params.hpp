@@ -28,10 +28,59 @@ struct CellParams {
   cell_params::FlowParams<real> flow;
   cell_params::WaterParams<real> water;
   cell_params::ErosionParams<real> erosion;
+  cell_params::SedimentParams<real> sediment;  ///< erosion.law = "physical"
   cell_params::ThermalParams<real> thermal;
   cell_params::EvaporationParams<real> evaporation;
   cell_params::SnowParams<real> snow;
 };
+
+/// The physical erosion law's constants (erosion.h SedimentParams), derived in double from
+/// erosion.*, flow.gravity, flow.water_density and numerics.velocity_min_depth: the settling
+/// velocity (Ferguson & Church 2004) and critical Shields number (Soulsby & Whitehouse 1997)
+/// unless given, the grain roughness n' = (2.5 D)^(1/6) / (8.1 sqrt g), Engelund-Hansen's
+/// 0.05 sqrt(R g D^3) and Garcia-Parker's Re_p^0.6 / w_s, and each layer's 1 / (1 - phi).
+template <class real>
+cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
+  const auto r = [](double v) { return static_cast<real>(v); };
+  const auto& e = params.erosion;
+  const double g = params.flow.gravity, rho = params.flow.water_density;
+  const double big_r = e.sediment_density / rho - 1.0, d = e.grain_size;
+  const double nu = e.kinematic_viscosity;
+  const double w_s = e.settling_velocity ? *e.settling_velocity
+                                         : cell::ferguson_church_settling<double>(d, big_r, g, nu,
+                                                                                  e.settling_shape);
+  const double theta_c = e.critical_shields
+                             ? *e.critical_shields
+                             : cell::soulsby_whitehouse_shields<double>(d, big_r, g, nu);
+  const double skin_n = std::pow(2.5 * d, 1.0 / 6.0) / (8.1 * std::sqrt(g));
+  const double re_p = std::sqrt(big_r * g * d) * d / nu;
+  cell_params::SedimentParams<real> s{};
+  s.rho_g = r(rho * g);
+  s.gravity = r(g);
+  s.min_depth = r(params.numerics.velocity_min_depth);
+  s.shields_scale = r((e.sediment_density - rho) * g * d);
+  s.skin_n2 = r(skin_n * skin_n);
+  s.settling = r(w_s);
+  s.shields_flat = r(theta_c);
+  s.shields_slope = r(e.slope_threshold ? 0.15 : 0.0);
+  s.total_load = r(0.05 * std::sqrt(big_r * g * d * d * d));
+  s.pickup_z = r(std::pow(re_p, 0.6) / w_s);
+  s.inv_rho = r(1.0 / rho);
+  s.max_concentration = r(e.max_concentration);
+  s.pickup = e.pickup == Pickup::garcia_parker ? 1 : 0;
+  const auto layer = [&](const BedLayer& l, int& cohesive, real& bulk, real& rate, real& inv_e,
+                         real& inv_d) {
+    cohesive = l.closure == SedimentClosure::cohesive ? 1 : 0;
+    bulk = r(1.0 / (1.0 - l.porosity));
+    rate = r(cohesive ? l.erosion_rate / e.sediment_density : l.erodibility);
+    inv_e = r(1.0 / l.critical_shear);
+    inv_d = r(l.deposition_shear ? 1.0 / *l.deposition_shear : 0.0);
+  };
+  layer(e.soil, s.soil_cohesive, s.soil_bulk, s.soil_rate, s.soil_inv_tau_e, s.soil_inv_tau_d);
+  layer(e.bedrock, s.rock_cohesive, s.rock_bulk, s.rock_rate, s.rock_inv_tau_e, s.rock_inv_tau_d);
+  s.morfac = r(e.morfac);
+  return s;
+}
 
 /// The run constants from the parameters (units in the structs' headers): sea_level;
 /// gravity, theta, dry_depth, pipe_area, pipe_length; velocity_min_depth; the erosion rates,
@@ -60,6 +109,8 @@ CellParams<real> cell_params_of(const Params& params) {
   c.erosion.min_depth = r(e.min_depth);
   c.erosion.bedrock =
       e.bedrock_level ? r(*e.bedrock_level) : -std::numeric_limits<real>::infinity();
+
+  c.sediment = sediment_params_of<real>(params);
 
   const double pi = 3.14159265358979323846;
   c.thermal.rate = r(params.thermal.rate);
@@ -121,6 +172,7 @@ static_assert(sizeof(cell_params::BoundaryParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
+static_assert(sizeof(cell_params::SedimentParams<float>) == 21 * sizeof(float) + 3 * sizeof(int));
 static_assert(sizeof(cell_params::ThermalParams<float>) == 2 * sizeof(float));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::SnowParams<float>) == 5 * sizeof(float));

@@ -47,6 +47,7 @@ manning_n = 0.035
 [rain]
 rate = 2e-4
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.5
 [transport]
@@ -89,6 +90,7 @@ manning_n = 0.035
 [rain]
 series = [[0, "80 mm/h"], [200, "20 mm/h"]]
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.2
 dissolving_rate = 0.01
@@ -126,6 +128,7 @@ rate = "30 mm/h"
 point = [60.0, 140.0]
 hydrograph = [[0, 0.0], [5, 2.0], [15, 0.5]]
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.5
 dissolving_rate = 0.05

@@ -56,6 +56,7 @@ inline Params tujunga_storm(FlowScheme flow, TransportScheme transport, bool ada
   p.time.dt_max = dt;
   p.rain.rate = 2e-4;  // m/s (720 mm/h)
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   p.erosion.sediment_capacity = 0.5;
   p.transport.scheme = transport;
   p.thermal.enabled = true;
@@ -234,6 +235,7 @@ struct SedimentAdaptation {
   Params params(TransportScheme scheme, double dx) const {
     Params p = quiet_params(FlowScheme::local_inertial, courant * dx / speed);
     p.erosion.enabled = true;
+    p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
     p.erosion.sediment_capacity = capacity_k;
     p.erosion.dissolving_rate = dissolving_rate;
     p.transport.scheme = scheme;

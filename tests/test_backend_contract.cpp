@@ -43,6 +43,7 @@ Params valley_storm(const Target& target, FlowScheme flow, TransportScheme trans
   p.rain.rate = 80e-3 / 3600;  // m/s
   p.inflow.push_back({{{155.0, 255.0}}, {{0.0, 0.5}, {60.0, 2.0}}});
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   p.erosion.sediment_capacity = 0.2;
   p.erosion.dissolving_rate = 0.01;
   p.erosion.deposition_rate = 0.05;

@@ -86,6 +86,7 @@ struct SedimentChannel {
     // leaves over a sea that pushes back on it
     p.boundary.sea_level = bed_at_east() + 0.5 * normal_depth();
     p.erosion.enabled = true;
+    p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
     p.erosion.sediment_capacity = 0.2;
     p.erosion.dissolving_rate = 0.5;
     p.transport.scheme = scheme;
@@ -256,6 +257,7 @@ TEST_P(BoundarySediment, ClearSeaWaterFloodingInKeepsMaterial) {
     p.boundary.west = BoundaryKind::fixed_level;
     p.boundary.sea_level = 0.0;
     p.erosion.enabled = true;
+    p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
     p.erosion.sediment_capacity = 0.2;
     p.erosion.dissolving_rate = 0.5;
     p.transport.scheme = scheme;
@@ -415,6 +417,7 @@ Simulation hardness_channel(const Target& target, const TempDir& dir, bool raste
   p.dem.path = dem;
   if (raster) p.erosion.hardness.path = hardness;
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   p.erosion.sediment_capacity = 0.2;
   p.erosion.dissolving_rate = 0.05;
   p.boundary.east = BoundaryKind::open;

@@ -51,6 +51,7 @@ dt = 0.5
 [rain]
 rate = "100 mm/h"
 [erosion]
+law = "mei"
 enabled = true
 [boundary]
 east = "open"

@@ -78,6 +78,7 @@ TEST_P(Physics, ClosedBoxConservesWaterAndMaterial) {
     SCOPED_TRACE(name);
     Params p = sloshing_params(scheme);
     p.erosion.enabled = true;
+    p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
     p.erosion.sediment_capacity = 0.5;
     p.transport.scheme = TransportScheme::conservative;
     p.thermal.enabled = true;
@@ -118,6 +119,7 @@ TEST_P(Physics, SemiLagrangianLossIsMeasured) {
   // conservative, and the ledger's transport_change books what it removed from suspension.
   Params p = sloshing_params(FlowScheme::local_inertial);
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   // 2.0 (was 0.5 until the cell velocity was taken over the faces' flow depths, issue 14,
   // which slowed the shore cells and left 7.6e-4 of the material eroded, below the bound that
   // keeps the scenario meaningful)
@@ -169,6 +171,7 @@ Simulation floor_channel(const Target& target, std::optional<double> bedrock) {
       t.bed[static_cast<std::size_t>(r) * n + c] = 0.3 * std::exp(-std::pow((c + 0.5 - 20) / 6, 2));
   Params p = quiet_params(FlowScheme::local_inertial, 0.4);
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   p.erosion.sediment_capacity = 10.0;
   p.erosion.dissolving_rate = 0.05;
   p.erosion.bedrock_level = bedrock;

@@ -47,6 +47,7 @@ Params storm_params() {
   p.time.adaptive = true;
   p.time.duration = 3600.0;
   p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;  // the capacity law these figures were recorded with
   p.thermal.enabled = true;
   p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
   return p;

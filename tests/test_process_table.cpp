@@ -104,10 +104,12 @@ TEST(ProcessTable, CheckRejectsAReadOfAFieldNothingProvides) {
 // the model written by hand in cmd_bench.cpp (2026-11-23; full local-inertial step 213 B/cell),
 // the code had changed under that model: the water update reads the bed since the velocities
 // are taken over the faces' flow depths (+4), erosion and slope collapse read and write the
-// bed residual since the bed pair (+8, +8), and so do the statistics (+4): 237 B/cell.
+// bed residual since the bed pair (+8, +8), and so do the statistics (+4): 237 B/cell with Mei's
+// erosion law; the physical law reads Manning n and updates the soil (+12).
 TEST(ProcessTable, ByteModelFromTheSweeps) {
   Params p;
   p.erosion.enabled = p.thermal.enabled = true;
+  p.erosion.law = ErosionLaw::mei;
   p.rain.rate = 1e-6;
   p.evaporation.rate = 1e-7;
   auto bytes = [&](Process pr) { return process_bytes(pr, p, 4).total(); };
@@ -125,6 +127,9 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
   EXPECT_EQ(full, 237);
   std::printf(
       "[process table] full local-inertial step %d B/cell (hand model of 2026-11-23: 213)\n", full);
+  // kind bed bed_residual sediment soil depth u v manning hardness | bed residual sediment soil
+  p.erosion.law = ErosionLaw::physical;
+  EXPECT_EQ(bytes(Process::erosion), 41 + 12);
   p.flow.scheme = FlowScheme::pipes;
   p.transport.scheme = TransportScheme::semi_lagrangian;
   EXPECT_EQ(bytes(Process::flow), 41);
@@ -159,24 +164,25 @@ TEST(ProcessTable, BedChangesWithErosionOrThermal) {
 TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
   // state_fields() and output.fields' choices as written by hand before the table
   // (simulation.cpp and schema.cpp of 2026-11-25) with the snow pack and the shallow-water
-  // scheme's unit discharges added, and the bed shear stress as an output, as sets: the order
-  // is the table's now.
+  // scheme's unit discharges added, the bed shear stress as an output and the soil of the
+  // physical erosion law, as sets: the order is the table's now.
   std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
   for (FieldId id : state_fields()) state.insert(field_info(id).name);
   EXPECT_EQ(state, (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment",
                                           "velocity_x", "velocity_y", "flux_left", "flux_right",
                                           "flux_top", "flux_bottom", "wetness", "bed_residual",
-                                          "snow", "momentum_x", "momentum_y"}));
-  EXPECT_EQ(output, (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x",
-                                           "velocity_y", "erosion", "wetness", "hardness",
-                                           "flux_left", "flux_right", "flux_top", "flux_bottom",
-                                           "snow", "momentum_x", "momentum_y", "shear_stress"}));
+                                          "snow", "momentum_x", "momentum_y", "soil_thickness"}));
+  EXPECT_EQ(output, (std::set<std::string>{
+                        "bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion",
+                        "wetness", "hardness", "flux_left", "flux_right", "flux_top", "flux_bottom",
+                        "snow", "momentum_x", "momentum_y", "shear_stress", "soil_thickness"}));
   // a field restored from files that lack it starts at 0: the bed residual and the snow pack,
   // added later
   for (const auto& f : field_table())
     EXPECT_EQ(f.restart_zero_if_absent, f.id == FieldId::bed_residual || f.id == FieldId::snow ||
                                             f.id == FieldId::momentum_x ||
-                                            f.id == FieldId::momentum_y)
+                                            f.id == FieldId::momentum_y ||
+                                            f.id == FieldId::soil_thickness)
         << f.name;
 }
 
@@ -198,6 +204,7 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "flow_local_inertial_split_interior",
                                    "water_update",
                                    "erosion",
+                                   "erosion_physical",
                                    "transport_conservative",
                                    "transport_semi_lagrangian",
                                    "thermal_share",
@@ -210,7 +217,7 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 22u) << "a kernel listed twice";
+  EXPECT_EQ(k.size(), 23u) << "a kernel listed twice";
   EXPECT_EQ(opencl_program_order(),
             (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl",
                                       "water.cl", "erosion.cl", "transport.cl", "thermal.cl",

@@ -43,6 +43,7 @@ manning_n = 0.035
 [rain]
 series = [[0, "80 mm/h"], [200, "20 mm/h"]]
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.2
 dissolving_rate = 0.01
@@ -104,6 +105,7 @@ rate = "30 mm/h"
 point = [60.0, 140.0]
 hydrograph = [[0, 0.0], [5, 2.0], [15, 0.5]]
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.5
 dissolving_rate = 0.05

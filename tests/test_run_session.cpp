@@ -50,6 +50,7 @@ dt_max = "2 s"
 [rain]
 rate = "60 mm/h"
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.2
 [thermal]

@@ -38,7 +38,7 @@ std::string Ledger::format() const {
                                            "clipped",       "water_exchanged", "material_initial",
                                            "material",      "sediment_out",    "transport_change",
                                            "eroded",        "deposited",       "sediment_exchanged",
-                                           "thermal_moved"};
+                                           "thermal_moved", "eroded_bedrock",  "bed_bulking"};
   for (const auto& e : ledger_entries())
     if (!named.count(e.name))
       s += fmt::format("           {:<24} {:>14.9e}\n", e.name, this->*e.member);
@@ -50,6 +50,9 @@ std::string Ledger::format() const {
   s += fmt::format("           eroded  {:>18.9e}   deposited {:>12.9e}\n", eroded, deposited);
   s += fmt::format("           exchanged: sediment {:>14.9e}   thermal {:>14.9e}\n",
                    sediment_exchanged, thermal_moved);
+  if (eroded_bedrock != 0 || bed_bulking != 0)  // the physical erosion law (solid volumes)
+    s += fmt::format("           from bedrock {:>13.9e}   bed bulking {:>15.9e}\n", eroded_bedrock,
+                     bed_bulking);
   s += fmt::format("           closure {:>18.9e}   relative {:>13.3e} of {:.9e} moved\n",
                    material_closure_error(), relative_material_closure_error(), material_moved());
   return s;

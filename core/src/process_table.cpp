@@ -135,7 +135,23 @@ std::vector<SweepInfo> water_sweeps(const Params& p) {
   return s;
 }
 
-std::vector<SweepInfo> erosion_sweeps(const Params&) {
+std::vector<SweepInfo> erosion_sweeps(const Params& p) {
+  if (p.erosion.law == ErosionLaw::physical)
+    // sediment_cell (erosion.h): the bed shear stress and the bed's slope, the surface layer's
+    // closure, the exact exchange over the step, Exner with the layer's porosity
+    return {{"erosion_physical",
+             Domain::cells,
+             {{"kind", R},
+              {"bed", U},
+              {"bed_residual", U},
+              {"sediment", U},
+              {"soil_thickness", U},
+              {"water_depth", R},
+              {"velocity_x", R},
+              {"velocity_y", R},
+              {"manning_n", R},
+              {"hardness", R}},
+             {"erosion_physical"}}};
   // erosion_cell (erosion.h): capacity from the speed and the bed's tilt, the exact transfer
   // between the bed pair and the sediment
   return {{"erosion",
@@ -209,6 +225,22 @@ std::vector<std::pair<FieldId, std::vector<double>>> snow_initial(const Terrain&
   return {{FieldId::snow, std::move(snow)}};
 }
 
+/// The initial soil (physical law): erosion.soil_thickness (uniform or its raster), or bed -
+/// bedrock_level (at least 0) where a bedrock level is given, on the active cells.
+std::vector<std::pair<FieldId, std::vector<double>>> erosion_initial(const Terrain& t,
+                                                                     const Params& p) {
+  if (p.erosion.law != ErosionLaw::physical) return {};
+  std::vector<double> soil(t.bed.size(), 0.0);
+  for (std::size_t i = 0; i < soil.size(); ++i) {
+    if (!t.active(i)) continue;
+    if (p.erosion.bedrock_level)
+      soil[i] = std::max(t.bed[i] - *p.erosion.bedrock_level, 0.0);
+    else
+      soil[i] = t.soil_thickness.empty() ? p.erosion.soil_thickness.value : t.soil_thickness[i];
+  }
+  return {{FieldId::soil_thickness, std::move(soil)}};
+}
+
 }  // namespace
 
 const std::vector<ProcessInfo>& process_table() {
@@ -228,8 +260,9 @@ const std::vector<ProcessInfo>& process_table() {
        "erosion",
        erosion_on,
        erosion_sweeps,
-       {"eroded", "deposited"},
-       "erosion.cl"},
+       {"eroded", "deposited", "eroded_bedrock", "bed_bulking"},
+       "erosion.cl",
+       erosion_initial},
       // erosion.enabled switches transport too: what erosion lifts must move
       {Process::transport,
        "transport",
@@ -383,17 +416,20 @@ std::vector<std::string> opencl_cell_kernels() {
     for (const char* k : sweep.opencl_kernels)
       if (std::find(out.begin(), out.end(), k) == out.end()) out.emplace_back(k);
   };
-  // every process of the table (enabled or not), with each flow and transport scheme
+  // every process of the table (enabled or not), with each flow and transport scheme and
+  // erosion law
   Params p;
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
   for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial, FlowScheme::shallow_water})
-    for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian}) {
-      p.flow.scheme = flow;
-      p.transport.scheme = transport;
-      for (const auto& e : process_table())
-        for (const auto& sweep : e.sweeps(p)) add(sweep);
-    }
+    for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian})
+      for (auto law : {ErosionLaw::mei, ErosionLaw::physical}) {
+        p.flow.scheme = flow;
+        p.transport.scheme = transport;
+        p.erosion.law = law;
+        for (const auto& e : process_table())
+          for (const auto& sweep : e.sweeps(p)) add(sweep);
+      }
   add(stats_sweep());
   return out;
 }

@@ -31,11 +31,6 @@ bool is_section(const std::string& key) {
   return false;
 }
 
-std::string section_of(const std::string& key) {
-  const size_t dot = key.find('.');
-  return dot == std::string::npos ? std::string() : key.substr(0, dot);
-}
-
 std::string leaf_of(const std::string& key) {
   const size_t dot = key.rfind('.');
   return dot == std::string::npos ? key : key.substr(dot + 1);
@@ -159,6 +154,10 @@ void check_cross_fields(const Params& p, const std::string& source) {
     throw fail("rain.rate", "give rain.rate or rain.series, not both");
   }
   if (p.output.path.empty()) throw fail("output.path", "must not be empty");
+  if (p.erosion.bedrock_level && p.erosion.soil_thickness.is_raster())
+    throw fail("erosion.bedrock_level",
+               "give erosion.bedrock_level or a raster erosion.soil_thickness, not both (the "
+               "level sets the soil thickness to bed - bedrock_level)");
   if (p.flow.order == 2 && p.flow.scheme != FlowScheme::shallow_water)
     throw fail("flow.order",
                "order 2 is the shallow_water scheme's (flow.scheme = \"shallow_water\")");
@@ -215,7 +214,7 @@ std::string dump_toml(const Params& p) {
       inflow = &d;
       continue;
     }
-    const std::string s = section_of(d.key);
+    const std::string s = d.key.substr(0, d.key.rfind('.'));  // erosion.soil for its keys
     if (s != section) {
       out += "\n[" + s + "]\n";
       section = s;

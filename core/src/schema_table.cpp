@@ -14,11 +14,31 @@ namespace erodem::schema_detail {
     return p.member;              \
   }
 
+/// The keys of one bed layer, erosion.<layer>.* (Params::Erosion::soil, ::bedrock).
+#define ERODEM_BED_LAYER(layer, what)                                                           \
+  choice(ERODEM_FIELD(erosion.layer.closure), closures,                                         \
+         "physical: closure of " what                                                           \
+         ": non_cohesive (sand, gravel) or cohesive (silt, clay, "                              \
+         "soil, rock)"),                                                                        \
+      number(ERODEM_FIELD(erosion.layer.porosity), D::dimensionless, right_open(0, 1),          \
+             "physical: porosity phi of " what " (1)"),                                         \
+      number(ERODEM_FIELD(erosion.layer.erodibility), D::dimensionless, at_least(0),            \
+             "physical, non_cohesive: multiplier of the pick-up of " what " (1)"),              \
+      number(ERODEM_FIELD(erosion.layer.erosion_rate), D::mass_flux, at_least(0),               \
+             "physical, cohesive: Partheniades' erosion rate M of " what " (kg/m^2/s)"),        \
+      number(ERODEM_FIELD(erosion.layer.critical_shear), D::stress, above(0),                   \
+             "physical, cohesive: critical shear stress for erosion tau_c,e of " what " (Pa)"), \
+      optional_number(ERODEM_FIELD(erosion.layer.deposition_shear), D::stress, above(0),        \
+                      "physical, cohesive: Krone's critical shear stress for deposition "       \
+                      "tau_c,d over " what " (Pa); not set = deposition w_s c at any stress")
+
 const std::vector<Descriptor>& descriptor_table() {
   using D = Dimension;
   static const Choices<BoundaryKind> boundary{{"closed", BoundaryKind::closed},
                                               {"open", BoundaryKind::open},
                                               {"fixed_level", BoundaryKind::fixed_level}};
+  static const Choices<SedimentClosure> closures{{"non_cohesive", SedimentClosure::non_cohesive},
+                                                 {"cohesive", SedimentClosure::cohesive}};
   static const std::vector<Descriptor> table{
       text(ERODEM_FIELD(dem.path), "DEM file (GDAL raster); relative to the config file"),
       choice(ERODEM_FIELD(dem.synthetic),
@@ -99,20 +119,58 @@ const std::vector<Descriptor>& descriptor_table() {
                         "point or line inflows with a hydrograph [[time (s), discharge (m^3/s)]]"),
 
       boolean(ERODEM_FIELD(erosion.enabled), "hydraulic erosion and deposition"),
+      choice(ERODEM_FIELD(erosion.law),
+             Choices<ErosionLaw>{{"physical", ErosionLaw::physical}, {"mei", ErosionLaw::mei}},
+             "erosion law: physical (shear-stress closures in physical units, a layered bed) or "
+             "mei (Mei et al. 2007's transport capacity, a comparison and terrain-generation "
+             "law)"),
+      number(ERODEM_FIELD(erosion.grain_size), D::length, above(0),
+             "physical: grain (sieve) diameter D of the sediment (m)"),
+      number(ERODEM_FIELD(erosion.sediment_density), D::density, above(0),
+             "physical: grain density rho_s (kg/m^3)"),
+      number(ERODEM_FIELD(erosion.kinematic_viscosity), D::viscosity, above(0),
+             "physical: kinematic viscosity of the water nu (m^2/s)"),
+      optional_number(ERODEM_FIELD(erosion.settling_velocity), D::speed, above(0),
+                      "physical: settling velocity w_s (m/s); not set = Ferguson & Church "
+                      "(2004) from the grain size"),
+      number(ERODEM_FIELD(erosion.settling_shape), D::dimensionless, above(0),
+             "physical: Ferguson & Church's C2 (1): 1 natural grains, 0.4 smooth spheres, 1.2 "
+             "angular"),
+      optional_number(ERODEM_FIELD(erosion.critical_shields), D::dimensionless, above(0),
+                      "physical: critical Shields number theta_c on a flat bed (1); not set = "
+                      "Soulsby & Whitehouse (1997)"),
+      boolean(ERODEM_FIELD(erosion.slope_threshold),
+              "physical: raise theta_c on steep beds to 0.15 S^0.25 (Lamb et al. 2008)"),
+      choice(ERODEM_FIELD(erosion.pickup),
+             Choices<Pickup>{{"engelund_hansen", Pickup::engelund_hansen},
+                             {"garcia_parker", Pickup::garcia_parker}},
+             "physical, non-cohesive: equilibrium concentration from Engelund & Hansen (1967) "
+             "total load or Garcia & Parker (1991) pick-up"),
+      number(ERODEM_FIELD(erosion.max_concentration), D::dimensionless, left_open(0, 1),
+             "physical: cap of the equilibrium volume concentration c_max (1)"),
+      scalar_or_raster(ERODEM_FIELD(erosion.soil_thickness), D::length, at_least(0),
+                       "physical: thickness of the loose layer (soil) over the bedrock (m), "
+                       "uniform or a raster path"),
+      number(ERODEM_FIELD(erosion.morfac), D::dimensionless, at_least(1),
+             "physical: morphological acceleration factor (1), Roelvink (2006): the bed "
+             "changes morfac times what the suspension exchanges"),
       number(ERODEM_FIELD(erosion.sediment_capacity), D::time, at_least(0),
-             "sediment capacity K_c (s): capacity per unit speed and tilt"),
+             "mei: sediment capacity K_c (s): capacity per unit speed and tilt"),
       number(ERODEM_FIELD(erosion.dissolving_rate), D::inverse_time, at_least(0),
-             "dissolving (erosion) rate K_s (1/s)"),
+             "mei: dissolving (erosion) rate K_s (1/s)"),
       number(ERODEM_FIELD(erosion.deposition_rate), D::inverse_time, at_least(0),
-             "deposition rate K_d (1/s)"),
+             "mei: deposition rate K_d (1/s)"),
       number(ERODEM_FIELD(erosion.min_tilt), D::dimensionless, closed(0, 1),
-             "minimum tilt sin_min in the capacity (1)"),
+             "mei: minimum tilt sin_min in the capacity (1)"),
       scalar_or_raster(ERODEM_FIELD(erosion.hardness), D::dimensionless, closed(0, 1),
                        "hardness R in [0, 1] (1), uniform or a raster path"),
       number(ERODEM_FIELD(erosion.min_depth), D::length, at_least(0),
-             "depth below which the capacity ramps to 0 (m); 0 = off"),
+             "mei: depth below which the capacity ramps to 0 (m); 0 = off"),
       optional_number(ERODEM_FIELD(erosion.bedrock_level), D::length, any_finite(),
-                      "no erosion below this bed elevation (m)"),
+                      "no erosion below this bed elevation (m); physical: the soil is bed - "
+                      "bedrock_level thick (an alias of soil_thickness)"),
+      ERODEM_BED_LAYER(soil, "the loose layer"),
+      ERODEM_BED_LAYER(bedrock, "the bedrock"),
 
       choice(ERODEM_FIELD(transport.scheme),
              Choices<TransportScheme>{{"conservative", TransportScheme::conservative},

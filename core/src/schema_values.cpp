@@ -61,6 +61,9 @@ Range open(double lo, double hi) {
 Range left_open(double lo, double hi) {
   return Range{lo, hi, true, false};
 }
+Range right_open(double lo, double hi) {
+  return Range{lo, hi, false, true};
+}
 
 std::string node_text(const toml::node& n) {
   if (const auto str = n.value_exact<std::string>()) return quoted_string(*str);

@@ -58,6 +58,7 @@ Range above(double lo);
 Range closed(double lo, double hi);
 Range open(double lo, double hi);
 Range left_open(double lo, double hi);
+Range right_open(double lo, double hi);
 
 // ---- error context ----------------------------------------------------------------------
 

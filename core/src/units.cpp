@@ -52,6 +52,13 @@ const std::vector<Unit>& unit_table() {
       {"l/s", Dimension::discharge, 0.001},
       {"kg/m^3", Dimension::density, 1.0},
       {"g/cm^3", Dimension::density, 1000.0},
+      {"Pa", Dimension::stress, 1.0},
+      {"kPa", Dimension::stress, 1000.0},
+      {"N/m^2", Dimension::stress, 1.0},
+      {"kg/m^2/s", Dimension::mass_flux, 1.0},
+      {"g/m^2/s", Dimension::mass_flux, 0.001},
+      {"m^2/s", Dimension::viscosity, 1.0},
+      {"mm^2/s", Dimension::viscosity, 1e-6},
   };
   return units;
 }
@@ -119,6 +126,12 @@ std::string si_unit(Dimension dim) {
       return "s m^-1/3";
     case Dimension::density:
       return "kg/m^3";
+    case Dimension::stress:
+      return "Pa";
+    case Dimension::mass_flux:
+      return "kg/m^2/s";
+    case Dimension::viscosity:
+      return "m^2/s";
   }
   return "1";
 }
@@ -147,6 +160,12 @@ std::string dimension_noun(Dimension dim) {
       return "a Manning coefficient";
     case Dimension::density:
       return "a density";
+    case Dimension::stress:
+      return "a stress";
+    case Dimension::mass_flux:
+      return "a mass flux";
+    case Dimension::viscosity:
+      return "a kinematic viscosity";
   }
   return "a number";
 }
@@ -181,6 +200,12 @@ std::string unit_example(Dimension dim) {
       return "20 m^3/s";
     case Dimension::density:
       return "1000 kg/m^3";
+    case Dimension::stress:
+      return "0.5 Pa";
+    case Dimension::mass_flux:
+      return "1e-4 kg/m^2/s";
+    case Dimension::viscosity:
+      return "1 mm^2/s";
     case Dimension::dimensionless:
     case Dimension::manning:
       return "";

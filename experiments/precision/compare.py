@@ -29,6 +29,7 @@ STORM = [
     "time.duration=1 h",
     "time.adaptive=true",
     "erosion.enabled=true",
+    "erosion.law=mei",
     "thermal.enabled=true",
 ] + ["boundary.%s=open" % e for e in ("north", "south", "east", "west")]
 

@@ -75,6 +75,7 @@ def run(dem, backend: str, duration: float, dt_max: float, every: float) -> dict
         backend=backend,
         rain__rate="50 mm/h",
         erosion__enabled=True,
+        erosion__law="mei",
         boundary__north="open",
         boundary__south="open",
         boundary__east="open",

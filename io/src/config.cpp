@@ -46,6 +46,7 @@ void resolve_relative_paths(Params& p, const std::string& base_dir) {
   p.flow.manning_n.path = resolve_against(p.flow.manning_n.path, base);
   p.erosion.hardness.path = resolve_against(p.erosion.hardness.path, base);
   p.rain.raster = resolve_against(p.rain.raster, base);
+  p.erosion.soil_thickness.path = resolve_against(p.erosion.soil_thickness.path, base);
 }
 
 Params load_config(const std::string& path) {

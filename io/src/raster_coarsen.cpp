@@ -112,6 +112,7 @@ Terrain coarsen(const Terrain& fine, int factor) {
   t.manning_n = average(fine.manning_n);
   t.hardness = average(fine.hardness);
   t.rain_factor = average(fine.rain_factor);
+  t.soil_thickness = average(fine.soil_thickness);
   return t;
 }
 

@@ -27,7 +27,8 @@ namespace {
 /// load_terrain, so a terrain loaded without them cannot be used as it is).
 bool has_parameter_rasters(const Params& p) {
   return p.initial.water_depth.is_raster() || p.flow.manning_n.is_raster() ||
-         p.erosion.hardness.is_raster() || !p.rain.raster.empty();
+         p.erosion.hardness.is_raster() || p.erosion.soil_thickness.is_raster() ||
+         !p.rain.raster.empty();
 }
 
 /// The snapshot of `reader` at `time` (the last one when no time is given). Times match to

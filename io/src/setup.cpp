@@ -46,6 +46,9 @@ Terrain load_terrain(const Params& p) {
     t.manning_n = parameter_raster(p.flow.manning_n.path, t, p, "flow.manning_n", 0.0, 1.0);
   if (p.erosion.hardness.is_raster())
     t.hardness = parameter_raster(p.erosion.hardness.path, t, p, "erosion.hardness", 0.0, 1.0);
+  if (p.erosion.soil_thickness.is_raster())
+    t.soil_thickness =
+        parameter_raster(p.erosion.soil_thickness.path, t, p, "erosion.soil_thickness", 0.0, inf);
   if (!p.rain.raster.empty())
     t.rain_factor = parameter_raster(p.rain.raster, t, p, "rain.raster", 0.0, inf);
   const int factor = resample_factor(p.dem, t.grid);

@@ -33,6 +33,8 @@ typedef uchar erodem_kind_t;
 namespace erodem {
 namespace cell {
 using std::cbrt;
+using std::exp;
+using std::expm1;
 using std::fabs;
 using std::fmax;
 using std::fmin;

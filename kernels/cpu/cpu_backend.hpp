@@ -65,6 +65,7 @@ class CpuBackend final : public Backend {
   void run_flow(Real dt);
   void run_water(Real dt, StepTally& tally);
   void run_erosion(Real dt, StepTally& tally);
+  void run_erosion_physical(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
   void run_thermal(Real dt, StepTally& tally);
   /// A generic sweep of the process table (process.hpp SweepInfo::generic), in

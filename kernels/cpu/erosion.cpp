@@ -10,6 +10,7 @@ namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_erosion(Real dt, StepTally& tally) {
+  if (params_.erosion.law == ErosionLaw::physical) return run_erosion_physical(dt, tally);
   const Kind* kind = kind_.data();
   const Real *bed = bed_.data(), *depth = depth_.data(), *u = velocity_x_.data(),
              *v = velocity_y_.data(), *hardness = hardness_.data(), *dx = dx_.data(),
@@ -35,8 +36,50 @@ void CpuBackend<Real>::run_erosion(Real dt, StepTally& tally) {
   std::swap(bed_, bed_next_);
 }
 
+// The physical law (erosion.h sediment_sweep_cell): the same loop with the soil, Manning n and
+// four tallies.
+template <class Real>
+void CpuBackend<Real>::run_erosion_physical(Real dt, StepTally& tally) {
+  const Kind* kind = kind_.data();
+  const Real *bed = bed_.data(), *depth = depth_.data(), *u = velocity_x_.data(),
+             *v = velocity_y_.data(), *n = manning_.data(), *hardness = hardness_.data(),
+             *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
+  Real *bed_out = bed_next_.data(), *bed_lo = bed_residual_.data(), *sediment = sediment_.data(),
+       *soil = field_storage(FieldId::soil_thickness)->data();
+  const cell_params::SedimentParams<Real> params = cell_.sediment;
+  const int W = W_;
+  if (row_sums_.size() < 4) row_sums_.resize(4);
+  for (auto& r : row_sums_) r.assign(H_, 0.0);
+  for_rows(1, H_ - 1,
+           [&, bed, depth, u, v, n, hardness, dx, dy, area, bed_out, bed_lo, sediment, soil,
+            kind](int y) {
+             // Locals, not closure members: stores to Real arrays could alias those.
+             const Real step = dt;
+             const cell_params::SedimentParams<Real> p = params;
+             const auto r0 = row_scratch(W), r1 = row_scratch(W), r2 = row_scratch(W),
+                        r3 = row_scratch(W);
+             Real *eroded = r0.get(), *deposited = r1.get(), *rock = r2.get(), *bulking = r3.get();
+             ERODEM_IVDEP
+             for (int x = 1; x < W - 1; ++x)
+               cell::sediment_sweep_cell(x, y, W, kind, bed, bed_out, bed_lo, sediment, soil, depth,
+                                         u, v, n, hardness, dx, dy, area, step, p, eroded + x,
+                                         deposited + x, rock + x, bulking + x);
+             row_sums_[0][y] = sum_row(eroded, static_cast<std::size_t>(W));
+             row_sums_[1][y] = sum_row(deposited, static_cast<std::size_t>(W));
+             row_sums_[2][y] = sum_row(rock, static_cast<std::size_t>(W));
+             row_sums_[3][y] = sum_row(bulking, static_cast<std::size_t>(W));
+           });
+  tally.eroded += sum_rows(row_sums_[0]);
+  tally.deposited += sum_rows(row_sums_[1]);
+  tally.eroded_bedrock += sum_rows(row_sums_[2]);
+  tally.bed_bulking += sum_rows(row_sums_[3]);
+  std::swap(bed_, bed_next_);
+}
+
 template void CpuBackend<float>::run_erosion(float, StepTally&);
 template void CpuBackend<double>::run_erosion(double, StepTally&);
+template void CpuBackend<float>::run_erosion_physical(float, StepTally&);
+template void CpuBackend<double>::run_erosion_physical(double, StepTally&);
 
 }  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

@@ -25,3 +25,33 @@ __kernel void erosion(int W, int H, __global const uchar* restrict kind,
                   partials + ERODEM_TALLY_ERODED * stride + g,
                   partials + ERODEM_TALLY_DEPOSITED * stride + g);
 }
+
+/* The physical law (erosion.law = "physical"): sediment_sweep_cell, with the soil thickness and
+ * Manning n; the eroded, deposited and bedrock volumes and the bed's bulking are summed per
+ * work-group into the tally partials (two cell_group_sum2 on four arrays of their own: the
+ * second's barrier comes after every work-item stored the first's values). */
+__kernel void erosion_physical(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global real* restrict bed_out, __global real* restrict bed_residual,
+    __global real* restrict sediment, __global real* restrict soil,
+    __global const real* restrict depth, __global const real* restrict velocity_x,
+    __global const real* restrict velocity_y, __global const real* restrict manning,
+    __global const real* restrict hardness, __global const real* restrict dx,
+    __global const real* restrict dy, __global const real* restrict area, real dt, SedimentParams p,
+    __global acc_t* restrict partials, int stride) {
+  __local real s_eroded[ERODEM_CELL_GROUP_MAX], s_deposited[ERODEM_CELL_GROUP_MAX],
+      s_rock[ERODEM_CELL_GROUP_MAX], s_bulking[ERODEM_CELL_GROUP_MAX];
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  real eroded = 0, deposited = 0, rock = 0, bulking = 0;
+  if (!ERODEM_PAST_ROW(x, W))
+    sediment_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, sediment, soil, depth,
+                        velocity_x, velocity_y, manning, hardness, dx, dy, area, dt, p, &eroded,
+                        &deposited, &rock, &bulking);
+  const int g = cell_group_index();
+  cell_group_sum2(s_eroded, s_deposited, eroded, deposited,
+                  partials + ERODEM_TALLY_ERODED * stride + g,
+                  partials + ERODEM_TALLY_DEPOSITED * stride + g);
+  cell_group_sum2(s_rock, s_bulking, rock, bulking,
+                  partials + ERODEM_TALLY_ERODED_BEDROCK * stride + g,
+                  partials + ERODEM_TALLY_BED_BULKING * stride + g);
+}

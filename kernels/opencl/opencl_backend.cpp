@@ -370,6 +370,18 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
+  if (params_.erosion.law == ErosionLaw::physical) {
+    cl_kernel k = kernel("erosion_physical");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_,
+             *field_buffer(FieldId::soil_thickness), depth_, velocity_x_, velocity_y_, manning_,
+             hardness_, dx_, dy_, area_, dt, cell_.sediment, tally_partials_,
+             static_cast<cl_int>(tally_stride_));
+    defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited) |
+                     tally_bit(&StepTally::eroded_bedrock) | tally_bit(&StepTally::bed_bulking));
+    launch_interior(k);
+    std::swap(bed_, bed_next_);
+    return;
+  }
   cl_kernel k = kernel("erosion");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_, depth_,
            velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt, cell_.erosion, tally_partials_,

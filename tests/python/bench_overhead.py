@@ -38,6 +38,7 @@ dt_max = "2 s"
 [rain]
 rate = "60 mm/h"
 [erosion]
+law = "mei"
 enabled = true
 sediment_capacity = 0.02
 dissolving_rate = 0.005

@@ -23,7 +23,7 @@ enum FieldFlag : unsigned {
 #define ERODEM_FIELDS(X)                                                                           \
   X(bed, "m", "bed (terrain) elevation", kStateField | kOutputField | kTwinField)                  \
   X(water_depth, "m", "water column depth", kStateField | kOutputField | kTwinField)               \
-  X(sediment, "m", "suspended sediment as an equivalent bed layer",                                \
+  X(sediment, "m", "suspended sediment, solid volume per unit area",                               \
     kStateField | kOutputField | kTwinField)                                                       \
   X(velocity_x, "m s-1", "depth-averaged eastward velocity", kStateField | kOutputField)           \
   X(velocity_y, "m s-1", "depth-averaged northward velocity", kStateField | kOutputField)          \
@@ -49,7 +49,10 @@ enum FieldFlag : unsigned {
   X(momentum_y, "m2 s-1", "depth-integrated northward discharge per unit width",                   \
     kStateField | kOutputField | kRestartZero | kTwinField)                                        \
   /* derived: the bed shear stress of the depth, velocities and Manning n (erosion.h) */           \
-  X(shear_stress, "Pa", "bed shear stress", kOutputField | kDerivedField)
+  X(shear_stress, "Pa", "bed shear stress", kOutputField | kDerivedField)                          \
+  /* the loose layer over the bedrock (erosion.law = "physical"; 0 with Mei's law) */              \
+  X(soil_thickness, "m", "thickness of the loose layer (soil) over the bedrock",                   \
+    kStateField | kOutputField | kRestartZero)
 
 enum class FieldId {
 #define ERODEM_FIELD_ID(id, units, long_name, flags) id,

@@ -29,7 +29,11 @@ namespace erodem {
   X(deposited, true, "suspended sediment laid down on the bed")                            \
   X(sediment_exchanged, true, "sediment the cells gave through their faces")               \
   X(thermal_moved, true, "bed moved between cells by slope collapse")                      \
-  X(snow_melted, true, "snow melted into the water depth (water equivalent)")
+  X(snow_melted, true, "snow melted into the water depth (water equivalent)")              \
+  X(eroded_bedrock, true, "solid taken into suspension from the bedrock (part of eroded)") \
+  X(bed_bulking, true,                                                                     \
+    "bed volume lowered minus solid moved into suspension: pores opened (closed by "       \
+    "deposits), and the morphological acceleration's extra")
 
 /// The volumes (m^3) that crossed the model's boundaries or moved inside it during the
 /// processes run so far in one step (ERODEM_TALLIES).
@@ -75,9 +79,11 @@ struct Ledger {
     const double scale = water_moved();
     return scale > 0 ? closure_error() / scale : 0.0;
   }
-  /// M(t) - M(0) + sediment out - transport change: 0 up to rounding (m^3).
+  /// M(t) - M(0) + sediment out - transport change + bed bulking: 0 up to rounding (m^3).
+  /// M is the bed's volume plus the suspended solid: erosion from a porous layer lowers the
+  /// bed by more than the solid it lifts (bed_bulking; 0 with Mei's law).
   double material_closure_error() const {
-    return material - material_initial + sediment_out - transport_change;
+    return material - material_initial + sediment_out - transport_change + bed_bulking;
   }
   /// What moved of the material (m^3): max(eroded + deposited + sediment out, sediment and
   /// bed exchanged between cells, kVolumeEpsilon * material on the grid).

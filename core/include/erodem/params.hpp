@@ -24,6 +24,23 @@ inline const char* scheme_name(TransportScheme s) {
   return s == TransportScheme::conservative ? "conservative" : "semi_lagrangian";
 }
 enum class BoundaryKind { closed, open, fixed_level };
+/// erosion.law: the physical closures (docs/model.md 4.2) or Mei et al. (2007)'s capacity law.
+enum class ErosionLaw { physical, mei };
+/// A bed layer's closure: non-cohesive grains (sand, gravel) or cohesive material (silt, clay,
+/// soil, weathered rock).
+enum class SedimentClosure { non_cohesive, cohesive };
+/// The non-cohesive equilibrium: Engelund-Hansen's total load or Garcia-Parker's pick-up.
+enum class Pickup { engelund_hansen, garcia_parker };
+
+/// One layer of the bed (erosion.soil, erosion.bedrock): its closure and parameters.
+struct BedLayer {
+  SedimentClosure closure = SedimentClosure::non_cohesive;
+  double porosity = 0.4;                   ///< phi (1): pore fraction of the layer's bulk volume
+  double erodibility = 1.0;                ///< non-cohesive: multiplier of the pick-up (1)
+  double erosion_rate = 0.0;               ///< cohesive: Partheniades' M (kg m^-2 s^-1)
+  double critical_shear = 1.0;             ///< cohesive: tau_c,e (Pa), the threshold of erosion
+  std::optional<double> deposition_shear;  ///< cohesive: Krone's tau_c,d (Pa); none = w_s c
+};
 enum class NodataKind { wall, sea };
 enum class Precision { float32, float64 };
 
@@ -99,13 +116,30 @@ struct Params {
 
   struct Erosion {
     bool enabled = false;
-    double sediment_capacity = 1.0;       ///< K_c (s): capacity per unit speed and tilt
-    double dissolving_rate = 0.5;         ///< K_s (1/s)
-    double deposition_rate = 1.0;         ///< K_d (1/s)
-    double min_tilt = 0.05;               ///< sin_min (1)
-    ScalarOrRaster hardness{1.0, {}};     ///< R in [0, 1]
-    double min_depth = 0.0;               ///< d_erosion_min (m): capacity ramps to 0 below; 0 = off
-    std::optional<double> bedrock_level;  ///< no erosion below this elevation (m)
+    ErosionLaw law = ErosionLaw::physical;
+    // the physical law (docs/model.md 4.2): one grain-size class over two bed layers
+    double grain_size = 0.5e-3;               ///< D (m): sieve diameter of the grains
+    double sediment_density = 2650.0;         ///< rho_s (kg/m^3)
+    double kinematic_viscosity = 1.0e-6;      ///< nu (m^2/s): water at 20 degrees C
+    std::optional<double> settling_velocity;  ///< w_s (m/s); none = Ferguson & Church (2004)
+    double settling_shape = 1.0;             ///< Ferguson & Church's C2 (1): 1 natural, 0.4 spheres
+    std::optional<double> critical_shields;  ///< theta_c (1); none = Soulsby & Whitehouse (1997)
+    bool slope_threshold = true;             ///< raise theta_c on slopes (Lamb et al. 2008)
+    Pickup pickup = Pickup::engelund_hansen;
+    double max_concentration = 0.1;  ///< c_max (1): cap of the equilibrium volume concentration
+    ScalarOrRaster soil_thickness{1.0, {}};  ///< loose layer over the bedrock (m), or a raster
+    double morfac = 1.0;  ///< morphological acceleration factor (1), Roelvink (2006)
+    BedLayer soil{};      ///< the loose layer
+    BedLayer bedrock{SedimentClosure::cohesive, 0.0, 1.0, 0.0, 1.0, {}};  ///< below it
+    // Mei et al. (2007)'s law (erosion.law = "mei")
+    double sediment_capacity = 1.0;    ///< K_c (s): capacity per unit speed and tilt
+    double dissolving_rate = 0.5;      ///< K_s (1/s)
+    double deposition_rate = 1.0;      ///< K_d (1/s)
+    double min_tilt = 0.05;            ///< sin_min (1)
+    ScalarOrRaster hardness{1.0, {}};  ///< R in [0, 1]
+    double min_depth = 0.0;            ///< d_erosion_min (m): capacity ramps to 0 below; 0 = off
+    /// no erosion below this elevation (m); physical law: the soil is bed - bedrock_level thick
+    std::optional<double> bedrock_level;
   } erosion;
 
   struct Transport {

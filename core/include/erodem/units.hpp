@@ -24,6 +24,9 @@ enum class Dimension {
   discharge,      ///< m^3/s, l/s
   manning,        ///< Manning n (s m^-1/3); numbers only
   density,        ///< kg/m^3, g/cm^3
+  stress,         ///< Pa, kPa, N/m^2 (shear stresses)
+  mass_flux,      ///< kg/m^2/s, g/m^2/s (erosion rates)
+  viscosity,      ///< m^2/s, mm^2/s (kinematic viscosity)
 };
 
 /// A configuration error from `source` (a file name or "--set") about parameter `key`:
