@@ -6,6 +6,7 @@
 
 #include "common/compat.h"
 #include "erodem/error.hpp"
+#include "erodem/terrain_synth.hpp"
 
 namespace erodem {
 
@@ -122,7 +123,13 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
     return out;
   };
   s.manning = raster_or(terrain.manning_n, params.flow.manning_n.value);
-  s.hardness = raster_or(terrain.hardness, params.erosion.hardness.value);
+  // erosion.hardness = "noise": the noise field stands where a hardness raster would.
+  if (params.erosion.hardness_noise && !terrain.hardness.empty())
+    throw config_error("erosion.hardness",
+                       "is \"noise\", but the terrain carries a hardness raster; give one");
+  s.hardness = raster_or(
+      params.erosion.hardness_noise ? hardness_noise(terrain, params.erosion) : terrain.hardness,
+      params.erosion.hardness.value);
   s.rain_factor = raster_or(terrain.rain_factor, 1.0);
   return s;
 }

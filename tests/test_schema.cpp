@@ -303,6 +303,66 @@ TEST(Schema, ScalarOrRaster) {
   EXPECT_NE(msg.find("'initial.water_depth'"), std::string::npos) << msg;
 }
 
+TEST(Schema, HardnessNoise) {
+  // erosion.hardness takes "noise" besides a number and a raster path, with its four keys
+  // (the scale a length: units accepted).
+  Params p = from_text(
+      "[erosion]\nhardness = \"noise\"\nnoise_amplitude = 0.25\nnoise_scale = \"2 km\"\n"
+      "noise_octaves = 7\nnoise_seed = -3\n");
+  EXPECT_TRUE(p.erosion.hardness_noise);
+  EXPECT_FALSE(p.erosion.hardness.is_raster());
+  EXPECT_EQ(p.erosion.noise_amplitude, 0.25);
+  EXPECT_EQ(p.erosion.noise_scale, 2000.0);
+  EXPECT_EQ(p.erosion.noise_octaves, 7);
+  EXPECT_EQ(p.erosion.noise_seed, -3);
+  // Defaults: amplitude 0.5, 500 m, 5 octaves, seed 1; a number or a path is not noise.
+  const Params d;
+  EXPECT_FALSE(d.erosion.hardness_noise);
+  EXPECT_EQ(d.erosion.noise_amplitude, 0.5);
+  EXPECT_EQ(d.erosion.noise_scale, 500.0);
+  EXPECT_EQ(d.erosion.noise_octaves, 5);
+  EXPECT_EQ(d.erosion.noise_seed, 1);
+  EXPECT_EQ(erodem::parameter_info("erosion.noise_scale").unit, "m");
+  EXPECT_FALSE(from_text("[erosion]\nhardness = 0.5\n").erosion.hardness_noise);
+  EXPECT_EQ(from_text("[erosion]\nhardness = \"h.tif\"\n").erosion.hardness.path, "h.tif");
+  // --set: "noise", then a number again (which clears it).
+  p = valid_params();
+  erodem::apply_setting(p, "erosion.hardness", "noise");
+  EXPECT_TRUE(p.erosion.hardness_noise);
+  erodem::apply_setting(p, "erosion.hardness", "0.75");
+  EXPECT_FALSE(p.erosion.hardness_noise);
+  EXPECT_EQ(p.erosion.hardness.value, 0.75);
+  // Rejected, naming the key and what it accepts: a typo of "noise" (a bare word, not a
+  // raster file name), and values out of range.
+  std::string msg = config_error_message([] { from_text("[erosion]\nhardness = \"nois\"\n"); });
+  EXPECT_NE(msg.find("'erosion.hardness': expected a number in [0, 1], a raster path or "
+                     "\"noise\", got \"nois\""),
+            std::string::npos)
+      << msg;
+  msg = config_error_message([] { from_text("[erosion]\nnoise_amplitude = 1.5\n"); });
+  EXPECT_NE(msg.find("'erosion.noise_amplitude'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("in [0, 1]"), std::string::npos) << msg;
+  msg = config_error_message([] { from_text("[erosion]\nnoise_scale = 0\n"); });
+  EXPECT_NE(msg.find("'erosion.noise_scale'"), std::string::npos) << msg;
+  msg = config_error_message([] { from_text("[erosion]\nnoise_scale = \"3 s\"\n"); });
+  EXPECT_NE(msg.find("'erosion.noise_scale'"), std::string::npos) << msg;
+  msg = config_error_message([] { from_text("[erosion]\nnoise_octaves = 17\n"); });
+  EXPECT_NE(msg.find("'erosion.noise_octaves': expected an integer in [1, 16]"), std::string::npos)
+      << msg;
+  msg = config_error_message([] { from_text("[erosion]\nnoise_seed = 1.5\n"); });
+  EXPECT_NE(msg.find("'erosion.noise_seed'"), std::string::npos) << msg;
+  // Round trip through dump_toml.
+  p = valid_params();
+  p.erosion.hardness_noise = true;
+  p.erosion.noise_scale = 250.0;
+  const std::string text = erodem::dump_toml(p);
+  EXPECT_NE(text.find("hardness = \"noise\""), std::string::npos) << text;
+  const Params back = erodem::params_from_toml(toml::parse(text), "dump");
+  EXPECT_TRUE(erodem::params_equal(p, back)) << text;
+  EXPECT_TRUE(back.erosion.hardness_noise);
+  EXPECT_NO_THROW(erodem::validate(back));
+}
+
 // ---- --set ------------------------------------------------------------------------------
 
 TEST(Set, BareStringNumberAndArray) {

@@ -62,6 +62,44 @@ Descriptor pipe_length_descriptor(const char* key, const char* doc) {
   return d;
 }
 
+Descriptor hardness_descriptor(const char* key, const char* doc) {
+  auto access = [](auto& p) -> auto& {
+    return p.erosion.hardness;
+  };
+  const Descriptor inner =
+      scalar_or_raster(key, access, Dimension::dimensionless, closed(0, 1), doc);
+  Descriptor d = inner;
+  d.type = "number, raster path or \"noise\"";
+  d.accepted = inner.accepted + ", or \"noise\"";
+  d.reset = [reset = inner.reset](Params& p) {
+    reset(p);
+    p.erosion.hardness_noise = Params{}.erosion.hardness_noise;
+  };
+  d.assign = [assign = inner.assign](Params& p, const toml::node& n, const Where& w) {
+    const auto s = n.value_exact<std::string>();
+    if (s && *s == "noise") {
+      p.erosion.hardness = Params{}.erosion.hardness;
+      p.erosion.hardness_noise = true;
+      return;
+    }
+    if (s && !s->empty() && !looks_like_quantity(*s) &&
+        s->find_first_of("./\\") == std::string::npos) {
+      throw w.fail("expected a number in [0, 1], a raster path or \"noise\", got " + node_text(n) +
+                   " (a raster path names its file with an extension or a directory, e.g. "
+                   "\"hardness.tif\" or \"./hardness\")");
+    }
+    assign(p, n, w);
+    p.erosion.hardness_noise = false;
+  };
+  d.check = [check = inner.check](const Params& p, const Where& w) {
+    if (!p.erosion.hardness_noise) check(p, w);
+  };
+  d.format = [format = inner.format](const Params& p) -> std::optional<std::string> {
+    return p.erosion.hardness_noise ? quoted_string("noise") : format(p);
+  };
+  return d;
+}
+
 // ---- inflow -----------------------------------------------------------------------------
 
 const Range kDischargeRange = at_least(0);

@@ -302,6 +302,11 @@ Descriptor resample_descriptor(const char* key, const char* doc);
 /// flow.pipe_length: "cell" (stored as 0) or a length > 0.
 Descriptor pipe_length_descriptor(const char* key, const char* doc);
 
+/// erosion.hardness: a number or raster path as scalar_or_raster reads them, or "noise"
+/// (Params::Erosion::hardness_noise). A bare word (no '.', '/' or '\\') is neither a raster
+/// file name nor "noise", and is rejected, so that a typo such as "nois" fails here.
+Descriptor hardness_descriptor(const char* key, const char* doc);
+
 /// [[inflow]]: point or line inflows, each with a hydrograph.
 Descriptor inflow_descriptor(const char* key, const char* doc);
 

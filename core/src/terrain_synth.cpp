@@ -124,17 +124,18 @@ int ilog2(int n) {
   return k;
 }
 
-/// A sum of Perlin octaves over the grid: lacunarity 2, gain 0.5, the first octave with a
-/// period of half the larger grid side, the last with a period of about 4 cells.
+/// A sum of `octaves` Perlin octaves over nx x ny points, lacunarity 2, gain 0.5: octave o
+/// is sampled at (ox_o + x(c, r) f_o, oy_o + y(r) f_o) lattice units with f_o = freq0 2^o,
+/// its lattice seed and offsets (ox_o, oy_o) in [0, 1024) drawn from SplitMix64(`stream`).
 /// `ridged` selects the ridged multifractal ((1 - |n|)^2 signals weighted by the previous
 /// octave, after Musgrave) instead of plain fbm.
-std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged) {
-  const int side = std::max(nx, ny);
-  const int octaves = std::max(1, ilog2(side) - 2);
-  SplitMix64 rng(seed ^ 0x5DEECE66DULL);
+template <class X, class Y>
+std::vector<double> perlin_octaves(int nx, int ny, int octaves, double freq0, std::uint64_t stream,
+                                   bool ridged, X x, Y y) {
+  SplitMix64 rng(stream);
   std::vector<double> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 0.0);
   std::vector<double> weight(ridged ? out.size() : 0, 1.0);
-  double freq = 2.0 / side;  // lattice cells per grid cell
+  double freq = freq0;
   double amp = 1.0;
   for (int o = 0; o < octaves; ++o) {
     const std::uint64_t oseed = rng.next();
@@ -142,7 +143,7 @@ std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged
     for (int r = 0; r < ny; ++r) {
       for (int c = 0; c < nx; ++c) {
         const std::size_t i = static_cast<std::size_t>(r) * nx + c;
-        const double n = perlin(ox + (c + 0.5) * freq, oy + (r + 0.5) * freq, oseed);
+        const double n = perlin(ox + x(c, r) * freq, oy + y(r) * freq, oseed);
         if (ridged) {
           double s = 1.0 - std::fabs(n);
           s = s * s * weight[i];
@@ -157,6 +158,15 @@ std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged
     amp *= 0.5;
   }
   return out;
+}
+
+/// The terrain generators' octaves, in cells: the first octave with a period of half the
+/// larger grid side, the last with a period of about 4 cells.
+std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged) {
+  const int side = std::max(nx, ny);
+  return perlin_octaves(
+      nx, ny, std::max(1, ilog2(side) - 2), 2.0 / side, seed ^ 0x5DEECE66DULL, ridged,
+      [](int c, int) { return c + 0.5; }, [](int r) { return r + 0.5; });
 }
 
 /// Diamond-square midpoint displacement on an n x n grid, n = 2^k + 1 >= max(nx, ny),
@@ -358,6 +368,58 @@ std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell
   }
   normalise(h, relief_m);
   return h;
+}
+
+std::vector<double> fbm_field(const Grid& grid, double scale_m, int octaves, std::uint64_t seed) {
+  grid.validate();
+  if (!(std::isfinite(scale_m) && scale_m > 0.0))
+    throw Error(ExitCode::usage, "fbm field: the scale must be a positive length (m)");
+  if (octaves < 1 || octaves > 16)
+    throw Error(ExitCode::usage,
+                "fbm field: between 1 and 16 octaves, got " + std::to_string(octaves));
+  // Row centres: the sum of the cell heights of the rows above plus half the row's own.
+  std::vector<double> y(static_cast<std::size_t>(grid.ny));
+  double top = 0.0, width = 0.0;
+  for (int r = 0; r < grid.ny; ++r) {
+    y[r] = top + 0.5 * grid.dy[r];
+    top += grid.dy[r];
+    width = std::max(width, grid.nx * grid.dx[r]);
+  }
+  // Lattice coordinates must stay far inside the int64 range of perlin()'s lattice indices
+  // (and keep a fraction worth sampling): at most 2^40 lattice cells in the last octave.
+  if (!(std::max(width, top) / scale_m * std::ldexp(1.0, octaves - 1) <= 0x1.0p40))
+    throw Error(ExitCode::usage, "fbm field: a scale of " + std::to_string(scale_m) +
+                                     " m is too small for a grid of " + std::to_string(width) +
+                                     " x " + std::to_string(top) + " m");
+  return perlin_octaves(
+      grid.nx, grid.ny, octaves, 1.0 / scale_m, seed ^ 0x6A09E667F3BCC909ULL, false,
+      [&](int c, int r) { return (c + 0.5) * grid.dx[r]; }, [&](int r) { return y[r]; });
+}
+
+std::vector<double> hardness_noise(const Terrain& terrain, const Params::Erosion& erosion) {
+  const double a = erosion.noise_amplitude;
+  if (!(std::isfinite(a) && a >= 0.0 && a <= 1.0))
+    throw config_error("erosion.noise_amplitude", "must be in [0, 1] (1)");
+  if (!(std::isfinite(erosion.noise_scale) && erosion.noise_scale > 0.0))
+    throw config_error("erosion.noise_scale", "must be a positive length (m)");
+  if (erosion.noise_octaves < 1 || erosion.noise_octaves > 16)
+    throw config_error("erosion.noise_octaves",
+                       "must be between 1 and 16, got " + std::to_string(erosion.noise_octaves));
+  // The seed is an int in the configuration; its two's-complement bits seed the PRNG.
+  const auto seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(erosion.noise_seed));
+  std::vector<double> r = fbm_field(terrain.grid, erosion.noise_scale, erosion.noise_octaves, seed);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (!terrain.active(i)) continue;
+    lo = std::min(lo, r[i]);
+    hi = std::max(hi, r[i]);
+  }
+  const double range = hi - lo;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const double n = terrain.active(i) && range > 0.0 ? (r[i] - lo) / range : 1.0;
+    r[i] = 1.0 - a * (1.0 - std::min(1.0, std::max(0.0, n)));
+  }
+  return r;
 }
 
 Terrain make_synthetic_terrain(const Params::Dem& dem) {

@@ -51,7 +51,7 @@ struct Terrain {
   std::vector<std::uint8_t> mask;      ///< 1 = active cell, 0 = nodata; empty = all active
   std::vector<double> water_depth;     ///< initial depth (m)
   std::vector<double> manning_n;       ///< Manning n (s m^-1/3)
-  std::vector<double> hardness;        ///< erodibility R in [0, 1]
+  std::vector<double> hardness;        ///< erodibility R in [0, 1]; empty: scalar or "noise"
   std::vector<double> rain_factor;     ///< rain multiplier (1)
   std::vector<double> soil_thickness;  ///< loose layer over the bedrock (m): erosion's initial
                                        ///< soil_thickness field (process_table.cpp)

@@ -56,6 +56,35 @@ SynthKind synth_kind_from_string(const std::string& name);
 std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell_size_m,
                                      double relief_m, std::uint64_t seed);
 
+/// Fractal Brownian motion of 2-D Perlin gradient noise sampled at the cell centres of
+/// `grid`, in metres: `octaves` octaves, the first with a lattice spacing (wavelength) of
+/// `scale_m`, each next one with half the wavelength and half the amplitude (lacunarity 2,
+/// gain 1/2). Cell (col, row) lies at x = (col + 1/2) dx(row) east and y = dy(0) + ... +
+/// dy(row - 1) + dy(row) / 2 south of the grid's north-west corner, from the grid's per-row
+/// cell sizes: exact on projected grids; on geographic grids a local (sheared) map whose
+/// distances are right along each row and each column. The pattern is therefore one of
+/// position in metres, not of the resolution: two grids whose cell centres coincide get the
+/// same values there, bit for bit.
+///
+/// @param grid     the grid (validated)
+/// @param scale_m  wavelength of the first octave (m, finite, > 0)
+/// @param octaves  number of octaves (1 to 16)
+/// @param seed     random seed (any value); the same seed gives bit-identical output
+/// @return         grid.cells() values, row-major, unnormalised (roughly in [-2, 2])
+///
+/// Throws erodem::Error(ExitCode::usage) for a bad scale or octave count, or a scale so
+/// small that the last octave spans more than 2^40 wavelengths of the grid.
+std::vector<double> fbm_field(const Grid& grid, double scale_m, int octaves, std::uint64_t seed);
+
+/// The erodibility R of `erosion.hardness = "noise"` on `terrain`'s grid: n = fbm_field(grid,
+/// erosion.noise_scale, erosion.noise_octaves, erosion.noise_seed) mapped linearly onto [0, 1]
+/// over the active cells (their minimum to 0, their maximum to 1), and R = 1 - a (1 - n) with
+/// a = erosion.noise_amplitude, so R spans [1 - a, 1] and reaches both ends. Nodata cells, and
+/// every cell when the active ones hold one value, get R = 1. Computed once in double on the
+/// host; the backends round it like a hardness raster, so every backend sees the same values.
+/// Throws erodem::Error(ExitCode::config) naming the key for an out-of-range noise setting.
+std::vector<double> hardness_noise(const Terrain& terrain, const Params::Erosion& erosion);
+
 /// Builds a Terrain from the `[dem]` synthetic settings: kind `dem.synthetic`, a square grid
 /// of `dem.size` cells per side (Grid::uniform, no CRS), cell size `dem.cell_size` (m; 10 m
 /// when 0), relief `dem.relief` (m), seed `dem.seed`. All cells active; `source` describes
