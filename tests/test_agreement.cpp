@@ -29,11 +29,13 @@ struct AgreementCase {
   bool adaptive;
   double dt;      ///< s: the fixed step, or the upper bound of the adaptive one
   int order = 1;  ///< flow.order (shallow water)
+  ErosionLaw law = ErosionLaw::mei;
 };
 
 Params agreement_params(const AgreementCase& c) {
   Params p = tujunga_storm(c.flow, c.transport, c.adaptive, c.dt, Precision::float32);
   p.flow.order = c.order;
+  p.erosion.law = c.law;
   return p;
 }
 
@@ -64,7 +66,8 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
   const double bound = 1e-5;
   for (FieldId id : {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
                      FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right,
-                     FieldId::flux_top, FieldId::flux_bottom, FieldId::wetness, FieldId::erosion}) {
+                     FieldId::flux_top, FieldId::flux_bottom, FieldId::wetness, FieldId::erosion,
+                     FieldId::soil_thickness}) {
     const auto a = ocl.field(id), b = cpu.field(id);
     ASSERT_EQ(a.size(), b.size());
     // ||a - b|| / ||b|| (0 when both vanish) as `erodem compare` computes it; every cell
@@ -255,7 +258,12 @@ INSTANTIATE_TEST_SUITE_P(
                       AgreementCase{"shallow_water_conservative", FlowScheme::shallow_water,
                                     TransportScheme::conservative, true, 2.0},
                       AgreementCase{"shallow_water_order2_conservative", FlowScheme::shallow_water,
-                                    TransportScheme::conservative, true, 2.0, 2}),
+                                    TransportScheme::conservative, true, 2.0, 2},
+                      // the physical erosion law (its exp and expm1 are the libraries' on
+                      // each side, so not bit for bit)
+                      AgreementCase{"local_inertial_physical", FlowScheme::local_inertial,
+                                    TransportScheme::conservative, true, 2.0, 1,
+                                    ErosionLaw::physical}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
 
 }  // namespace

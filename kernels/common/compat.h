@@ -183,6 +183,67 @@ inline double erodem_cbrt_positive(double x) {
 }  // namespace erodem
 #endif
 
+/* exp(-x) for x >= 0, and (1 - exp(-x)) / x (1 at x = 0), with the same bits on the CPU and
+ * every OpenCL device (float32): the libraries' exp and expm1 may differ by an ulp, which the
+ * bed turns into visible differences of the flow after many steps (the physical erosion law's
+ * exact exchange, erosion.h). Correctly rounded +, -, * and / only: x = n ln 2 + r with |r| <=
+ * 0.35 (ln 2 in two parts, Cody & Waite, so n ln2_hi is exact), exp(-r) by its Taylor
+ * polynomial to r^7 (error below 6e-9), times 2^-n built from its bits; 0 beyond x = 87 (below
+ * the smallest normal float). The weight by its Taylor series to x^7 below x = 0.5 (error
+ * below 2e-8), else from exp(-x). Branch-free, so loops vectorise. For double: the C
+ * library's exp and expm1 (the CPU float64 reference). */
+ERODEM_BEGIN_NAMESPACE
+ERODEM_INLINE float exp_neg_f32(float x) {
+  const float xc = x < 87.0f ? x : 87.0f;
+  const int n = (int)(xc * 1.44269504f + 0.5f);
+  const float r = (xc - (float)n * 0.693145751953125f) - (float)n * 1.42860677e-6f;
+  float p = -1.98412698e-4f; /* -1/7! */
+  p = p * r + 1.38888889e-3f;
+  p = p * r - 8.33333333e-3f;
+  p = p * r + 4.16666667e-2f;
+  p = p * r - 1.66666667e-1f;
+  p = p * r + 0.5f;
+  p = p * r - 1.0f;
+  p = p * r + 1.0f;
+  const float scale = erodem_bits_float((unsigned int)(127 - n) << 23);
+  return x < 87.0f ? p * scale : 0.0f;
+}
+ERODEM_INLINE float relax_weight_f32(float x) {
+  float p = -2.48015873e-5f; /* -1/8! */
+  p = p * x + 1.98412698e-4f;
+  p = p * x - 1.38888889e-3f;
+  p = p * x + 8.33333333e-3f;
+  p = p * x - 4.16666667e-2f;
+  p = p * x + 1.66666667e-1f;
+  p = p * x - 0.5f;
+  p = p * x + 1.0f;
+  const float large = (1.0f - exp_neg_f32(x)) / (x > 0.5f ? x : 1.0f);
+  return x > 0.5f ? large : p;
+}
+ERODEM_END_NAMESPACE
+
+#ifdef __OPENCL_C_VERSION__
+#define erodem_exp_neg(x) exp_neg_f32(x)
+#define erodem_relax_weight(x) relax_weight_f32(x)
+#else
+namespace erodem {
+namespace cell {
+inline float erodem_exp_neg(float x) {
+  return exp_neg_f32(x);
+}
+inline double erodem_exp_neg(double x) {
+  return std::exp(-x);
+}
+inline float erodem_relax_weight(float x) {
+  return relax_weight_f32(x);
+}
+inline double erodem_relax_weight(double x) {
+  return x > 0 ? -std::expm1(-x) / x : 1.0;
+}
+}  // namespace cell
+}  // namespace erodem
+#endif
+
 /* The larger (smaller) of two numbers that are not NaN (for NaN the two languages differ: fmax
  * gives the other number, the comparison gives b). The same value everywhere else, bit for bit; the
  * spelling is per compiler: in the local-inertial face loops PoCL vectorises fmax across

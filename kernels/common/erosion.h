@@ -268,11 +268,9 @@ ERODEM_FN real equilibrium_concentration(real h, real speed, real n, ERODEM_S(Be
 }
 
 /* dt (1 - exp(-k dt)) / (k dt): the weight of a constant source over a step of the exact
- * solution of ds/dt = a - k s (k >= 0, s), dt at k = 0. */
+ * solution of ds/dt = a - k s (k >= 0), dt at k = 0 (compat.h erodem_relax_weight). */
 ERODEM_FN real relaxation_weight(real k, real dt) {
-  const real x = k * dt;
-  const real w = -expm1(-x) / (x > (real)0 ? x : (real)1);
-  return dt * (x > (real)0 ? w : (real)1);
+  return dt * erodem_relax_weight(k * dt);
 }
 
 /* One layer's exchange between the bed and the suspended sediment s (m of solid) of a cell,
@@ -292,7 +290,7 @@ ERODEM_FN real layer_exchange(int cohesive, real rate, real inv_tau_e, real inv_
   const real excess = tau * inv_tau_e - (real)1;
   const real a =
       hardness * rate * (cohesive ? (excess > (real)0 ? excess : (real)0) : p.settling * c_eq);
-  return s * exp(-k * dt) + a * relaxation_weight(k, dt);
+  return s * erodem_exp_neg(k * dt) + a * relaxation_weight(k, dt);
 }
 
 /* Erosion / deposition of the physical law at active padded cell (x, y). The soil (loose
@@ -328,7 +326,8 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
   const real s_rock = layer_exchange(p.rock_cohesive, p.rock_rate, p.rock_inv_tau_e,
                                      p.rock_inv_tau_d, s, h_f, r, c_eq, b.tau, dt, p);
   const real m_first = (on_soil ? s_soil : s_rock) - s;
-  const real solid_soil = soil_l / p.soil_bulk; /* solid the soil holds (m) */
+  /* the solid the soil holds (m), in exchanged solid: the bed takes morfac times it */
+  const real solid_soil = soil_l / (p.soil_bulk * p.morfac);
   const real m_soil_room = m_first - solid_soil;
   const int runs_out = on_soil & (m_soil_room > (real)0);
   /* the rest of the step on the bedrock, from the sediment the soil gave */
@@ -350,7 +349,8 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
   const real s_new = two_sum(s, moved, &e_s); /* s + moved = s_new + e_s */
   const real bed_new = two_sum(bed[i], -lowered, &e_b);
   *sediment_out = s_new;
-  *soil_out = soil_new > (real)0 ? soil_new : (real)0;
+  /* where the soil ran out it is gone (not a rounding residue of soil - its solid times bulk) */
+  *soil_out = soil_new > (real)0 && !runs_out ? soil_new : (real)0;
   *moved_out = moved;
   *rock_out = from_rock;
   *bulking_out = lowered - moved;

@@ -140,11 +140,11 @@ struct Params {
     double min_depth = 0.0;            ///< d_erosion_min (m): capacity ramps to 0 below; 0 = off
     /// no erosion below this elevation (m); physical law: the soil is bed - bedrock_level thick
     std::optional<double> bedrock_level;
-    bool hardness_noise = false;       ///< hardness = "noise": R from hardness_noise()
-    double noise_amplitude = 0.5;      ///< a (1): the noise's R spans [1 - a, 1]
-    double noise_scale = 500.0;        ///< wavelength of the noise's first octave (m)
-    int noise_octaves = 5;             ///< octaves of the noise (lacunarity 2, gain 1/2)
-    int noise_seed = 1;                ///< random seed of the noise
+    bool hardness_noise = false;   ///< hardness = "noise": R from hardness_noise()
+    double noise_amplitude = 0.5;  ///< a (1): the noise's R spans [1 - a, 1]
+    double noise_scale = 500.0;    ///< wavelength of the noise's first octave (m)
+    int noise_octaves = 5;         ///< octaves of the noise (lacunarity 2, gain 1/2)
+    int noise_seed = 1;            ///< random seed of the noise
   } erosion;
 
   struct Transport {
