@@ -172,7 +172,7 @@ int run(const RunOptions& o) {
               sim.backend().device().c_str());
   std::printf("%s", sim.ledger().format().c_str());
   if (p.erosion.enabled && p.erosion.law == ErosionLaw::physical) {
-    // the solid volumes as masses, and the yield over the active area (docs/model.md 4.2)
+    // the solid volumes as masses, and the yield over the active area (docs/model.md 3.5)
     const Terrain& t = sim.terrain();
     double area = 0;
     for (std::size_t i = 0; i < t.bed.size(); ++i)

@@ -1,4 +1,4 @@
-// erodem — the physical erosion law (erosion.law = "physical", docs/model.md section 4.2) against
+// erodem — the physical erosion law (erosion.law = "physical", docs/model.md section 3.5) against
 // closed forms: well-mixed settling, the threshold of motion and the equilibrium concentration,
 // the adaptation of clear water along a uniform channel, Exner's porosity in a closed box, and a
 // layered bed eroding through its soil into the bedrock. The flows are held fixed where the

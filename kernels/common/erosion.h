@@ -192,7 +192,7 @@ ERODEM_FN void erosion_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_
   *deposited = active & (volume < 0) ? -volume : (real)0;
 }
 
-/* ---- the physical law (erosion.law = "physical", docs/model.md section 4.2) ------------ */
+/* ---- the physical law (erosion.law = "physical", docs/model.md section 3.5) ------------ */
 
 /* Settling velocity (m/s) of natural grains of sieve diameter D (m), Ferguson & Church (2004):
  *   w_s = R g D^2 / (C1 nu + sqrt(0.75 C2 R g D^3)),

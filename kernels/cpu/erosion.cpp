@@ -50,25 +50,27 @@ void CpuBackend<Real>::run_erosion_physical(Real dt, StepTally& tally) {
   const int W = W_;
   if (row_sums_.size() < 4) row_sums_.resize(4);
   for (auto& r : row_sums_) r.assign(H_, 0.0);
-  for_rows(1, H_ - 1,
-           [&, bed, depth, u, v, n, hardness, dx, dy, area, bed_out, bed_lo, sediment, soil,
-            kind](int y) {
-             // Locals, not closure members: stores to Real arrays could alias those.
-             const Real step = dt;
-             const cell_params::SedimentParams<Real> p = params;
-             const auto r0 = row_scratch(W), r1 = row_scratch(W), r2 = row_scratch(W),
-                        r3 = row_scratch(W);
-             Real *eroded = r0.get(), *deposited = r1.get(), *rock = r2.get(), *bulking = r3.get();
-             ERODEM_IVDEP
-             for (int x = 1; x < W - 1; ++x)
-               cell::sediment_sweep_cell(x, y, W, kind, bed, bed_out, bed_lo, sediment, soil, depth,
-                                         u, v, n, hardness, dx, dy, area, step, p, eroded + x,
-                                         deposited + x, rock + x, bulking + x);
-             row_sums_[0][y] = sum_row(eroded, static_cast<std::size_t>(W));
-             row_sums_[1][y] = sum_row(deposited, static_cast<std::size_t>(W));
-             row_sums_[2][y] = sum_row(rock, static_cast<std::size_t>(W));
-             row_sums_[3][y] = sum_row(bulking, static_cast<std::size_t>(W));
-           });
+  std::vector<double>* sums = row_sums_.data();
+  for_rows(1, H_ - 1, [=](int y) {
+    // Locals, not closure members: stores to Real arrays could alias those (GCC then leaves
+    // the loop scalar).
+    const Kind* k_ = kind;
+    const Real *b_ = bed, *h_ = depth, *u_ = u, *v_ = v, *n_ = n, *r_ = hardness, *dx_l = dx,
+               *dy_l = dy, *a_ = area;
+    Real *bo_ = bed_out, *lo_ = bed_lo, *s_ = sediment, *l_ = soil;
+    const Real step = dt;
+    const cell_params::SedimentParams<Real> p = params;
+    const auto r0 = row_scratch(W), r1 = row_scratch(W), r2 = row_scratch(W), r3 = row_scratch(W);
+    Real *eroded = r0.get(), *deposited = r1.get(), *rock = r2.get(), *bulking = r3.get();
+    ERODEM_IVDEP
+    for (int x = 1; x < W - 1; ++x)
+      cell::sediment_sweep_cell(x, y, W, k_, b_, bo_, lo_, s_, l_, h_, u_, v_, n_, r_, dx_l, dy_l,
+                                a_, step, p, eroded + x, deposited + x, rock + x, bulking + x);
+    sums[0][y] = sum_row(eroded, static_cast<std::size_t>(W));
+    sums[1][y] = sum_row(deposited, static_cast<std::size_t>(W));
+    sums[2][y] = sum_row(rock, static_cast<std::size_t>(W));
+    sums[3][y] = sum_row(bulking, static_cast<std::size_t>(W));
+  });
   tally.eroded += sum_rows(row_sums_[0]);
   tally.deposited += sum_rows(row_sums_[1]);
   tally.eroded_bedrock += sum_rows(row_sums_[2]);

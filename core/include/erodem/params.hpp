@@ -24,7 +24,7 @@ inline const char* scheme_name(TransportScheme s) {
   return s == TransportScheme::conservative ? "conservative" : "semi_lagrangian";
 }
 enum class BoundaryKind { closed, open, fixed_level };
-/// erosion.law: the physical closures (docs/model.md 4.2) or Mei et al. (2007)'s capacity law.
+/// erosion.law: the physical closures (docs/model.md 3.5) or Mei et al. (2007)'s capacity law.
 enum class ErosionLaw { physical, mei };
 /// A bed layer's closure: non-cohesive grains (sand, gravel) or cohesive material (silt, clay,
 /// soil, weathered rock).
@@ -117,7 +117,7 @@ struct Params {
   struct Erosion {
     bool enabled = false;
     ErosionLaw law = ErosionLaw::physical;
-    // the physical law (docs/model.md 4.2): one grain-size class over two bed layers
+    // the physical law (docs/model.md 3.5): one grain-size class over two bed layers
     double grain_size = 0.5e-3;               ///< D (m): sieve diameter of the grains
     double sediment_density = 2650.0;         ///< rho_s (kg/m^3)
     double kinematic_viscosity = 1.0e-6;      ///< nu (m^2/s): water at 20 degrees C
