@@ -87,6 +87,17 @@ const std::string kShallowWater2 = [] {
   return c;
 }();
 
+/// The same with the physical erosion law (its soil thickness is state too), over a thin soil
+/// so that some of the bedrock erodes.
+const std::string kPhysical = [] {
+  std::string c = kInertial;
+  const std::string from = "law = \"mei\"";
+  c.replace(c.find(from), from.size(),
+            "law = \"physical\"\nsoil_thickness = \"2 mm\"\ngrain_size = \"0.2 mm\"\n"
+            "bedrock.erosion_rate = 1e-3\nbedrock.critical_shear = \"0.5 Pa\"");
+  return c;
+}();
+
 /// Pipes, semi-Lagrangian transport, a point inflow hydrograph and fixed steps.
 const char* kPipes = R"([dem]
 synthetic = "hill"
@@ -238,6 +249,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"shallow_water_order2", kShallowWater2.c_str(), "cpu", "float32"},
                       Case{"shallow_water_order2", kShallowWater2.c_str(), "cpu", "float64"},
                       Case{"shallow_water_order2", kShallowWater2.c_str(), "opencl", "float32"},
+                      Case{"physical", kPhysical.c_str(), "cpu", "float32"},
+                      Case{"physical", kPhysical.c_str(), "cpu", "float64"},
+                      Case{"physical", kPhysical.c_str(), "opencl", "float32"},
                       Case{"pipes", kPipes, "cpu", "float32"},
                       Case{"pipes", kPipes, "opencl", "float32"}),
     [](const ::testing::TestParamInfo<Case>& p) {
