@@ -64,10 +64,10 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
       cpu.last_stats().max_speed, cpu.ledger().water, cpu.ledger().rain, cpu.ledger().boundary_out);
   EXPECT_NEAR(ocl.time(), cpu.time(), 1e-5 * cpu.time());
   const double bound = 1e-5;
-  for (FieldId id : {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
-                     FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right,
-                     FieldId::flux_top, FieldId::flux_bottom, FieldId::wetness, FieldId::erosion,
-                     FieldId::soil_thickness}) {
+  for (FieldId id :
+       {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
+        FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right, FieldId::flux_top,
+        FieldId::flux_bottom, FieldId::wetness, FieldId::erosion, FieldId::soil_thickness}) {
     const auto a = ocl.field(id), b = cpu.field(id);
     ASSERT_EQ(a.size(), b.size());
     // ||a - b|| / ||b|| (0 when both vanish) as `erodem compare` computes it; every cell
