@@ -31,6 +31,7 @@ def small_config(dem_path, steps=200, **extra):
         "rain": {"rate": "80 mm/h"},
         "erosion": {
             "enabled": True,
+            "law": "mei",  # the capacity law these tests sweep and compare (its K_c, K_s, K_d)
             "sediment_capacity": 0.05,
             "dissolving_rate": 0.05,
             "deposition_rate": 0.1,
@@ -170,6 +171,37 @@ def test_parameter_forms_agree(erodem, tujunga):
     odd = 'run "a" \\ \t\r\n\x01\x7f Zürich 日本 😀.h5'
     toml = erodem._erodem.resolve_config("", _settings({"dem.path": tujunga, "output.path": odd}))
     assert "path = " + erodem._erodem.quoted_string(odd) in toml.splitlines()
+
+
+def test_physical_erosion_law_from_python(erodem, tujunga):
+    """The physical erosion law (the default): its nested layer keys in every form, its soil
+    field, its ledger in solid volumes that closes with the bed bulking, and a bad layer key
+    named in the error."""
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    a = erodem.Simulation(dem, backend="cpu", rain__rate="100 mm/h", erosion__enabled=True,
+                          erosion__soil_thickness="50 cm", erosion__soil__porosity=0.3,
+                          time__dt=1.0)
+    b = erodem.Simulation(dem, backend="cpu", rain={"rate": "100 mm/h"}, time={"dt": 1.0},
+                          erosion={"enabled": True, "soil_thickness": "50 cm",
+                                   "soil": {"porosity": 0.3}})
+    assert a.config_toml == b.config_toml
+    assert "[erosion.soil]" in a.config_toml and "porosity = 0.3" in a.config_toml
+    soil = a.field("soil_thickness")
+    assert np.nanmin(soil) == np.nanmax(soil) == np.float32(0.5)
+    a.step(300)
+    led = a.ledger
+    print("eroded %.4g m^3, deposited %.4g, bed bulking %.4g, material closure %.2e of moved"
+          % (led["eroded"], led["deposited"], led["bed_bulking"],
+             led["relative_material_closure_error"]))
+    # it must erode (an idle law: 0), the pores opened are phi / (1 - phi) of the net solid
+    # eroded on the soil (no bedrock erodes: M = 0), and the material closes to float32 rounding
+    assert led["eroded"] > 1.0
+    net = led["eroded"] - led["deposited"]
+    assert abs(led["bed_bulking"] - net * 0.3 / 0.7) <= 1e-4 * led["eroded"]
+    assert abs(led["relative_material_closure_error"]) < 1e-6
+    assert np.nanmin(a.field("soil_thickness")) < 0.5
+    with pytest.raises(ValueError, match="erosion.soil.porosty"):
+        erodem.Simulation(dem, backend="cpu", erosion__soil__porosty=0.3)
 
 
 # ---- numpy views ------------------------------------------------------------------------
