@@ -292,6 +292,40 @@ TEST(Schema, InflowErrors) {
   EXPECT_NE(msg.find("'inflow[0].hydrograph'"), std::string::npos) << msg;
 }
 
+TEST(Schema, InflowSedimentAndErosionLayers) {
+  // An inflow's sediment concentration (a volume fraction in [0, 1)), the erosion law and the
+  // nested bed-layer keys with their units, and the errors that name them.
+  Params p = from_text(
+      "[dem]\nsynthetic = \"hill\"\n[erosion]\nenabled = true\nlaw = \"physical\"\nsoil_thickness "
+      "= \"30 cm\"\n"
+      "[erosion.bedrock]\nclosure = \"cohesive\"\nerosion_rate = \"2 g/m^2/s\"\n"
+      "critical_shear = \"1 kPa\"\n"
+      "[[inflow]]\npoint = [0.0, 1.0]\nhydrograph = [[0, 1.0]]\nsediment_concentration = 0.01\n");
+  EXPECT_EQ(p.inflow[0].sediment_concentration, 0.01);
+  EXPECT_NEAR(p.erosion.soil_thickness.value, 0.3, 1e-15);
+  EXPECT_NEAR(p.erosion.bedrock.erosion_rate, 2e-3, 1e-15);
+  EXPECT_EQ(p.erosion.bedrock.critical_shear, 1000.0);
+  validate(p, "test");
+  std::string msg = config_error_message([] {
+    from_text(
+        "[[inflow]]\npoint = [0.0, 1.0]\nhydrograph = [[0, 1.0]]\n"
+        "sediment_concentration = 1.5\n");
+  });
+  EXPECT_NE(msg.find("'inflow[0].sediment_concentration'"), std::string::npos) << msg;
+  msg = config_error_message([] {
+    Params q = from_text(
+        "[dem]\nsynthetic = \"hill\"\n[[inflow]]\npoint = [0.0, 1.0]\n"
+        "hydrograph = [[0, 1.0]]\nsediment_concentration = 0.1\n");
+    validate(q, "test");
+  });
+  EXPECT_NE(msg.find("erosion.enabled"), std::string::npos) << msg;
+  msg = config_error_message([] { from_text("[erosion.soil]\ncritical_shear = \"2 m\"\n"); });
+  EXPECT_NE(msg.find("'erosion.soil.critical_shear'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Pa"), std::string::npos) << msg;
+  msg = config_error_message([] { from_text("[erosion]\nlaw = \"meii\"\n"); });
+  EXPECT_NE(msg.find("mei"), std::string::npos) << msg;
+}
+
 TEST(Schema, ScalarOrRaster) {
   Params p = from_text("[initial]\nwater_depth = \"2020_depth.tif\"\n");
   EXPECT_EQ(p.initial.water_depth.path, "2020_depth.tif");

@@ -229,6 +229,52 @@ TEST_P(Sediment, ClearWaterAdaptsToEngelundHansenOverTheSettlingLength) {
       target().label().c_str(), len, len / dx, c_eq, err, 0.1 * a, flux, q_t);
 }
 
+// ---- a channel fed at capacity ----------------------------------------------------------
+
+TEST_P(Sediment, ChannelFedAtCapacityCarriesTheEquilibriumFlux) {
+  // A 2 km channel of slope 1e-3 (n 0.03; ManningPlane, local inertial, adaptive steps) fed with
+  // q = 1 m^2/s carrying Engelund & Hansen's c_eq of its normal flow (h = 0.969 m, u = 1.03 m/s:
+  // theta' = 0.22, 7 times theta_c; c_eq = 2.6e-4) through a line inflow
+  // (inflow.sediment_concentration), open outlet, 0.5 mm sand. After 8000 s the flow is uniform
+  // and the sediment in equilibrium: the flux c q through the east faces of the middle half
+  // must be Engelund & Hansen's q_t within 1 % (the bound; the normal depth itself is
+  // met to 1e-4 here, ManningPlaneNormalDepth). An idle solver carries nothing; clear water fed
+  // in would have to pick the load up first (a settling length of 14 m here, so the middle is
+  // in equilibrium either way: the figure checks the closure's equilibrium, the inflow's
+  // sediment is checked by the ledger, which must count it to close).
+  const Grains g;
+  ManningPlane plane;
+  plane.q = 1.0;
+  const double h = plane.normal_depth(), u = plane.q / h, n = plane.manning;
+  const double c_eq = g.c_eq(h, u, n);
+  Params p = plane.params(1.0);
+  p.time.adaptive = true;
+  p.time.dt_max = 5.0;
+  p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::physical;
+  p.inflow[0].sediment_concentration = c_eq;
+  auto sim = make_simulation(plane.terrain(), p, target());
+  while (sim.time() < 8000.0) sim.step();
+  const auto s = middle_row(sim, FieldId::sediment), d = middle_row(sim, FieldId::water_depth),
+             f = middle_row(sim, FieldId::flux_right);
+  double flux = 0;
+  for (int c = plane.n / 4; c < 3 * plane.n / 4; ++c)
+    flux += s[c] / d[c] * f[c] / plane.dx / (plane.n / 2);
+  const double q_t = c_eq * plane.q;
+  const Ledger& L = sim.ledger();
+  vr::expect_below(
+      figure("sediment_channel_at_capacity", "physical", "|sediment flux / q_t - 1| (middle half)",
+             plane.dx, "Engelund & Hansen's q_t of the normal flow"),
+      std::abs(flux / q_t - 1.0), 0.01);
+  EXPECT_GT(L.sediment_inflow, 0.5 * q_t * 3 * plane.dx * 8000.0);
+  EXPECT_LT(std::abs(L.relative_material_closure_error()), bound(1e-12, 1e-6));
+  std::printf(
+      "[channel at capacity] %s: c_eq %.4e, flux %.6e of q_t %.6e m^2/s (%.2e); sediment "
+      "in %.4e m^3, out %.4e; material closure %.2e of what moved\n",
+      target().label().c_str(), c_eq, flux, q_t, flux / q_t - 1.0, L.sediment_inflow,
+      L.sediment_out, L.relative_material_closure_error());
+}
+
 // ---- Exner in a closed box -------------------------------------------------------------
 
 TEST_P(Sediment, ExnerWithPorosityInAClosedBox) {

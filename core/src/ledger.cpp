@@ -14,6 +14,7 @@ const std::vector<LedgerEntry>& ledger_entries() {
                                               {"water", &Ledger::water},
                                               {"rain", &Ledger::rain},
                                               {"inflow", &Ledger::inflow},
+                                              {"sediment_inflow", &Ledger::sediment_inflow, true},
                                               {"material_initial", &Ledger::material_initial},
                                               {"material", &Ledger::material},
 #define ERODEM_TALLY_ENTRY(name, zero_if_absent, doc) {#name, &Ledger::name, zero_if_absent},
@@ -33,12 +34,25 @@ std::string Ledger::format() const {
   s += fmt::format("           clipped {:>18.9e}\n", clipped);
   s += fmt::format("           exchanged between cells {:>14.9e}\n", water_exchanged);
   // the tallies this table does not name (ERODEM_TALLIES grows without editing it)
-  static const std::set<std::string> named{"water_initial", "water",           "rain",
-                                           "inflow",        "boundary_out",    "evaporated",
-                                           "clipped",       "water_exchanged", "material_initial",
-                                           "material",      "sediment_out",    "transport_change",
-                                           "eroded",        "deposited",       "sediment_exchanged",
-                                           "thermal_moved", "eroded_bedrock",  "bed_bulking"};
+  static const std::set<std::string> named{"water_initial",
+                                           "water",
+                                           "rain",
+                                           "inflow",
+                                           "boundary_out",
+                                           "evaporated",
+                                           "sediment_inflow",
+                                           "clipped",
+                                           "water_exchanged",
+                                           "material_initial",
+                                           "material",
+                                           "sediment_out",
+                                           "transport_change",
+                                           "eroded",
+                                           "deposited",
+                                           "sediment_exchanged",
+                                           "thermal_moved",
+                                           "eroded_bedrock",
+                                           "bed_bulking"};
   for (const auto& e : ledger_entries())
     if (!named.count(e.name))
       s += fmt::format("           {:<24} {:>14.9e}\n", e.name, this->*e.member);
@@ -47,6 +61,8 @@ std::string Ledger::format() const {
   s += fmt::format("  material initial {:>18.9e}   now {:>18.9e}\n", material_initial, material);
   s += fmt::format("           sediment out {:>13.9e}   transport change {:>10.3e}\n", sediment_out,
                    transport_change);
+  if (sediment_inflow != 0)
+    s += fmt::format("           sediment in  {:>13.9e}   (inflows)\n", sediment_inflow);
   s += fmt::format("           eroded  {:>18.9e}   deposited {:>12.9e}\n", eroded, deposited);
   s += fmt::format("           exchanged: sediment {:>14.9e}   thermal {:>14.9e}\n",
                    sediment_exchanged, thermal_moved);

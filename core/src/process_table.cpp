@@ -62,7 +62,10 @@ std::vector<SweepInfo> sources_sweeps(const Params& p) {
                  {{"kind", R}, {"rain_factor", R}, {"water_depth", U}},
                  {"sources_rain"}});
   if (!p.inflow.empty())
-    s.push_back({"sources_points", Domain::points, {{"water_depth", U}}, {"sources_points"}});
+    s.push_back({"sources_points",
+                 Domain::points,
+                 {{"water_depth", U}, {"sediment", U}},  // the sediment it brings
+                 {"sources_points"}});
   return s;
 }
 

@@ -3,6 +3,8 @@
 // keys, and the public API (parsing, --set, validation, dump_toml, parameter docs).
 #include "erodem/schema.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <limits>
 #include <optional>
@@ -154,6 +156,11 @@ void check_cross_fields(const Params& p, const std::string& source) {
     throw fail("rain.rate", "give rain.rate or rain.series, not both");
   }
   if (p.output.path.empty()) throw fail("output.path", "must not be empty");
+  for (std::size_t k = 0; k < p.inflow.size(); ++k)
+    if (p.inflow[k].sediment_concentration > 0 && !p.erosion.enabled)
+      throw fail(fmt::format("inflow[{}].sediment_concentration", k),
+                 "sediment enters only with erosion.enabled = true (the sediment it carries moves "
+                 "and settles with erosion and transport)");
   if (p.erosion.bedrock_level && p.erosion.soil_thickness.is_raster())
     throw fail("erosion.bedrock_level",
                "give erosion.bedrock_level or a raster erosion.soil_thickness, not both (the "

@@ -103,12 +103,16 @@ Descriptor hardness_descriptor(const char* key, const char* doc) {
 // ---- inflow -----------------------------------------------------------------------------
 
 const Range kDischargeRange = at_least(0);
+const Range kConcentrationRange = right_open(0, 1);
 
 void check_inflow(const InflowSpec& in, const Where& w) {
   if (in.vertices.empty()) throw w.fail("needs a point = [x, y] or a line = [[x, y], ...]");
   check_points(in.vertices, w.sub(in.vertices.size() == 1 ? ".point" : ".line"));
   if (in.hydrograph.empty()) throw w.sub(".hydrograph").fail("needs at least one [t, Q] pair");
   check_series(in.hydrograph, Dimension::discharge, kDischargeRange, w.sub(".hydrograph"));
+  if (!kConcentrationRange.contains(in.sediment_concentration))
+    throw w.sub(".sediment_concentration")
+        .fail("expected a volume concentration " + kConcentrationRange.text());
 }
 
 /// One inflow table: point = [x, y] or line = [[x, y], ...], and hydrograph = [[t, Q], ...].
@@ -132,8 +136,11 @@ InflowSpec read_inflow(const toml::node& n, const Where& w) {
       has_line = true;
     } else if (name == "hydrograph") {
       in.hydrograph = read_series(v, Dimension::discharge, kDischargeRange, wk);
+    } else if (name == "sediment_concentration") {
+      in.sediment_concentration = read_double(v, Dimension::dimensionless, kConcentrationRange, wk);
     } else {
-      throw wk.fail("unknown inflow key; accepted: point, line, hydrograph");
+      throw wk.fail(
+          "unknown inflow key; accepted: point, line, hydrograph, sediment_concentration");
     }
   }
   if (has_point && has_line) throw w.fail("give a point or a line, not both");
@@ -147,7 +154,8 @@ Descriptor inflow_descriptor(const char* key, const char* doc) {
   };
   Descriptor d = base(key, access, "inflow list", Dimension::discharge,
                       "[[inflow]] tables: point = [x, y] or line = [[x, y], ...], "
-                      "hydrograph = [[t, Q], ...] with Q >= 0 (m^3/s)",
+                      "hydrograph = [[t, Q], ...] with Q >= 0 (m^3/s), optional "
+                      "sediment_concentration in [0, 1) (1, solid volume per water volume)",
                       doc);
   d.assign = [](Params& p, const toml::node& n, const Where& w) {
     const toml::array& a = read_array(n, "an array of inflow tables ([[inflow]])", w);
@@ -177,6 +185,8 @@ std::string format_inflow_tables(const std::vector<InflowSpec>& list, const std:
       out += "line = " + format_points(in.vertices) + "\n";
     }
     out += "hydrograph = " + format_series(in.hydrograph) + "\n";
+    if (in.sediment_concentration != 0.0)
+      out += "sediment_concentration = " + format_number(in.sediment_concentration) + "\n";
   }
   return out;
 }

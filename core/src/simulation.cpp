@@ -357,7 +357,9 @@ StepInputs Simulation::inputs_for(double dt) const {
   for (const auto& ic : inflows_) {
     const double q = series_value(params_.inflow[ic.spec].hydrograph, t_mid);
     const double share = q * dt / static_cast<double>(ic.cells.size());
-    for (auto cell : ic.cells) in.points.push_back({cell, share});
+    // the sediment it brings (only where sediment moves: erosion on; schema.cpp checks)
+    const double c = params_.erosion.enabled ? params_.inflow[ic.spec].sediment_concentration : 0;
+    for (auto cell : ic.cells) in.points.push_back({cell, share, c * share});
   }
   return in;
 }
@@ -412,10 +414,11 @@ void Simulation::step() {
   probes_ = std::move(result.probes);
   probes_current_ = true;
 
-  double added = 0.0;
-  for (const auto& p : in.points) added += p.volume;
+  double added = 0.0, sediment_added = 0.0;
+  for (const auto& p : in.points) added += p.volume, sediment_added += p.sediment;
   ledger_.rain += in.rain_rate * dt * rain_area_;
   ledger_.inflow += added;
+  ledger_.sediment_inflow += sediment_added;
   for (const auto& t : tally_table()) ledger_.*t.ledger += tally.*t.step;
   ledger_.water = stats_.water_volume;
   ledger_.material = stats_.material_volume;

@@ -240,6 +240,12 @@ CASES = {
         "c_eq (1 - exp(-x / L)) to first-order upwind accuracy; the outlet flux is Engelund & "
         "Hansen's q_t.",
     ),
+    "sediment_channel_at_capacity": (
+        "Physical law: a channel fed at capacity carries the equilibrium flux",
+        "A 2 km channel of slope 1e-3 (n 0.03, local inertial), 1 m^2/s fed with Engelund & "
+        "Hansen's c_eq of its normal flow through a line inflow, 0.5 mm sand, 8000 s.",
+        "The sediment flux through the middle half equals q_t of the closure.",
+    ),
     "sediment_exner_box": (
         "Physical law: Exner with porosity in a closed box",
         "64 x 64 cells of Big Tujunga, closed edges, 100 mm/h for 600 s, default physical law.",

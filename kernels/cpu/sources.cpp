@@ -28,6 +28,8 @@ void CpuBackend<Real>::run_sources(const StepInputs& in) {
     const auto i = padded(p.cell);
     const int y = static_cast<int>(i / static_cast<std::size_t>(W_));
     depth_[i] += static_cast<Real>(p.volume / static_cast<double>(area_[y]));
+    if (p.sediment != 0)
+      sediment_[i] += static_cast<Real>(p.sediment / static_cast<double>(area_[y]));
   }
 }
 

@@ -251,11 +251,16 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   if (in.points.empty()) return;
   std::vector<cl_int> cells;
   std::vector<Real> amounts;
+  bool sediment = false;
   for (const auto& p : in.points) {
     const int x = static_cast<int>(p.cell % nx_) + 1, y = static_cast<int>(p.cell / nx_) + 1;
     cells.push_back(x + y * W_);
     amounts.push_back(static_cast<Real>(p.volume / area_host_[y]));
+    sediment = sediment || p.sediment != 0;
   }
+  if (sediment)  // the sediment's amounts after the water's (sources_points)
+    for (const auto& p : in.points)
+      amounts.push_back(static_cast<Real>(p.sediment / area_host_[p.cell / nx_ + 1]));
   // The previous upload (if any) may still read the host vectors.
   if (points_written_) {
     cl_event e = points_written_.get();
@@ -269,7 +274,7 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   if (cells_h.size() > point_capacity_) {
     point_capacity_ = std::max<std::size_t>(cells_h.size(), 2 * point_capacity_);
     point_cells_ = make_buffer(point_capacity_ * sizeof(cl_int));
-    point_amounts_ = make_buffer(point_capacity_ * sizeof(Real));
+    point_amounts_ = make_buffer(2 * point_capacity_ * sizeof(Real));  // water, sediment
   }
   // Non-blocking uploads (the queue is in order): the step does not wait for the device.
   check(clEnqueueWriteBuffer(queue_.get(), point_cells_.get(), CL_FALSE, 0,
@@ -282,7 +287,8 @@ void OpenClBackend::run_sources(const StepInputs& in) {
       "clEnqueueWriteBuffer");
   points_written_ = Event(written);
   cl_kernel k = kernel("sources_points");
-  set_args(k, depth_, point_cells_, point_amounts_, static_cast<cl_int>(cells_h.size()));
+  set_args(k, depth_, sediment_, point_cells_, point_amounts_, static_cast<cl_int>(cells_h.size()),
+           cl_int{sediment ? 1 : 0});
   const std::size_t one = 1;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &one, nullptr, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel(sources_points)");

@@ -15,9 +15,13 @@ __kernel void sources_rain(int W, int H, __global const uchar* restrict kind,
 
 /* Point and line inflows, one work-item adding them in order (a cell may appear twice):
  * cells are padded indices, amounts the depth each adds (volume / area, rounded on the host
- * as the CPU reference rounds it). */
-__kernel void sources_points(__global real* restrict depth, __global const int* restrict cells,
-                             __global const real* restrict amounts, int count) {
+ * as the CPU reference rounds it), and where `with_sediment` the sediment each brings after
+ * them (amounts[count + k], m of solid). */
+__kernel void sources_points(__global real* restrict depth, __global real* restrict sediment,
+                             __global const int* restrict cells,
+                             __global const real* restrict amounts, int count, int with_sediment) {
   if (get_global_id(0) != 0) return;
   for (int k = 0; k < count; ++k) depth[cells[k]] += amounts[k];
+  if (with_sediment)
+    for (int k = 0; k < count; ++k) sediment[cells[k]] += amounts[count + k];
 }

@@ -32,6 +32,7 @@ const char* process_name(Process p);
 struct PointSource {
   std::int64_t cell = 0;  ///< row-major DEM cell index (row * nx + col)
   double volume = 0.0;    ///< m^3 added this step
+  double sediment = 0.0;  ///< m^3 of solid sediment it brings (inflow.sediment_concentration)
 };
 
 /// What a process needs to know about the current step.

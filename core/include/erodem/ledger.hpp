@@ -49,6 +49,8 @@ struct Ledger {
   double water = 0.0;
   double rain = 0.0;    ///< cumulative rain volume
   double inflow = 0.0;  ///< cumulative point/line inflow volume
+  /// cumulative solid sediment the inflows brought (inflow.sediment_concentration)
+  double sediment_inflow = 0.0;
   // material: bed + suspended sediment (m^3)
   double material_initial = 0.0;
   double material = 0.0;
@@ -79,16 +81,18 @@ struct Ledger {
     const double scale = water_moved();
     return scale > 0 ? closure_error() / scale : 0.0;
   }
-  /// M(t) - M(0) + sediment out - transport change + bed bulking: 0 up to rounding (m^3).
+  /// M(t) - M(0) - sediment inflow + sediment out - transport change + bed bulking: 0 up to
+  /// rounding (m^3).
   /// M is the bed's volume plus the suspended solid: erosion from a porous layer lowers the
   /// bed by more than the solid it lifts (bed_bulking; 0 with Mei's law).
   double material_closure_error() const {
-    return material - material_initial + sediment_out - transport_change + bed_bulking;
+    return material - material_initial - sediment_inflow + sediment_out - transport_change +
+           bed_bulking;
   }
-  /// What moved of the material (m^3): max(eroded + deposited + sediment out, sediment and
+  /// What moved of the material (m^3): max(eroded + deposited + sediment out + in, sediment and
   /// bed exchanged between cells, kVolumeEpsilon * material on the grid).
   double material_moved() const {
-    return std::max({eroded + deposited + std::abs(sediment_out),
+    return std::max({eroded + deposited + std::abs(sediment_out) + sediment_inflow,
                      sediment_exchanged + thermal_moved + std::abs(transport_change),
                      kVolumeEpsilon * std::max(std::abs(material_initial), std::abs(material))});
   }

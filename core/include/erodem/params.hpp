@@ -62,6 +62,8 @@ using Series = std::vector<SeriesPoint>;
 struct InflowSpec {
   std::vector<std::array<double, 2>> vertices;  ///< x, y in the DEM's CRS
   Series hydrograph;                            ///< time (s), discharge (m^3/s)
+  /// Volume concentration of solid sediment in the water it brings (1); 0 = clear water.
+  double sediment_concentration = 0.0;
 };
 
 struct Params {
