@@ -91,6 +91,8 @@ CellParams<real> cell_params_of(const Params& params) {
   const auto r = [](double v) { return static_cast<real>(v); };
   CellParams<real> c{};
   c.boundary.sea_level = r(params.boundary.sea_level);
+  c.boundary.sediment_concentration =
+      r(params.erosion.enabled ? params.boundary.sediment_concentration : 0.0);
 
   const auto& f = params.flow;
   c.flow.gravity = r(f.gravity);
@@ -168,7 +170,7 @@ extern template ParamBytes cell_params_bytes(const CellParams<double>&, Process)
 
 // Members of type real or int only: the host's structs have the device's layout (OpenCL
 // passes them by value as kernel arguments).
-static_assert(sizeof(cell_params::BoundaryParams<float>) == 1 * sizeof(float));
+static_assert(sizeof(cell_params::BoundaryParams<float>) == 2 * sizeof(float));
 static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));

@@ -98,7 +98,9 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
       else
         s.depth[p] = params.initial.water_depth.value;
     }
-  // Nodata cells: sea ghosts hold the sea over a bed no higher than their active neighbours.
+  // Nodata cells: sea ghosts hold the sea over a bed no higher than their active neighbours,
+  // and the sediment its water carries in.
+  s.sediment.assign(n, 0.0);
   const double sea = params.boundary.sea_level;
   for (int y = 1; y <= ny; ++y)
     for (int x = 1; x <= nx; ++x) {
@@ -109,6 +111,8 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
         if (s.kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, s.bed[q]);
       s.bed[p] = s.kind[p] == ERODEM_CELL_FIXED ? low : 0.0;
       s.depth[p] = s.kind[p] == ERODEM_CELL_FIXED ? sea - low : 0.0;
+      if (params.erosion.enabled)
+        s.sediment[p] = params.boundary.sediment_concentration * s.depth[p];
     }
 
   // Rasters or scalars; halo cells copy the nearest DEM cell (Manning n is read at faces).

@@ -275,6 +275,61 @@ TEST_P(Sediment, ChannelFedAtCapacityCarriesTheEquilibriumFlux) {
       L.sediment_out, L.relative_material_closure_error());
 }
 
+// ---- sediment-laden sea water -----------------------------------------------------------
+
+TEST_P(Sediment, SeaWaterBringsItsConcentrationIn) {
+  // A dry basin of 30 x 10 cells of 2 m, its floor 0.5 to 1.1 m below the sea, behind the sea:
+  // a fixed_level west edge, or a west column of nodata cells with boundary.nodata = "sea".
+  // The sea water carries boundary.sediment_concentration = 0.02; the bed neither gives nor
+  // takes (theta_c = 100, w_s = 1e-16 m/s), so after 300 steps of 0.1 s the suspended solid must
+  // be 0.02 times the water that came in (the ledger's -boundary_out): bound 1e-12 (float64)
+  // and 1e-5 (float32 rounding of s / d times the fluxes), and the ledger must count it as
+  // sediment in (sediment_out = -0.02 x water in, material closure at rounding). Clear sea
+  // water (the default) or a ghost that gave none would bring 0.
+  const int nx = 30, ny = 10;
+  const double dx = 2.0, dt = 0.1, c_b = 0.02;
+  for (bool nodata_sea : {false, true}) {
+    Terrain t = flat_terrain(nx, ny, dx);
+    for (int r = 0; r < ny; ++r)
+      for (int c = 0; c < nx; ++c)
+        t.bed[static_cast<std::size_t>(r) * nx + c] = -0.5 - 0.6 * c / (nx - 1.0);
+    Params p = sediment_params(Grains{}, dt);
+    p.flow.manning_n.value = 0.03;
+    p.boundary.sea_level = 0.0;
+    p.boundary.sediment_concentration = c_b;
+    p.erosion.critical_shields = 100.0;
+    p.erosion.settling_velocity = 1e-16;  // settles w_s t / h = 6e-15 of it in 30 s
+    if (nodata_sea) {
+      t.mask.assign(t.grid.cells(), 1);
+      for (int r = 0; r < ny; ++r) t.mask[static_cast<std::size_t>(r) * nx] = 0;
+      p.boundary.nodata = NodataKind::sea;
+    } else {
+      p.boundary.west = BoundaryKind::fixed_level;
+    }
+    auto sim = make_simulation(t, p, target());
+    sim.step(300);
+    const Ledger& L = sim.ledger();
+    const auto s = sim.field(FieldId::sediment);
+    double suspended = 0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if (t.active(i)) suspended += s[i] * dx * dx;
+    const double water_in = -L.boundary_out;
+    const double err = std::abs(suspended / (c_b * water_in) - 1.0);
+    const char* scheme = nodata_sea ? "physical, sea nodata" : "physical, fixed_level edge";
+    vr::expect_below(figure("sediment_sea_inflow", scheme, "|suspended / (c_b x water in) - 1|", dx,
+                            "the sea's concentration times the water it gave"),
+                     err, bound(1e-12, 1e-5));
+    EXPECT_GT(water_in, 10.0) << "the sea must flood in";
+    EXPECT_NEAR(L.sediment_out, -c_b * water_in, 1e-5 * c_b * water_in);
+    EXPECT_LT(std::abs(L.relative_material_closure_error()), bound(1e-12, 1e-6));
+    std::printf(
+        "[sea sediment] %s %s: water in %.4f m^3, suspended %.6e m^3 (%.2e off), "
+        "sediment out %.6e, material closure %.2e\n",
+        target().label().c_str(), scheme, water_in, suspended, err, L.sediment_out,
+        L.relative_material_closure_error());
+  }
+}
+
 // ---- Exner in a closed box -------------------------------------------------------------
 
 TEST_P(Sediment, ExnerWithPorosityInAClosedBox) {

@@ -49,7 +49,7 @@ std::vector<SweepInfo> boundary_sweeps(const Params&) {
   // boundary_fill_cell (boundary.h): the ghosts take the bed and depth their edge gives them
   return {{"boundary_fill",
            Domain::halo,
-           {{"kind", R}, {"bed", U}, {"water_depth", U}},
+           {{"kind", R}, {"bed", U}, {"water_depth", U}, {"sediment", U}},
            {"boundary_fill"}}};
 }
 

@@ -214,6 +214,9 @@ const std::vector<Descriptor>& descriptor_table() {
       choice(ERODEM_FIELD(boundary.south), boundary, "south edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.east), boundary, "east edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.west), boundary, "west edge: closed, open or fixed_level"),
+      number(ERODEM_FIELD(boundary.sediment_concentration), D::dimensionless, right_open(0, 1),
+             "volume concentration of solid sediment in the water fixed_level edges and sea "
+             "nodata cells give (1); 0 = clear water"),
       number(ERODEM_FIELD(boundary.sea_level), D::length, any_finite(),
              "water level of fixed_level edges and sea nodata cells (m)"),
       choice(ERODEM_FIELD(boundary.nodata),

@@ -246,6 +246,13 @@ CASES = {
         "Hansen's c_eq of its normal flow through a line inflow, 0.5 mm sand, 8000 s.",
         "The sediment flux through the middle half equals q_t of the closure.",
     ),
+    "sediment_sea_inflow": (
+        "Physical law: the sea brings its sediment in",
+        "A dry basin of 30 x 10 cells of 2 m, 0.5-1.1 m below the sea, floods for 30 s from a "
+        "fixed-level west edge or a column of sea nodata cells carrying "
+        "boundary.sediment_concentration = 0.02; the bed neither gives nor takes.",
+        "The suspended solid is 0.02 times the water that came in; the ledger books it.",
+    ),
     "sediment_exner_box": (
         "Physical law: Exner with porosity in a closed box",
         "64 x 64 cells of Big Tujunga, closed edges, 100 mm/h for 600 s, default physical law.",

@@ -6,18 +6,20 @@
 
 /* The run constants of the boundary ghosts (boundary_params, kernels/cell_params.cpp). */
 ERODEM_PARAMS(BoundaryParams, {
-  real sea_level; /* the level of fixed_level edges and of sea nodata cells (m) */
+  real sea_level;              /* the level of fixed_level edges and of sea nodata cells (m) */
+  real sediment_concentration; /* c_b (1): the solid in the water fixed-level ghosts give */
 })
 
 ERODEM_BEGIN_NAMESPACE
 
-/* Set bed and depth of halo cell (x, y) from the edge cell inside it:
+/* Set bed, depth and sediment of halo cell (x, y) from the edge cell inside it:
  *  - open: bed one cell of the local slope below the edge cell's bed, same depth (free,
- *    zero-gradient outflow);
- *  - fixed_level: water surface at sea_level (m) over a bed no higher than the edge's.
+ *    zero-gradient outflow), no sediment (it gives no water);
+ *  - fixed_level: water surface at sea_level (m) over a bed no higher than the edge's, holding
+ *    c_b of its depth as sediment (m of solid), which the water it gives carries in.
  * Walls and corners keep what they have: no water crosses their faces. */
 ERODEM_FN void boundary_fill_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
-                                  GLOBAL real* bed, GLOBAL real* depth,
+                                  GLOBAL real* bed, GLOBAL real* depth, GLOBAL real* sediment,
                                   ERODEM_P(BoundaryParams) p) {
   const real sea_level = p.sea_level;
   const int i = x + y * W;
@@ -42,10 +44,12 @@ ERODEM_FN void boundary_fill_cell(int x, int y, int W, int H, GLOBAL const erode
     const real slope_drop = has_inner ? fabs(b_e - bed[e2]) : (real)0;
     bed[i] = b_e - slope_drop;
     depth[i] = depth[e];
+    sediment[i] = (real)0;
   } else {
     const real b_g = fmin(b_e, sea_level);
     bed[i] = b_g;
     depth[i] = sea_level - b_g;
+    sediment[i] = p.sediment_concentration * (sea_level - b_g);
   }
 }
 

@@ -14,9 +14,11 @@ ERODEM_FN real sediment_concentration(real sediment, real depth) {
   return wet ? c : (real)0;
 }
 
-/* Sediment volume (m^3) that padded cell i carries out of the domain in dt (s): its
- * concentration times what flows through its faces with ghosts. Only cells beside a ghost
- * have one (the OpenCL backend sums it over a list of them, kernels/opencl/edges.cl). */
+/* Net sediment volume (m^3) that padded cell i carries out of the domain in dt (s): its
+ * concentration times what flows through its faces to ghosts, less what the ghosts' water
+ * brings in at theirs (fixed-level ghosts hold boundary.sediment_concentration of their depth;
+ * others none). Only cells beside a ghost have one (the OpenCL backend sums it over a list of
+ * them, kernels/opencl/edges.cl). */
 ERODEM_FN real transport_boundary_out_cell(int i, int W, GLOBAL const erodem_kind_t* kind,
                                            GLOBAL const real* sediment,
                                            GLOBAL const real* depth_flow, GLOBAL const real* f_left,
@@ -28,7 +30,21 @@ ERODEM_FN real transport_boundary_out_cell(int i, int W, GLOBAL const erodem_kin
                          (kind[i + 1] != ERODEM_CELL_ACTIVE ? f_right[i] : (real)0) +
                          (kind[i - W] != ERODEM_CELL_ACTIVE ? f_top[i] : (real)0) +
                          (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] : (real)0);
-  return dt * c * to_ghosts;
+  const real from_ghosts =
+      (real)0 +
+      (kind[i - 1] != ERODEM_CELL_ACTIVE
+           ? sediment_concentration(sediment[i - 1], depth_flow[i - 1]) * f_right[i - 1]
+           : (real)0) +
+      (kind[i + 1] != ERODEM_CELL_ACTIVE
+           ? sediment_concentration(sediment[i + 1], depth_flow[i + 1]) * f_left[i + 1]
+           : (real)0) +
+      (kind[i - W] != ERODEM_CELL_ACTIVE
+           ? sediment_concentration(sediment[i - W], depth_flow[i - W]) * f_bottom[i - W]
+           : (real)0) +
+      (kind[i + W] != ERODEM_CELL_ACTIVE
+           ? sediment_concentration(sediment[i + W], depth_flow[i + W]) * f_top[i + W]
+           : (real)0);
+  return dt * c * to_ghosts - dt * from_ghosts;
 }
 
 /* Conservative (flux-form upwind) transport for active padded cell (x, y): sediment leaves

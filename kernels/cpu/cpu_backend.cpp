@@ -47,7 +47,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   bed0_ = bed_;
   bed_residual_.assign(n, Real(0));
   depth_next_ = depth_;
-  sediment_.assign(n, Real(0));
+  take(sediment_, s.sediment);
   sediment_next_ = sediment_;
   for (int k = 0; k < 4; ++k) {
     flux_[k].assign(n, Real(0));

@@ -7,7 +7,7 @@
  * row, the west column and the east column (the cells the CPU loops visit). */
 __kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
                             __global real* restrict bed, __global real* restrict depth,
-                            BoundaryParams p) {
+                            __global real* restrict sediment, BoundaryParams p) {
   const int id = (int)get_global_id(0);
   const int nxi = W - 2, nyi = H - 2;
   int x, y;
@@ -26,5 +26,5 @@ __kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
   } else {
     return;
   }
-  boundary_fill_cell(x, y, W, H, kind, bed, depth, p);
+  boundary_fill_cell(x, y, W, H, kind, bed, depth, sediment, p);
 }

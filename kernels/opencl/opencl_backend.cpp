@@ -86,8 +86,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   bed_residual_ = upload(std::vector<Real>(bed_r.size(), Real(0)));
   depth_ = upload(depth_r);
   depth_next_ = upload(depth_r);
-  sediment_ = upload(zeros);
-  sediment_next_ = upload(zeros);
+  sediment_ = upload(to_real(state.sediment));
+  sediment_next_ = upload(to_real(state.sediment));
   for (int k = 0; k < 4; ++k) {
     flux_[k] = upload(zeros);
     flux_next_[k] = upload(zeros);
@@ -234,7 +234,7 @@ StepResult OpenClBackend::end_step() {
 
 void OpenClBackend::run_boundary() {
   cl_kernel k = kernel("boundary_fill");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, cell_.boundary);
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, cell_.boundary);
   const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
         "clEnqueueNDRangeKernel(boundary_fill)");

@@ -180,6 +180,9 @@ struct Params {
     BoundaryKind east = BoundaryKind::closed;
     BoundaryKind west = BoundaryKind::closed;
     double sea_level = 0.0;  ///< level of fixed_level edges and sea nodata cells (m)
+    /// Volume concentration of solid sediment in the water that fixed_level edges and sea
+    /// nodata cells give (1); 0 = clear water.
+    double sediment_concentration = 0.0;
     NodataKind nodata = NodataKind::wall;
   } boundary;
 

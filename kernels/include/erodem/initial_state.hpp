@@ -18,6 +18,8 @@ struct PaddedState {
   std::vector<std::uint8_t> kind;    ///< ERODEM_CELL_* of every padded cell
   std::vector<double> dx, dy, area;  ///< per padded row (m, m, m^2); halo rows repeat
   std::vector<double> bed, depth;    ///< m; ghosts as the boundary kinds set them
+  /// m of solid: 0, but sea nodata cells hold boundary.sediment_concentration of their depth
+  std::vector<double> sediment;
   std::vector<double> manning, hardness, rain_factor;  ///< rasters or the scalar parameter
   std::size_t at(int x, int y) const {
     return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
