@@ -190,7 +190,8 @@ inline double erodem_cbrt_positive(double x) {
  * 0.35 (ln 2 in two parts, Cody & Waite, so n ln2_hi is exact), exp(-r) by its Taylor
  * polynomial to r^7 (error below 6e-9), times 2^-n built from its bits; 0 beyond x = 87 (below
  * the smallest normal float). The weight by its Taylor series to x^7 below x = 0.5 (error
- * below 2e-8), else from exp(-x). Branch-free, so loops vectorise. For double: the C
+ * below 2e-8), else from exp(-x). Branch-free (the choices are products with 0 or 1), so
+ * loops vectorise. For double: the C
  * library's exp and expm1 (the CPU float64 reference). */
 ERODEM_BEGIN_NAMESPACE
 ERODEM_INLINE float exp_neg_f32(float x) {
@@ -206,7 +207,10 @@ ERODEM_INLINE float exp_neg_f32(float x) {
   p = p * r - 1.0f;
   p = p * r + 1.0f;
   const float scale = erodem_bits_float((unsigned int)(127 - n) << 23);
-  return x < 87.0f ? p * scale : 0.0f;
+  /* times 1 or 0, not a select: GCC threads a select on x < 87 through the clamp above into
+   * two paths, and the loop then is not vectorised ("control flow in loop") */
+  const float in_range = (float)(x < 87.0f);
+  return p * scale * in_range;
 }
 ERODEM_INLINE float relax_weight_f32(float x) {
   float p = -2.48015873e-5f; /* -1/8! */
@@ -217,8 +221,9 @@ ERODEM_INLINE float relax_weight_f32(float x) {
   p = p * x + 1.66666667e-1f;
   p = p * x - 0.5f;
   p = p * x + 1.0f;
-  const float large = (1.0f - exp_neg_f32(x)) / (x > 0.5f ? x : 1.0f);
-  return x > 0.5f ? large : p;
+  const float big = (1.0f - exp_neg_f32(x)) / (x > 0.5f ? x : 1.0f);
+  const float large = (float)(x > 0.5f); /* the same blend by 1 and 0 (exact: both finite) */
+  return large * big + (1.0f - large) * p;
 }
 ERODEM_END_NAMESPACE
 

@@ -229,7 +229,10 @@ ERODEM_FN ERODEM_S(BedLoad)
   ERODEM_S(BedLoad) r;
   r.tau = bed_shear_stress(h, u, v, n, p.rho_g / p.gravity, p.gravity, p.min_depth);
   const real n2 = n * n;
-  const real skin = p.skin_n2 < n2 ? p.skin_n2 / n2 : (real)1;
+  /* divisions unconditional, by a safe denominator: a division under a condition stays a
+   * branch (it may trap), and the loop then is not vectorised */
+  const int rough = p.skin_n2 < n2;
+  const real skin = rough ? p.skin_n2 / (rough ? n2 : (real)1) : (real)1;
   r.theta = r.tau / p.shields_scale;
   r.theta_skin = r.theta * skin;
   const real slope_crit = p.shields_slope * sqrt(sqrt(sqrt(tan2)));
@@ -286,10 +289,14 @@ ERODEM_FN real layer_exchange(int cohesive, real rate, real inv_tau_e, real inv_
                               ERODEM_P(SedimentParams) p) {
   const real settle = p.settling / h_f;
   const real krone = (real)1 - tau * inv_tau_d;
-  const real k = cohesive ? settle * (krone > (real)0 ? krone : (real)0) : settle;
+  /* the closure chosen by products with 1 and 0 (exact: both terms are finite), not by a
+   * select on the int: GCC does not vectorise the loop with that one ("no vectype") */
+  const real coh = (real)cohesive;
+  const real k = settle * (coh * (krone > (real)0 ? krone : (real)0) + ((real)1 - coh));
   const real excess = tau * inv_tau_e - (real)1;
   const real a =
-      hardness * rate * (cohesive ? (excess > (real)0 ? excess : (real)0) : p.settling * c_eq);
+      hardness * rate *
+      (coh * (excess > (real)0 ? excess : (real)0) + ((real)1 - coh) * (p.settling * c_eq));
   return s * erodem_exp_neg(k * dt) + a * relaxation_weight(k, dt);
 }
 
@@ -319,29 +326,33 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
   const real speed = sqrt(u * u + v * v);
   const real c_eq = equilibrium_concentration(h, speed, n, b, p);
   const real h_f = h > p.min_depth ? h : p.min_depth;
-  /* the soil first while there is some, then the bedrock */
-  const int on_soil = soil_l > (real)0;
+  /* the soil first while there is some, then the bedrock. The choices between the layers are
+   * blends by 1 and 0 (exact: every term is finite), not selects on their conditions: GCC
+   * does not vectorise the loop with those (a select between masks of the float compares in a
+   * loop that also compares the bytes of the kinds: "conversion not supported by target"). */
+  const real on_soil = (real)(soil_l > (real)0);
   const real s_soil = layer_exchange(p.soil_cohesive, p.soil_rate, p.soil_inv_tau_e,
                                      p.soil_inv_tau_d, s, h_f, r, c_eq, b.tau, dt, p);
   const real s_rock = layer_exchange(p.rock_cohesive, p.rock_rate, p.rock_inv_tau_e,
                                      p.rock_inv_tau_d, s, h_f, r, c_eq, b.tau, dt, p);
-  const real m_first = (on_soil ? s_soil : s_rock) - s;
+  const real m_first = (on_soil * s_soil + ((real)1 - on_soil) * s_rock) - s;
   /* the solid the soil holds (m), in exchanged solid: the bed takes morfac times it */
   const real solid_soil = soil_l / (p.soil_bulk * p.morfac);
   const real m_soil_room = m_first - solid_soil;
-  const int runs_out = on_soil & (m_soil_room > (real)0);
-  /* the rest of the step on the bedrock, from the sediment the soil gave */
-  const real rest = runs_out ? m_soil_room / m_first : (real)0;
+  const real runs_out = on_soil * (real)(m_soil_room > (real)0);
+  /* the rest of the step on the bedrock, from the sediment the soil gave (m_first > 0 where
+   * the soil runs out) */
+  const real rest = runs_out * (m_soil_room / (m_first > (real)0 ? m_first : (real)1));
   const real s1 = s + solid_soil;
   const real s_after = layer_exchange(p.rock_cohesive, p.rock_rate, p.rock_inv_tau_e,
                                       p.rock_inv_tau_d, s1, h_f, r, c_eq, b.tau, rest * dt, p);
   const real m_second = s_after - s1;
+  const real gain_1 = m_first > (real)0 ? m_first : (real)0, loss_1 = m_first - gain_1;
+  const real gain_2 = m_second > (real)0 ? m_second : (real)0, loss_2 = m_second - gain_2;
   /* solid from (+) or to (-) the soil and from the bedrock */
-  const real m_rock_only = on_soil ? (real)0 : m_first;
-  const real from_soil = runs_out ? solid_soil + (m_second < (real)0 ? m_second : (real)0)
-                                  : (on_soil ? m_first : (m_first < (real)0 ? m_first : (real)0));
-  const real from_rock = runs_out ? (m_second > (real)0 ? m_second : (real)0)
-                                  : (m_rock_only > (real)0 ? m_rock_only : (real)0);
+  const real from_soil = runs_out * (solid_soil + loss_2) +
+                         ((real)1 - runs_out) * (on_soil * m_first + ((real)1 - on_soil) * loss_1);
+  const real from_rock = runs_out * gain_2 + ((real)1 - runs_out) * (((real)1 - on_soil) * gain_1);
   const real moved = from_soil + from_rock;
   const real lowered = p.morfac * (from_soil * p.soil_bulk + from_rock * p.rock_bulk);
   const real soil_new = soil_l - p.morfac * from_soil * p.soil_bulk;
@@ -350,12 +361,12 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
   const real bed_new = two_sum(bed[i], -lowered, &e_b);
   *sediment_out = s_new;
   /* where the soil ran out it is gone (not a rounding residue of soil - its solid times bulk) */
-  *soil_out = soil_new > (real)0 && !runs_out ? soil_new : (real)0;
+  *soil_out = ((real)1 - runs_out) * (soil_new > (real)0 ? soil_new : (real)0);
   *moved_out = moved;
   *rock_out = from_rock;
   *bulking_out = lowered - moved;
   /* the sediment kept e_s less than moved: the bed gives that back, in the surface's bulk */
-  const real bulk = on_soil ? p.soil_bulk : p.rock_bulk;
+  const real bulk = on_soil * p.soil_bulk + ((real)1 - on_soil) * p.rock_bulk;
   return two_sum(bed_new, (bed_residual[i] + e_b) + e_s * bulk * p.morfac, bed_residual_out);
 }
 
