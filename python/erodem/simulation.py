@@ -320,8 +320,11 @@ class Simulation:
         ``water_moved``, ``relative_closure_error`` (1, of ``water_moved``),
         ``material_initial``, ``material``, ``sediment_out``, ``transport_change``,
         ``eroded``, ``deposited``, ``sediment_exchanged``, ``thermal_moved``,
+        ``snow_melted``, ``sediment_inflow``, ``eroded_bedrock``, ``bed_bulking``,
         ``material_closure_error``, ``material_moved``, ``relative_material_closure_error``
-        (1, of ``material_moved``). docs/model.md section 7 defines what moved."""
+        (1, of ``material_moved``). With the physical erosion law the sediment volumes are of
+        solid (times ``erosion.sediment_density`` for kg). docs/model.md section 7 defines what
+        moved."""
         return dict(self._sim.ledger)
 
     @property
