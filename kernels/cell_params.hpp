@@ -38,7 +38,8 @@ struct CellParams {
 /// erosion.*, flow.gravity, flow.water_density and numerics.velocity_min_depth: the settling
 /// velocity (Ferguson & Church 2004) and critical Shields number (Soulsby & Whitehouse 1997)
 /// unless given, the grain roughness n' = (2.5 D)^(1/6) / (8.1 sqrt g), Engelund-Hansen's
-/// 0.05 sqrt(R g D^3) and Garcia-Parker's Re_p^0.6 / w_s, and each layer's 1 / (1 - phi).
+/// 0.05 sqrt(R g D^3) and Garcia-Parker's sqrt(R g D) Re_p^0.6 / w_s, and each layer's
+/// 1 / (1 - phi).
 template <class real>
 cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
   const auto r = [](double v) { return static_cast<real>(v); };
@@ -55,7 +56,7 @@ cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
   const double skin_n = std::pow(2.5 * d, 1.0 / 6.0) / (8.1 * std::sqrt(g));
   const double re_p = std::sqrt(big_r * g * d) * d / nu;
   cell_params::SedimentParams<real> s{};
-  s.rho_g = r(rho * g);
+  s.rho = r(rho);
   s.gravity = r(g);
   s.min_depth = r(params.numerics.velocity_min_depth);
   s.shields_scale = r((e.sediment_density - rho) * g * d);
@@ -64,8 +65,7 @@ cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
   s.shields_flat = r(theta_c);
   s.shields_slope = r(e.slope_threshold ? 0.15 : 0.0);
   s.total_load = r(0.05 * std::sqrt(big_r * g * d * d * d));
-  s.pickup_z = r(std::pow(re_p, 0.6) / w_s);
-  s.inv_rho = r(1.0 / rho);
+  s.pickup_z = r(std::sqrt(big_r * g * d) * std::pow(re_p, 0.6) / w_s);
   s.max_concentration = r(e.max_concentration);
   s.pickup = e.pickup == Pickup::garcia_parker ? 1 : 0;
   const auto layer = [&](const BedLayer& l, int& cohesive, real& bulk, real& rate, real& inv_e,
@@ -174,7 +174,7 @@ static_assert(sizeof(cell_params::BoundaryParams<float>) == 2 * sizeof(float));
 static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
-static_assert(sizeof(cell_params::SedimentParams<float>) == 21 * sizeof(float) + 3 * sizeof(int));
+static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));
 static_assert(sizeof(cell_params::ThermalParams<float>) == 2 * sizeof(float));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::SnowParams<float>) == 5 * sizeof(float));

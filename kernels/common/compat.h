@@ -191,8 +191,7 @@ inline double erodem_cbrt_positive(double x) {
  * polynomial to r^7 (error below 6e-9), times 2^-n built from its bits; 0 beyond x = 87 (below
  * the smallest normal float). The weight by its Taylor series to x^7 below x = 0.5 (error
  * below 2e-8), else from exp(-x). Branch-free (the choices are products with 0 or 1), so
- * loops vectorise. For double: the C
- * library's exp and expm1 (the CPU float64 reference). */
+ * loops vectorise. For double: the C library's exp and expm1 (the CPU float64 reference). */
 ERODEM_BEGIN_NAMESPACE
 ERODEM_INLINE float exp_neg_f32(float x) {
   const float xc = x < 87.0f ? x : 87.0f;

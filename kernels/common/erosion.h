@@ -17,11 +17,11 @@ ERODEM_PARAMS(ErosionParams, {
 })
 
 /* The run constants of the physical erosion law (erosion.law = "physical", docs/model.md
- * section 4.2; sediment_params_of, kernels/cell_params.hpp, from Params::Erosion): one
+ * section 3.5.2; sediment_params_of, kernels/cell_params.hpp, from Params::Erosion): one
  * grain-size class in suspension over a bed of two layers, the loose soil over the bedrock,
  * each with its closure. Derived constants are computed once on the host in double. */
 ERODEM_PARAMS(SedimentParams, {
-  real rho_g;             /* rho g (N/m^3): water density times gravity */
+  real rho;               /* water density (kg/m^3), flow.water_density */
   real gravity;           /* g (m/s^2) */
   real min_depth;         /* h_min (m): numerics.velocity_min_depth, the thin-film depth */
   real shields_scale;     /* (rho_s - rho) g D (Pa): the Shields number is tau / this */
@@ -30,8 +30,7 @@ ERODEM_PARAMS(SedimentParams, {
   real shields_flat;      /* theta_c on a flat bed (1): Soulsby-Whitehouse or given */
   real shields_slope;     /* Lamb et al. (2008): theta_c >= this * S^(1/4) (1); 0 = off */
   real total_load;        /* 0.05 sqrt(R g D^3) (m^2/s): Engelund-Hansen's transport scale */
-  real pickup_z;          /* Re_p^0.6 / w_s (s/m): Garcia-Parker's Z per shear velocity */
-  real inv_rho;           /* 1 / rho (m^3/kg) */
+  real pickup_z;          /* sqrt(R g D) Re_p^0.6 / w_s (1): Garcia-Parker's Z per sqrt(theta') */
   real max_concentration; /* c_max (1): cap of the equilibrium volume concentration */
   int pickup;             /* 0: Engelund-Hansen c_eq, 1: Garcia-Parker pick-up */
   int soil_cohesive;      /* the soil's closure: 0 non-cohesive, 1 cohesive */
@@ -227,12 +226,11 @@ ERODEM_STRUCT(BedLoad, {
 ERODEM_FN ERODEM_S(BedLoad)
     bed_load_of(real h, real u, real v, real n, real tan2, ERODEM_P(SedimentParams) p) {
   ERODEM_S(BedLoad) r;
-  r.tau = bed_shear_stress(h, u, v, n, p.rho_g / p.gravity, p.gravity, p.min_depth);
+  r.tau = bed_shear_stress(h, u, v, n, p.rho, p.gravity, p.min_depth);
   const real n2 = n * n;
-  /* divisions unconditional, by a safe denominator: a division under a condition stays a
-   * branch (it may trap), and the loop then is not vectorised */
-  const int rough = p.skin_n2 < n2;
-  const real skin = rough ? p.skin_n2 / (rough ? n2 : (real)1) : (real)1;
+  /* n'^2 / max(n^2, n'^2): 1 (exactly) where the grains are the rougher; one unconditional
+   * division (a division under a condition stays a branch, and the loop is not vectorised) */
+  const real skin = p.skin_n2 / (p.skin_n2 < n2 ? n2 : p.skin_n2);
   r.theta = r.tau / p.shields_scale;
   r.theta_skin = r.theta * skin;
   const real slope_crit = p.shields_slope * sqrt(sqrt(sqrt(tan2)));
@@ -247,13 +245,13 @@ ERODEM_FN ERODEM_S(BedLoad)
  *   theta'), the excess of the skin Shields number over theta_c, scaled to the total stress
  *   (erodem's threshold; theta_e -> theta far above it);
  * - Garcia & Parker (1991) pick-up, E_s = A Z^5 / (1 + A Z^5 / 0.3), A = 1.3e-7,
- *   Z = u*' Re_p^0.6 / w_s with u*' = sqrt(tau' / rho); 0 below the threshold.
- * h is at least h_min (thin films: c_f and q_t / h grow without bound as h -> 0, and c_max
- * caps what is left). */
-ERODEM_FN real equilibrium_concentration(real h, real speed, real n, ERODEM_S(BedLoad) b,
+ *   Z = u*' Re_p^0.6 / w_s with u*' = sqrt(tau' / rho) = sqrt(theta' R g D); 0 below the
+ *   threshold.
+ * h_f is the depth, at least h_min (thin films: c_f and q_t / h grow without bound as h -> 0,
+ * and c_max caps what is left). */
+ERODEM_FN real equilibrium_concentration(real h_f, real speed, real n, ERODEM_S(BedLoad) b,
                                          ERODEM_P(SedimentParams) p) {
   const int moves = b.theta_skin > b.theta_crit;
-  const real h_f = h > p.min_depth ? h : p.min_depth;
   /* Engelund-Hansen: theta_e^(5/2) / (c_f |u| h) = theta_e^2 sqrt(theta_e) h^(1/3) / (g n^2 |u| h)
    */
   const real ratio = b.theta_crit / (moves ? b.theta_skin : (real)1);
@@ -262,8 +260,7 @@ ERODEM_FN real equilibrium_concentration(real h, real speed, real n, ERODEM_S(Be
   const real eh = p.total_load * excess * excess * sqrt(excess) * erodem_cbrt_positive(h_f) /
                   (moves ? denom : (real)1);
   /* Garcia-Parker */
-  const real z =
-      sqrt(b.tau * p.inv_rho * (b.theta > (real)0 ? b.theta_skin / b.theta : (real)0)) * p.pickup_z;
+  const real z = sqrt(b.theta_skin) * p.pickup_z;
   const real z5 = (real)1.3e-7 * (z * z) * (z * z) * z;
   const real gp = z5 / ((real)1 + z5 / (real)0.3);
   const real c = moves ? (p.pickup ? gp : eh) : (real)0;
@@ -324,8 +321,8 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
   const real tan2 = bed_slope_tan2(x, y, W, kind, bed, dx, dy);
   const ERODEM_S(BedLoad) b = bed_load_of(h, u, v, n, tan2, p);
   const real speed = sqrt(u * u + v * v);
-  const real c_eq = equilibrium_concentration(h, speed, n, b, p);
   const real h_f = h > p.min_depth ? h : p.min_depth;
+  const real c_eq = equilibrium_concentration(h_f, speed, n, b, p);
   /* the soil first while there is some, then the bedrock. The choices between the layers are
    * blends by 1 and 0 (exact: every term is finite), not selects on their conditions: GCC
    * does not vectorise the loop with those (a select between masks of the float compares in a

@@ -250,17 +250,17 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   }
   if (in.points.empty()) return;
   std::vector<cl_int> cells;
-  std::vector<Real> amounts;
+  std::vector<Real> amounts, sediment_amounts;
   bool sediment = false;
   for (const auto& p : in.points) {
     const int x = static_cast<int>(p.cell % nx_) + 1, y = static_cast<int>(p.cell / nx_) + 1;
     cells.push_back(x + y * W_);
     amounts.push_back(static_cast<Real>(p.volume / area_host_[y]));
+    sediment_amounts.push_back(static_cast<Real>(p.sediment / area_host_[y]));
     sediment = sediment || p.sediment != 0;
   }
   if (sediment)  // the sediment's amounts after the water's (sources_points)
-    for (const auto& p : in.points)
-      amounts.push_back(static_cast<Real>(p.sediment / area_host_[p.cell / nx_ + 1]));
+    amounts.insert(amounts.end(), sediment_amounts.begin(), sediment_amounts.end());
   // The previous upload (if any) may still read the host vectors.
   if (points_written_) {
     cl_event e = points_written_.get();
