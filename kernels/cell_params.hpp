@@ -12,6 +12,7 @@
 #include "common/boundary.h"
 #include "common/erosion.h"
 #include "common/flow.h"
+#include "common/infiltration.h"
 #include "common/snow.h"
 #include "common/sources.h"
 #include "common/thermal.h"
@@ -32,6 +33,7 @@ struct CellParams {
   cell_params::ThermalParams<real> thermal;
   cell_params::EvaporationParams<real> evaporation;
   cell_params::SnowParams<real> snow;
+  cell_params::InfiltrationParams<real> infiltration;
 };
 
 /// The physical erosion law's constants (erosion.h SedimentParams), derived in double from
@@ -85,7 +87,8 @@ cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
 /// The run constants from the parameters (units in the structs' headers): sea_level;
 /// gravity, theta, dry_depth, pipe_area, pipe_length; velocity_min_depth; the erosion rates,
 /// with -inf for no bedrock level; K_t and tan(talus angle); K_e, the wetness time and
-/// whether it evaporates; the snow pack's DDF, temperatures, reference elevation and lapse rate.
+/// whether it evaporates; the snow pack's DDF, temperatures, reference elevation and lapse rate;
+/// infiltration's recovery constant (given, or SWMM's rule from K_sat).
 template <class real>
 CellParams<real> cell_params_of(const Params& params) {
   const auto r = [](double v) { return static_cast<real>(v); };
@@ -128,6 +131,13 @@ CellParams<real> cell_params_of(const Params& params) {
   c.snow.air_temperature = r(sn.air_temperature);
   c.snow.reference_elevation = r(sn.reference_elevation);
   c.snow.lapse_rate = r(sn.lapse_rate);
+
+  // SWMM's recovery constant sqrt(K_sat / (1 in/h)) / 75 per hour = sqrt(K_sat swmm_scale) /
+  // 270000 per second (Rossman 2015, section 4.3)
+  const auto& in = params.infiltration;
+  c.infiltration.recovery_swmm = in.recovery_rate ? 0 : 1;
+  c.infiltration.recovery_rate = r(in.recovery_rate ? *in.recovery_rate : 0.0);
+  c.infiltration.swmm_scale = r(3600.0 / 0.0254);
   return c;
 }
 
@@ -156,6 +166,8 @@ ParamBytes cell_params_bytes(const CellParams<real>& c, Process p) {
       return of(c.evaporation);
     case Process::snow:
       return of(c.snow);
+    case Process::infiltration:
+      return of(c.infiltration);
     default:
       return {};
   }
@@ -178,5 +190,6 @@ static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) +
 static_assert(sizeof(cell_params::ThermalParams<float>) == 2 * sizeof(float));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::SnowParams<float>) == 5 * sizeof(float));
+static_assert(sizeof(cell_params::InfiltrationParams<float>) == 2 * sizeof(float) + sizeof(int));
 
 }  // namespace erodem

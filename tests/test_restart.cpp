@@ -22,8 +22,8 @@ namespace {
 using erodem::test::run_cli;
 
 /// Local inertial flow, conservative transport, thermal collapse, a melting snow pack above
-/// 20 m, an open and a fixed-level edge, a rain series and adaptive steps: every state field
-/// changes.
+/// 20 m, Green-Ampt infiltration into a finite store, an open and a fixed-level edge, a rain
+/// series and adaptive steps: every state field changes.
 const char* kInertial = R"([dem]
 synthetic = "valley"
 size = 48
@@ -60,6 +60,10 @@ initial = "20 mm"
 snow_line = "20 m"
 air_temperature = 3.0
 melt_factor = "100 mm/d"
+[infiltration]
+enabled = true
+ksat = "10 mm/h"
+soil_depth = "5 cm"
 [boundary]
 east = "open"
 west = "fixed_level"
@@ -68,7 +72,7 @@ sea_level = 1.0
 path = "full.h5"
 interval = "2 min"
 fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness",
-          "snow"]
+          "snow", "infiltrated"]
 )";
 
 /// The same with the shallow-water scheme: its unit discharges are state too.

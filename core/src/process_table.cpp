@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 
 #include "erodem/error.hpp"
@@ -28,6 +29,9 @@ bool thermal_on(const Params& p) {
 }
 bool snow_on(const Params& p) {
   return p.snow.enabled;
+}
+bool infiltration_on(const Params& p) {
+  return p.infiltration.enabled;
 }
 bool rains(const Params& p) {
   return p.rain.rate > 0 || !p.rain.series.empty();
@@ -228,6 +232,41 @@ std::vector<std::pair<FieldId, std::vector<double>>> snow_initial(const Terrain&
   return {{FieldId::snow, std::move(snow)}};
 }
 
+std::vector<SweepInfo> infiltration_sweeps(const Params&) {
+  // infiltration_sweep_cell (infiltration.h): Green-Ampt's implicit increment from the depth
+  // into the store, or the store's recovery on a dry cell
+  return {generic_sweep("infiltration",
+                        {{"kind", R},
+                         {"water_depth", U},
+                         {"infiltrated", U},
+                         {"infiltration_ksat", R},
+                         {"infiltration_suction_deficit", R},
+                         {"infiltration_store", R}},
+                        {"infiltrated", "soil_drained"})};
+}
+
+/// The soil of infiltration on the DEM cells: K_sat, psi delta theta and the store
+/// L delta theta (unlimited: the largest float), each from its uniform value or raster.
+std::vector<std::pair<FieldId, std::vector<double>>> infiltration_initial(const Terrain& t,
+                                                                          const Params& p) {
+  const auto& in = p.infiltration;
+  const std::size_t n = t.bed.size();
+  const auto value = [](const std::vector<double>& raster, const ScalarOrRaster& s, std::size_t i) {
+    return raster.empty() ? s.value : raster[i];
+  };
+  std::vector<double> ksat(n), suction(n), store(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double deficit = value(t.moisture_deficit, in.moisture_deficit, i);
+    ksat[i] = value(t.ksat, in.ksat, i);
+    suction[i] = value(t.suction, in.suction, i) * deficit;
+    store[i] = in.soil_depth ? value(t.soil_depth, *in.soil_depth, i) * deficit
+                             : static_cast<double>(std::numeric_limits<float>::max());
+  }
+  return {{FieldId::infiltration_ksat, std::move(ksat)},
+          {FieldId::infiltration_suction_deficit, std::move(suction)},
+          {FieldId::infiltration_store, std::move(store)}};
+}
+
 /// The initial soil (physical law): erosion.soil_thickness (uniform or its raster), or bed -
 /// bedrock_level (at least 0) where a bedrock level is given, on the active cells.
 std::vector<std::pair<FieldId, std::vector<double>>> erosion_initial(const Terrain& t,
@@ -296,6 +335,14 @@ const std::vector<ProcessInfo>& process_table() {
        {"snow_melted"},
        "snow.cl",
        snow_initial},
+      {Process::infiltration,
+       "infiltration",
+       "infiltration",
+       infiltration_on,
+       infiltration_sweeps,
+       {"infiltrated", "soil_drained"},
+       "infiltration.cl",
+       infiltration_initial},
   };
   return table;
 }
@@ -321,8 +368,16 @@ const char* process_name(Process p) {
 }
 
 const std::vector<std::string>& grid_inputs() {
-  static const std::vector<std::string> inputs{"kind",     "dx",        "dy",         "area",
-                                               "hardness", "manning_n", "rain_factor"};
+  static const std::vector<std::string> inputs{"kind",
+                                               "dx",
+                                               "dy",
+                                               "area",
+                                               "hardness",
+                                               "manning_n",
+                                               "rain_factor",
+                                               "infiltration_ksat",
+                                               "infiltration_suction_deficit",
+                                               "infiltration_store"};
   return inputs;
 }
 

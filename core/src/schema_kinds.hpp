@@ -190,6 +190,35 @@ Descriptor scalar_or_raster(const char* key, Access access, Dimension dim, Range
   return d;
 }
 
+/// scalar_or_raster's value, or not set (nullopt; printed as absent).
+template <class Access>
+Descriptor optional_scalar_or_raster(const char* key, Access access, Dimension dim, Range range,
+                                     const char* doc) {
+  // the value, made on assignment; read from a const Params (by the checks this descriptor
+  // replaces below) an unset one reads as the default
+  const auto inner = [access](auto& p) -> auto& {
+    if constexpr (std::is_const_v<std::remove_reference_t<decltype(p)>>) {
+      static const ScalarOrRaster unset{};
+      return access(p) ? *access(p) : unset;
+    } else {
+      if (!access(p)) access(p).emplace();
+      return *access(p);
+    }
+  };
+  Descriptor d = scalar_or_raster(key, inner, dim, range, doc);
+  d.type = "optional number or raster path";
+  d.check = [=](const Params& p, const Where& w) {
+    if (access(p) && !access(p)->is_raster()) check_double(access(p)->value, dim, range, w);
+  };
+  d.format = [=](const Params& p) -> std::optional<std::string> {
+    if (!access(p)) return std::nullopt;
+    return access(p)->is_raster() ? quoted_string(access(p)->path)
+                                  : format_number(access(p)->value);
+  };
+  d.reset = [access](Params& p) { access(p).reset(); };
+  return d;
+}
+
 /// A time series [[t, value], ...] with increasing times.
 template <class Access>
 Descriptor series(const char* key, Access access, Dimension dim, Range range, const char* doc) {

@@ -210,6 +210,23 @@ const std::vector<Descriptor>& descriptor_table() {
       number(ERODEM_FIELD(snow.lapse_rate), D::dimensionless, any_finite(),
              "air temperature lapse rate dT/dz (K/m; -0.0065 is -6.5 K/km)"),
 
+      boolean(ERODEM_FIELD(infiltration.enabled),
+              "Green-Ampt infiltration of the water depth into the soil"),
+      scalar_or_raster(ERODEM_FIELD(infiltration.ksat), D::speed, at_least(0),
+                       "saturated hydraulic conductivity K_sat (m/s; e.g. '0.34 cm/h'), uniform "
+                       "or a raster path"),
+      scalar_or_raster(ERODEM_FIELD(infiltration.suction), D::length, at_least(0),
+                       "wetting-front suction head psi (m), uniform or a raster path"),
+      scalar_or_raster(ERODEM_FIELD(infiltration.moisture_deficit), D::dimensionless, closed(0, 1),
+                       "moisture deficit delta theta = theta_s - theta_i (1), uniform or a raster "
+                       "path"),
+      optional_scalar_or_raster(ERODEM_FIELD(infiltration.soil_depth), D::length, at_least(0),
+                                "depth L of the soil store (m), uniform or a raster path: it "
+                                "holds at most L delta theta of water; not set = unlimited"),
+      optional_number(ERODEM_FIELD(infiltration.recovery_rate), D::inverse_time, at_least(0),
+                      "recovery constant k_r (1/s): a dry cell's infiltrated depth decays as "
+                      "e^(-k_r t); not set = SWMM's sqrt(K_sat in in/h) / 75 per hour"),
+
       choice(ERODEM_FIELD(boundary.north), boundary, "north edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.south), boundary, "south edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.east), boundary, "east edge: closed, open or fixed_level"),

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "erodem/error.hpp"
+#include "erodem/parameter_rasters.hpp"
 #include "erodem/schema.hpp"
 
 namespace erodem {
@@ -42,11 +43,8 @@ std::string read_config_text(const std::string& path) {
 void resolve_relative_paths(Params& p, const std::string& base_dir) {
   const fs::path base(base_dir.empty() ? "." : base_dir);
   p.dem.path = resolve_against(p.dem.path, base);
-  p.initial.water_depth.path = resolve_against(p.initial.water_depth.path, base);
-  p.flow.manning_n.path = resolve_against(p.flow.manning_n.path, base);
-  p.erosion.hardness.path = resolve_against(p.erosion.hardness.path, base);
-  p.rain.raster = resolve_against(p.rain.raster, base);
-  p.erosion.soil_thickness.path = resolve_against(p.erosion.soil_thickness.path, base);
+  for (const auto& r : parameter_rasters())
+    if (std::string* path = r.path(p)) *path = resolve_against(*path, base);
 }
 
 Params load_config(const std::string& path) {

@@ -8,6 +8,7 @@
 
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
+#include "erodem/parameter_rasters.hpp"
 #include "raster_gdal.hpp"
 
 namespace erodem::io {
@@ -108,11 +109,7 @@ Terrain coarsen(const Terrain& fine, int factor) {
         block_mean(v, r, col, out[static_cast<std::size_t>(r) * nx + col]);
     return out;
   };
-  t.water_depth = average(fine.water_depth);
-  t.manning_n = average(fine.manning_n);
-  t.hardness = average(fine.hardness);
-  t.rain_factor = average(fine.rain_factor);
-  t.soil_thickness = average(fine.soil_thickness);
+  for (const auto& r : parameter_rasters()) t.*r.values = average(fine.*r.values);
   return t;
 }
 

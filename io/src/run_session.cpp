@@ -16,6 +16,7 @@
 #include "erodem/error.hpp"
 #include "erodem/io/paths.hpp"
 #include "erodem/io/setup.hpp"
+#include "erodem/parameter_rasters.hpp"
 #include "erodem/schema.hpp"
 #include "erodem/units.hpp"
 
@@ -26,9 +27,9 @@ namespace {
 /// Whether `p` reads any parameter raster (those are loaded on the DEM's grid by
 /// load_terrain, so a terrain loaded without them cannot be used as it is).
 bool has_parameter_rasters(const Params& p) {
-  return p.initial.water_depth.is_raster() || p.flow.manning_n.is_raster() ||
-         p.erosion.hardness.is_raster() || p.erosion.soil_thickness.is_raster() ||
-         !p.rain.raster.empty();
+  for (const auto& r : parameter_rasters())
+    if (!parameter_raster_path(r, p).empty()) return true;
+  return false;
 }
 
 /// The snapshot of `reader` at `time` (the last one when no time is given). Times match to

@@ -5,6 +5,7 @@
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
+#include "erodem/parameter_rasters.hpp"
 #include "erodem/terrain_synth.hpp"
 
 namespace erodem::io {
@@ -38,19 +39,10 @@ Terrain load_terrain(const Params& p) {
   for (std::size_t i = 0; i < t.grid.cells() && !any_active; ++i) any_active = t.active(i);
   if (!any_active)
     throw Error(ExitCode::data, t.source + ": every cell is nodata; nothing to simulate");
-  const double inf = HUGE_VAL;
-  if (p.initial.water_depth.is_raster())
-    t.water_depth =
-        parameter_raster(p.initial.water_depth.path, t, p, "initial.water_depth", 0.0, inf);
-  if (p.flow.manning_n.is_raster())
-    t.manning_n = parameter_raster(p.flow.manning_n.path, t, p, "flow.manning_n", 0.0, 1.0);
-  if (p.erosion.hardness.is_raster())
-    t.hardness = parameter_raster(p.erosion.hardness.path, t, p, "erosion.hardness", 0.0, 1.0);
-  if (p.erosion.soil_thickness.is_raster())
-    t.soil_thickness =
-        parameter_raster(p.erosion.soil_thickness.path, t, p, "erosion.soil_thickness", 0.0, inf);
-  if (!p.rain.raster.empty())
-    t.rain_factor = parameter_raster(p.rain.raster, t, p, "rain.raster", 0.0, inf);
+  for (const auto& r : parameter_rasters()) {
+    const std::string path = parameter_raster_path(r, p);
+    if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);
+  }
   const int factor = resample_factor(p.dem, t.grid);
   return factor > 1 ? coarsen(t, factor) : t;
 }

@@ -39,6 +39,7 @@ using std::fabs;
 using std::fmax;
 using std::fmin;
 using std::isfinite;
+using std::log1p;
 using std::sqrt;
 typedef std::uint8_t erodem_kind_t;
 }  // namespace cell

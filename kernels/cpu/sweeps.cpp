@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "common/infiltration.h"
 #include "common/shallow_water.h"
 #include "common/snow.h"
 #include "common/sources.h"
@@ -128,6 +129,7 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
   static const std::pair<const char*, Run> sweeps[] = {
       {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
       {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
+      {"infiltration", &CpuBackend::cell_sweep<&cell::infiltration_sweep_cell<Real>>},
       {"shallow_water_velocity",
        &CpuBackend::cell_sweep<&cell::shallow_water_velocity_sweep_cell<Real>>},
   };

@@ -321,7 +321,8 @@ class Simulation:
         ``material_initial``, ``material``, ``sediment_out``, ``transport_change``,
         ``eroded``, ``deposited``, ``sediment_exchanged``, ``thermal_moved``,
         ``snow_melted``, ``sediment_inflow``, ``eroded_bedrock``, ``bed_bulking``,
-        ``material_closure_error``, ``material_moved``, ``relative_material_closure_error``
+        ``infiltrated`` and ``soil_drained`` (Green-Ampt: into the soil, and drained from its
+        store as it recovers), ``material_closure_error``, ``material_moved``, ``relative_material_closure_error``
         (1, of ``material_moved``). With the physical erosion law the sediment volumes are of
         solid (times ``erosion.sediment_density`` for kg). docs/model.md section 7 defines what
         moved."""

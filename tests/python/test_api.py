@@ -204,6 +204,30 @@ def test_physical_erosion_law_from_python(erodem, tujunga):
         erodem.Simulation(dem, backend="cpu", erosion__soil__porosty=0.3)
 
 
+def test_infiltration_from_python(erodem, tujunga):
+    """Green-Ampt infiltration from keywords with units: the soil takes part of the storm (the
+    ledger's infiltrated, the infiltrated field), and the water closes with it."""
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", rain__rate="100 mm/h", time__dt=1.0,
+                            infiltration__enabled=True, infiltration__ksat="10 mm/h",
+                            infiltration__suction="11 cm", infiltration__soil_depth="30 cm")
+    assert "[infiltration]" in sim.config_toml and "soil_depth = 0.3" in sim.config_toml
+    sim.step(600)
+    led = sim.ledger
+    f = sim.field("infiltrated")
+    print("rain %.4g m^3, infiltrated %.4g, out %.4g, closure %.2e of moved"
+          % (led["rain"], led["infiltrated"], led["boundary_out"],
+             led["relative_closure_error"]))
+    # 10 min of rain at 100 mm/h: the soil (S = 11 cm x 0.3) ponds after F_p = S K / (r - K)
+    # = 3.7 mm, at 2.2 min (Mein & Larson); it takes more than K_sat's 1/10 of the rain and
+    # less than all of it
+    assert 0.1 * led["rain"] < led["infiltrated"] < 0.9 * led["rain"]
+    assert np.nanmax(f) > 0 and led["soil_drained"] == 0.0
+    assert abs(led["relative_closure_error"]) < 1e-5
+    with pytest.raises(ValueError, match="infiltration.moisture_deficit"):
+        erodem.Simulation(dem, backend="cpu", infiltration__moisture_deficit=1.5)
+
+
 # ---- numpy views ------------------------------------------------------------------------
 
 

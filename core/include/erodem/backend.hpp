@@ -16,15 +16,16 @@ namespace erodem {
 /// The processes of one step (MODEL.md "One step"). Simulation::sequence() runs them in this
 /// order but for sources, which run after flow (model.md section 2).
 enum class Process {
-  boundary,     ///< ghost cells take the state the edge conditions give them
-  sources,      ///< rain and point/line inflows
-  flow,         ///< outflow fluxes (pipes or local_inertial)
-  water,        ///< depth and velocity update
-  erosion,      ///< erosion / deposition
-  transport,    ///< suspended sediment transport
-  thermal,      ///< slope collapse
-  evaporation,  ///< evaporation and the wetness running mean
-  snow,         ///< degree-day melt of the snow pack into the depth
+  boundary,      ///< ghost cells take the state the edge conditions give them
+  sources,       ///< rain and point/line inflows
+  flow,          ///< outflow fluxes (pipes or local_inertial)
+  water,         ///< depth and velocity update
+  erosion,       ///< erosion / deposition
+  transport,     ///< suspended sediment transport
+  thermal,       ///< slope collapse
+  evaporation,   ///< evaporation and the wetness running mean
+  snow,          ///< degree-day melt of the snow pack into the depth
+  infiltration,  ///< Green-Ampt infiltration of the depth into the soil store
 };
 const char* process_name(Process p);
 

@@ -52,7 +52,13 @@ enum FieldFlag : unsigned {
   X(shear_stress, "Pa", "bed shear stress", kOutputField | kDerivedField)                          \
   /* the loose layer over the bedrock (erosion.law = "physical"; 0 with Mei's law) */              \
   X(soil_thickness, "m", "thickness of the loose layer (soil) over the bedrock",                   \
-    kStateField | kOutputField | kRestartZero)
+    kStateField | kOutputField | kRestartZero)                                                     \
+  /* Green-Ampt infiltration (infiltration.h): the depth the soil holds, and the soil */           \
+  X(infiltrated, "m", "water infiltrated into the soil store (Green-Ampt F)",                      \
+    kStateField | kOutputField | kRestartZero)                                                     \
+  X(infiltration_ksat, "m s-1", "saturated hydraulic conductivity", 0u)                            \
+  X(infiltration_suction_deficit, "m", "wetting-front suction head times moisture deficit", 0u)    \
+  X(infiltration_store, "m", "largest depth the soil store holds", 0u)
 
 enum class FieldId {
 #define ERODEM_FIELD_ID(id, units, long_name, flags) id,

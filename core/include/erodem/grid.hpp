@@ -47,16 +47,20 @@ struct Grid {
 /// Optional rasters are empty when the scalar parameter applies.
 struct Terrain {
   Grid grid;
-  std::vector<double> bed;             ///< bed elevation (m)
-  std::vector<std::uint8_t> mask;      ///< 1 = active cell, 0 = nodata; empty = all active
-  std::vector<double> water_depth;     ///< initial depth (m)
-  std::vector<double> manning_n;       ///< Manning n (s m^-1/3)
-  std::vector<double> hardness;        ///< erodibility R in [0, 1]; empty: scalar or "noise"
-  std::vector<double> rain_factor;     ///< rain multiplier (1)
-  std::vector<double> soil_thickness;  ///< loose layer over the bedrock (m): erosion's initial
-                                       ///< soil_thickness field (process_table.cpp)
-  std::string source;                  ///< DEM path or generator description
-  std::string source_sha256;           ///< checksum of the DEM file, when read from one
+  std::vector<double> bed;               ///< bed elevation (m)
+  std::vector<std::uint8_t> mask;        ///< 1 = active cell, 0 = nodata; empty = all active
+  std::vector<double> water_depth;       ///< initial depth (m)
+  std::vector<double> manning_n;         ///< Manning n (s m^-1/3)
+  std::vector<double> hardness;          ///< erodibility R in [0, 1]; empty: scalar or "noise"
+  std::vector<double> rain_factor;       ///< rain multiplier (1)
+  std::vector<double> soil_thickness;    ///< loose layer over the bedrock (m): erosion's initial
+                                         ///< soil_thickness field (process_table.cpp)
+  std::vector<double> ksat;              ///< infiltration K_sat (m/s)
+  std::vector<double> suction;           ///< infiltration suction head psi (m)
+  std::vector<double> moisture_deficit;  ///< infiltration delta theta (1)
+  std::vector<double> soil_depth;        ///< infiltration soil depth L (m)
+  std::string source;                    ///< DEM path or generator description
+  std::string source_sha256;             ///< checksum of the DEM file, when read from one
 
   bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
 };

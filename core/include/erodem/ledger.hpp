@@ -33,7 +33,9 @@ namespace erodem {
   X(eroded_bedrock, true, "solid taken into suspension from the bedrock (part of eroded)") \
   X(bed_bulking, true,                                                                     \
     "bed volume lowered minus solid moved into suspension: pores opened (closed by "       \
-    "deposits), and the morphological acceleration's extra")
+    "deposits), and the morphological acceleration's extra")                               \
+  X(infiltrated, true, "water infiltrated into the soil")                                  \
+  X(soil_drained, true, "water drained from the soil store as its capacity recovers")
 
 /// The volumes (m^3) that crossed the model's boundaries or moved inside it during the
 /// processes run so far in one step (ERODEM_TALLIES).
@@ -63,18 +65,18 @@ struct Ledger {
   /// against this fraction of the volume on the grid (the rounding of a double sum).
   static constexpr double kVolumeEpsilon = std::numeric_limits<double>::epsilon();
 
-  /// V(t) - V(0) - rain - inflow + out + evaporated - clipped - snow melted: 0 up to rounding
-  /// (m^3).
+  /// V(t) - V(0) - rain - inflow + out + evaporated - clipped - snow melted + infiltrated: 0
+  /// up to rounding (m^3).
   double closure_error() const {
     return water - water_initial - rain - inflow + boundary_out + evaporated - clipped -
-           snow_melted;
+           snow_melted + infiltrated;
   }
   /// What moved of the water (m^3): max(rain + inflow + |boundary out| + evaporated + snow
-  /// melted, water exchanged between cells, kVolumeEpsilon * water on the grid).
+  /// melted + infiltrated, water exchanged between cells, kVolumeEpsilon * water on the grid).
   double water_moved() const {
-    return std::max({rain + inflow + std::abs(boundary_out) + evaporated + snow_melted,
-                     water_exchanged,
-                     kVolumeEpsilon * std::max(std::abs(water_initial), std::abs(water))});
+    return std::max(
+        {rain + inflow + std::abs(boundary_out) + evaporated + snow_melted + infiltrated,
+         water_exchanged, kVolumeEpsilon * std::max(std::abs(water_initial), std::abs(water))});
   }
   /// Closure error relative to water_moved().
   double relative_closure_error() const {

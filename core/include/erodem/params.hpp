@@ -174,6 +174,19 @@ struct Params {
     double lapse_rate = -0.0065;            ///< dT/dz (K/m)
   } snow;
 
+  /// Green-Ampt infiltration (infiltration.h, docs/model.md section 3.11). The soil's K_sat,
+  /// suction head and moisture deficit: uniform or rasters (Rawls et al. 1983's loam).
+  struct Infiltration {
+    bool enabled = false;
+    ScalarOrRaster ksat{0.34e-2 / 3600.0, {}};  ///< saturated conductivity K_sat (m/s)
+    ScalarOrRaster suction{0.0889, {}};         ///< wetting-front suction head psi (m)
+    ScalarOrRaster moisture_deficit{0.3, {}};   ///< delta theta = theta_s - theta_i (1)
+    /// depth L of the soil (m): the store holds at most L delta theta; none = unlimited
+    std::optional<ScalarOrRaster> soil_depth;
+    /// recovery constant k_r (1/s); none = SWMM's sqrt(K_sat in in/h) / 75 per hour
+    std::optional<double> recovery_rate;
+  } infiltration;
+
   struct Boundary {
     BoundaryKind north = BoundaryKind::closed;
     BoundaryKind south = BoundaryKind::closed;
