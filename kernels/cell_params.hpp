@@ -141,6 +141,13 @@ CellParams<real> cell_params_of(const Params& params) {
   return c;
 }
 
+/// The level of the fixed-level cells in the step of `in` (m): its boundary_level, or
+/// boundary.sea_level where it has none; the backends set BoundaryParams::sea_level to it when
+/// a step begins.
+inline double step_level(const StepInputs& in, const Params& params) {
+  return std::isnan(in.boundary_level) ? params.boundary.sea_level : in.boundary_level;
+}
+
 /// The bytes of process `p`'s parameter struct in `c` (what the generic sweeps pass to their
 /// cell function and kernel, process.hpp SweepInfo::generic); {nullptr, 0} for a process
 /// without one.

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "common/compat.h"
+#include "erodem/boundary_codes.hpp"
 #include "erodem/error.hpp"
 #include "erodem/terrain_synth.hpp"
 
@@ -12,7 +13,7 @@ namespace erodem {
 
 namespace {
 
-std::uint8_t edge_kind(BoundaryKind b) {
+std::uint8_t cell_kind(BoundaryKind b) {
   switch (b) {
     case BoundaryKind::open:
       return ERODEM_CELL_OPEN;
@@ -60,26 +61,29 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
     s.area[y] = g.area[r];
   }
 
-  // Cell kinds: DEM cells active or nodata (wall or sea); halo by the edge's boundary kind.
+  // Cell kinds: DEM cells active, or not (a wall, or held at the level: boundary_codes.hpp);
+  // halo by the edge's condition there (the edge's, or boundary.raster's at the edge cell).
   s.kind.assign(n, ERODEM_CELL_WALL);
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c < nx; ++c) {
       const auto i = static_cast<std::size_t>(r) * nx + c;
-      s.kind[s.at(c + 1, r + 1)] = terrain.active(i)                           ? ERODEM_CELL_ACTIVE
-                                   : params.boundary.nodata == NodataKind::sea ? ERODEM_CELL_FIXED
-                                                                               : ERODEM_CELL_WALL;
+      s.kind[s.at(c + 1, r + 1)] = terrain.active(i)                   ? ERODEM_CELL_ACTIVE
+                                   : held_at_level(terrain, params, i) ? ERODEM_CELL_FIXED
+                                                                       : ERODEM_CELL_WALL;
     }
   for (int y = 1; y <= ny; ++y) {
     if (s.kind[s.at(1, y)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(0, y)] = edge_kind(params.boundary.west);
+      s.kind[s.at(0, y)] = cell_kind(ghost_condition(terrain, params, 0, y - 1, Side::west));
     if (s.kind[s.at(nx, y)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(nx + 1, y)] = edge_kind(params.boundary.east);
+      s.kind[s.at(nx + 1, y)] =
+          cell_kind(ghost_condition(terrain, params, nx - 1, y - 1, Side::east));
   }
   for (int x = 1; x <= nx; ++x) {
     if (s.kind[s.at(x, 1)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(x, 0)] = edge_kind(params.boundary.north);
+      s.kind[s.at(x, 0)] = cell_kind(ghost_condition(terrain, params, x - 1, 0, Side::north));
     if (s.kind[s.at(x, ny)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(x, ny + 1)] = edge_kind(params.boundary.south);
+      s.kind[s.at(x, ny + 1)] =
+          cell_kind(ghost_condition(terrain, params, x - 1, ny - 1, Side::south));
   }
 
   // Bed and initial water (computed in double; backends round once).
@@ -98,19 +102,22 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
       else
         s.depth[p] = params.initial.water_depth.value;
     }
-  // Nodata cells: sea ghosts hold the sea over a bed no higher than their active neighbours,
-  // and the sediment its water carries in.
+  // Cells held at the level: nodata sea cells over a bed no higher than their active
+  // neighbours nor the lowest level (so the sea never runs dry), cells coded fixed_level on
+  // their own bed; each holds the level at t = 0 and the sediment its water carries in.
   s.sediment.assign(n, 0.0);
-  const double sea = params.boundary.sea_level;
+  const double sea = boundary_level(params, 0.0), lowest = lowest_boundary_level(params);
   for (int y = 1; y <= ny; ++y)
     for (int x = 1; x <= nx; ++x) {
       const auto p = s.at(x, y);
       if (s.kind[p] == ERODEM_CELL_ACTIVE) continue;
-      double low = sea;
+      const auto i = static_cast<std::size_t>(y - 1) * nx + (x - 1);
+      double low = lowest;
       for (auto q : {p - 1, p + 1, p - W, p + W})
         if (s.kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, s.bed[q]);
+      if (held_on_own_bed(terrain, i)) low = terrain.bed[i];
       s.bed[p] = s.kind[p] == ERODEM_CELL_FIXED ? low : 0.0;
-      s.depth[p] = s.kind[p] == ERODEM_CELL_FIXED ? sea - low : 0.0;
+      s.depth[p] = s.kind[p] == ERODEM_CELL_FIXED ? std::max(sea - low, 0.0) : 0.0;
       if (params.erosion.enabled)
         s.sediment[p] = params.boundary.sediment_concentration * s.depth[p];
     }

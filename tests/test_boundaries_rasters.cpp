@@ -9,8 +9,11 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "erodem/boundary_codes.hpp"
+#include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/io/setup.hpp"
 #include "scenarios.hpp"
@@ -620,9 +623,178 @@ TEST_P(RasterParameters, InfiltrationRastersGiveEachCellItsSoil) {
   EXPECT_EQ(rock_wet, 0);
 }
 
+// ==== the stage hydrograph and boundary.raster's codes =====================================
+
+class Stage : public TargetTest {};
+
+/// A flat basin of nx x ny cells of 10 m at bed 0, `depth` m of water, Manning 0.03, local
+/// inertial with adaptive steps (Courant 0.7, at most 2 s), every edge closed.
+Params stage_params(const std::string& dem) {
+  Params p = quiet_params(FlowScheme::local_inertial, 2.0);
+  p.dem.path = dem;
+  p.time.adaptive = true;
+  p.time.dt_max = 2.0;
+  p.flow.manning_n.value = 0.03;
+  return p;
+}
+
+TEST_P(Stage, RisingStageFillsAChannelToTheLevel) {
+  // A closed channel 1 km long (100 x 3 cells of 10 m, Manning 0.03), 0.5 m of still water, its
+  // west edge held at a stage that rises linearly from 0.5 m to 1 m over 3 h. The rise is slow
+  // against the channel's response (a wave crosses it in 6 min), so the analytic level is the
+  // stage itself on every cell, less the friction slope that drives the filling flow: the
+  // inflow q(x) = (L - x) d(stage)/dt, at most 0.046 m^2/s, gives S_f = n^2 u^2 / h^(4/3), whose
+  // integral over the channel is at most 1.7 mm at 0.75 m deep. Checked at 1, 2 and 3 h:
+  // every cell within 5 mm of the stage (an idle solver or a stage held at its start: 0.17 m
+  // off at 1 h; one at its end: 0.33 m). The water that came in is booked as negative boundary
+  // out: the closure. (A stage that stops abruptly excites a quarter-wave seiche of
+  // u h / c = 1.5 cm that friction damps only over hours: not what this test is about.)
+  TempDir dir;
+  const int nx = 100, ny = 3;
+  const Grid g = Grid::uniform(nx, ny, 10.0);
+  write_raster(dir.file("dem.tif"), g, std::vector<double>(g.cells(), 0.0));
+  Params p = stage_params(dir.file("dem.tif"));
+  p.initial.water_depth.value = 0.5;
+  p.boundary.west = BoundaryKind::fixed_level;
+  p.boundary.stage = {{0.0, 0.5}, {10800.0, 1.0}};
+  p.time.duration = 10800.0;
+  auto sim = make_simulation(io::load_terrain(p), p, target());
+  double worst = 0.0;
+  for (const double t : {3600.0, 7200.0, 10800.0}) {
+    while (sim.time() < t - 1e-9) sim.step();
+    const double stage = 0.5 + 0.5 * sim.time() / 10800.0;
+    const auto d = sim.field(FieldId::water_depth);
+    double off = 0.0;
+    for (double v : d) off = std::max(off, std::abs(v - stage));
+    worst = std::max(worst, off);
+    std::printf(
+        "[stage] %s: at %.0f s the stage is %.4f m, the channel %.4f-%.4f m: max |depth "
+        "- stage| %.2e m (bound 5e-3 m)\n",
+        target().label().c_str(), sim.time(), stage, *std::min_element(d.begin(), d.end()),
+        *std::max_element(d.begin(), d.end()), off);
+  }
+  const double came_in = -sim.ledger().boundary_out;
+  const double closure = std::abs(sim.ledger().relative_closure_error());
+  std::printf(
+      "[stage] %s: water in %.6g m^3 (0.5 m x area: %.6g m^3); closure %.1e of what "
+      "moved (bound %.0e)\n",
+      target().label().c_str(), came_in, 0.5 * nx * ny * 100.0, closure, bound(1e-12, 1e-5));
+  vr::expect_below(figure("stage_channel", "local_inertial", "max |depth - stage| at 1, 2, 3 h (m)",
+                          10.0, "a channel follows a slowly rising held stage"),
+                   worst, 5e-3);
+  EXPECT_LT(closure, bound(1e-12, 1e-5));
+}
+
+TEST_P(Stage, LevelHeldOnOneEdgeSegmentLeavesTheRestClosed) {
+  // A dry flat basin of 20 x 20 cells of 10 m, every edge closed but for four cells of the
+  // west edge (rows 8-11) that boundary.raster holds at 0.5 m. At 20 s the water has come in
+  // only there: the west edge's corner cells (8 rows, 80 m, from the segment; the front of a
+  // dam break onto a dry bed reaches 2 sqrt(g h) t = 89 m in 20 s along the edge only in
+  // the ideal frictionless case) are still dry, while a fully held west edge wets them at
+  // once. After 2 h the basin stands at 0.5 m everywhere (1 mm) and the ledger's water in is
+  // its volume. A segment ignored (the edge closed) lets nothing in; the whole edge held wets
+  // the corners.
+  TempDir dir;
+  const int n = 20;
+  const Grid g = Grid::uniform(n, n, 10.0);
+  std::vector<double> codes(g.cells(), 0.0);
+  for (int r = 8; r <= 11; ++r) codes[static_cast<std::size_t>(r) * n] = kBoundaryFixed;
+  write_raster(dir.file("dem.tif"), g, std::vector<double>(g.cells(), 0.0));
+  write_raster(dir.file("codes.tif"), g, codes);
+  Params p = stage_params(dir.file("dem.tif"));
+  p.boundary.raster = dir.file("codes.tif");
+  p.boundary.sea_level = 0.5;
+  p.time.duration = 7200.0;
+  auto sim = make_simulation(io::load_terrain(p), p, target());
+  while (sim.time() < 20.0) sim.step();
+  const auto d20 = sim.field(FieldId::water_depth);
+  const double corners = d20[0] + d20[static_cast<std::size_t>(n - 1) * n];
+  const double segment = d20[static_cast<std::size_t>(9) * n];
+  sim.run();
+  const auto d = sim.field(FieldId::water_depth);
+  double worst = 0;
+  for (double v : d) worst = std::max(worst, std::abs(v - 0.5));
+  const double came_in = -sim.ledger().boundary_out, volume = 0.5 * n * n * 100.0;
+  std::printf(
+      "[stage segment] %s: at %.1f s depth %.3f m at the segment, %.1e m at the west "
+      "corners (bound 0); after 2 h max |depth - 0.5 m| %.2e m (bound 1e-3 m); water in "
+      "%.6g m^3 of %.6g m^3\n",
+      target().label().c_str(), 20.0, segment, corners, worst, came_in, volume);
+  auto fig = [&](const char* q) {
+    return figure("stage_segment", "local_inertial", q, 10.0,
+                  "water enters through the held segment only");
+  };
+  vr::expect_below(fig("depth at the closed corners at 20 s (m)"), corners,
+                   std::numeric_limits<double>::min());
+  vr::expect_below(fig("max |depth - level| after 2 h (m)"), worst, 1e-3);
+  EXPECT_GT(segment, 0.1) << "the segment lets the water in";
+  EXPECT_NEAR(came_in, volume, 1e-3 * volume);
+}
+
+TEST_P(Stage, HeldCellInsideTheGridFollowsTheStage) {
+  // A closed dry basin of 20 x 20 cells of 10 m with one interior cell (10, 10) coded
+  // fixed_level (a well, a gauge-fed pond) under a stage from 0.2 m to 0.4 m over 30 min: the
+  // basin fills to 0.4 m (1 mm after 3 h) and the held cell is out of the active domain (its
+  // water is the boundary's, counted as water in). Ignoring the code leaves the basin dry;
+  // a constant level stops at 0.2 m.
+  TempDir dir;
+  const int n = 20;
+  const Grid g = Grid::uniform(n, n, 10.0);
+  std::vector<double> codes(g.cells(), 0.0);
+  codes[static_cast<std::size_t>(10) * n + 10] = kBoundaryFixed;
+  write_raster(dir.file("dem.tif"), g, std::vector<double>(g.cells(), 0.0));
+  write_raster(dir.file("codes.tif"), g, codes);
+  Params p = stage_params(dir.file("dem.tif"));
+  p.boundary.raster = dir.file("codes.tif");
+  p.boundary.stage = {{0.0, 0.2}, {1800.0, 0.4}};
+  p.time.duration = 3 * 3600.0;
+  auto sim = make_simulation(io::load_terrain(p), p, target());
+  sim.run();
+  const auto d = sim.field(FieldId::water_depth);
+  double worst = 0;
+  for (std::size_t i = 0; i < d.size(); ++i)
+    if (i != static_cast<std::size_t>(10) * n + 10) worst = std::max(worst, std::abs(d[i] - 0.4));
+  const double came_in = -sim.ledger().boundary_out, volume = 0.4 * (n * n - 1) * 100.0;
+  std::printf(
+      "[stage held cell] %s: after 3 h max |depth - 0.4 m| %.2e m (bound 1e-3 m); water "
+      "in %.6g m^3 of %.6g m^3; closure %.1e\n",
+      target().label().c_str(), worst, came_in, volume, sim.ledger().relative_closure_error());
+  vr::expect_below(figure("stage_held_cell", "local_inertial", "max |depth - stage| after 3 h (m)",
+                          10.0, "a basin fed by one held cell fills to the stage"),
+                   worst, 1e-3);
+  EXPECT_NEAR(came_in, volume, 1e-3 * volume);
+}
+
+TEST(BoundaryRaster, BadCodesAreNamed) {
+  // A code that is not 0-3, and open inside the grid, are errors naming the file, the key, the
+  // cell and the code; a code on an edge cell overrides the edge.
+  TempDir dir;
+  const Grid g = Grid::uniform(6, 6, 10.0);
+  write_raster(dir.file("dem.tif"), g, std::vector<double>(g.cells(), 0.0));
+  Params p = stage_params(dir.file("dem.tif"));
+  for (const auto& [cell, code, what] :
+       {std::tuple{14, 1.5, "is not a boundary code"}, std::tuple{14, 2.0, "inside the grid"}}) {
+    std::vector<double> codes(g.cells(), 0.0);
+    codes[static_cast<std::size_t>(cell)] = code;
+    write_raster(dir.file("codes.tif"), g, codes);
+    p.boundary.raster = dir.file("codes.tif");
+    try {
+      io::load_terrain(p);
+      ADD_FAILURE() << "code " << code << " accepted";
+    } catch (const Error& e) {
+      std::printf("[boundary raster] code %.1f at cell 2, 2: %s\n", code, e.what());
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cell 2, 2"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("codes.tif"), std::string::npos) << e.what();
+      EXPECT_EQ(e.code(), ExitCode::data);
+    }
+  }
+}
+
 }  // namespace
 
 ERODEM_INSTANTIATE_TARGETS(BoundarySediment);
 ERODEM_INSTANTIATE_TARGETS(RasterParameters);
+ERODEM_INSTANTIATE_TARGETS(Stage);
 
 }  // namespace erodem::test

@@ -190,8 +190,8 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
 
 TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // the cell kernels whose work-group the OpenCL backend queried from its own list (before
-  // 2026-11-26), the snow pack's, the shallow-water second order's and infiltration's (added
-  // through the table), as a set; the program in step order
+  // 2026-11-26), the snow pack's, the shallow-water second order's, infiltration's and the
+  // stage hydrograph's (added through the table), as a set; the program in step order
   // (flow before sources since they run after it; before, the files were listed in the enum's
   // order)
   const auto k = opencl_cell_kernels();
@@ -214,13 +214,14 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "evaporation",
                                    "snow",
                                    "infiltration",
+                                   "boundary_level",
                                    "flow_shallow_water",
                                    "flow_shallow_water_muscl",
                                    "flow_shallow_water_stage_depth",
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 24u) << "a kernel listed twice";
+  EXPECT_EQ(k.size(), 25u) << "a kernel listed twice";
   EXPECT_EQ(
       opencl_program_order(),
       (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl", "water.cl",

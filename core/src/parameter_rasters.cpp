@@ -28,6 +28,8 @@ const std::vector<ParameterRaster>& parameter_rasters() {
          return p.infiltration.soil_depth ? &p.infiltration.soil_depth->path : nullptr;
        },
        &Terrain::soil_depth, 0.0, inf},
+      {"boundary.raster", [](Params& p) { return &p.boundary.raster; }, &Terrain::boundary_code,
+       0.0, 3.0, true},
   };
   return table;
 }

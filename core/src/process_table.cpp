@@ -49,12 +49,18 @@ SweepInfo generic_sweep(const char* name, std::vector<FieldUse> uses,
 
 // ---- the sweeps of each process --------------------------------------------------------
 
-std::vector<SweepInfo> boundary_sweeps(const Params&) {
+std::vector<SweepInfo> boundary_sweeps(const Params& p) {
   // boundary_fill_cell (boundary.h): the ghosts take the bed and depth their edge gives them
-  return {{"boundary_fill",
-           Domain::halo,
-           {{"kind", R}, {"bed", U}, {"water_depth", U}, {"sediment", U}},
-           {"boundary_fill"}}};
+  std::vector<SweepInfo> s{{"boundary_fill",
+                            Domain::halo,
+                            {{"kind", R}, {"bed", U}, {"water_depth", U}, {"sediment", U}},
+                            {"boundary_fill"}}};
+  if (!p.boundary.stage.empty())
+    // boundary_level_sweep_cell (boundary.h): the cells held at the level inside the grid
+    // follow the stage hydrograph
+    s.push_back(generic_sweep("boundary_level",
+                              {{"kind", R}, {"bed", R}, {"water_depth", U}, {"sediment", U}}, {}));
+  return s;
 }
 
 std::vector<SweepInfo> sources_sweeps(const Params& p) {
@@ -475,10 +481,11 @@ std::vector<std::string> opencl_cell_kernels() {
       if (std::find(out.begin(), out.end(), k) == out.end()) out.emplace_back(k);
   };
   // every process of the table (enabled or not), with each flow and transport scheme and
-  // erosion law
+  // erosion law, and a stage hydrograph
   Params p;
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
+  p.boundary.stage = {{0.0, 0.0}};
   for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial, FlowScheme::shallow_water})
     for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian})
       for (auto law : {ErosionLaw::mei, ErosionLaw::physical}) {

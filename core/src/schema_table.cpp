@@ -236,6 +236,14 @@ const std::vector<Descriptor>& descriptor_table() {
              "nodata cells give (1); 0 = clear water"),
       number(ERODEM_FIELD(boundary.sea_level), D::length, any_finite(),
              "water level of fixed_level edges and sea nodata cells (m)"),
+      series(ERODEM_FIELD(boundary.stage), D::length, any_finite(),
+             "stage hydrograph [[time (s), level (m)], ...] of every fixed-level cell (edges, "
+             "sea nodata cells, boundary.raster's held cells), linear in between, held at the end "
+             "values outside; not set = boundary.sea_level"),
+      text(ERODEM_FIELD(boundary.raster),
+           "raster path of boundary codes on the DEM grid: 0 as the edges say, 1 closed, 2 "
+           "open, 3 fixed_level; on an edge cell the edge's condition there, inside the grid "
+           "a wall (1) or a cell held at the level (3); \"\" = none"),
       choice(ERODEM_FIELD(boundary.nodata),
              Choices<NodataKind>{{"wall", NodataKind::wall}, {"sea", NodataKind::sea}},
              "nodata cells: wall, or sea at boundary.sea_level"),

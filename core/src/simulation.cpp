@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "erodem/boundary_codes.hpp"
 #include "erodem/error.hpp"
 #include "erodem/process.hpp"
 
@@ -204,32 +205,34 @@ void Simulation::resolve_inflows() {
 
 void Simulation::find_coast_cells() {
   const auto& g = terrain_.grid;
-  const auto& b = params_.boundary;
-  const bool sea = b.nodata == NodataKind::sea;
-  // Whether the neighbour (c, r) of an active cell is a fixed-level cell: an edge ghost of a
-  // fixed_level edge, or a nodata cell that is sea (initial_state.cpp gives the kinds).
-  auto fixed = [&](int c, int r) {
-    if (c < 0) return b.west == BoundaryKind::fixed_level;
-    if (c >= g.nx) return b.east == BoundaryKind::fixed_level;
-    if (r < 0) return b.north == BoundaryKind::fixed_level;
-    if (r >= g.ny) return b.south == BoundaryKind::fixed_level;
-    return sea && !terrain_.active(static_cast<std::size_t>(r) * g.nx + c);
+  constexpr BoundaryKind fixed_level = BoundaryKind::fixed_level;
+  // Whether active cell (c, r)'s neighbour (c + dc, r + dr) is a fixed-level cell: the ghost of
+  // an edge held at the level there, or a cell held at it (boundary_codes.hpp, as
+  // initial_state.cpp gives the kinds).
+  auto fixed = [&](int c, int r, int dc, int dr, Side side) {
+    const int nc = c + dc, nr = r + dr;
+    if (nc < 0 || nr < 0 || nc >= g.nx || nr >= g.ny)
+      return ghost_condition(terrain_, params_, c, r, side) == fixed_level;
+    const auto n = static_cast<std::size_t>(nr) * g.nx + nc;
+    return !terrain_.active(n) && held_at_level(terrain_, params_, n);
   };
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
       const auto i = static_cast<std::size_t>(r) * g.nx + c;
-      if (terrain_.active(i) &&
-          (fixed(c - 1, r) || fixed(c + 1, r) || fixed(c, r - 1) || fixed(c, r + 1)))
+      if (terrain_.active(i) && (fixed(c, r, -1, 0, Side::west) || fixed(c, r, 1, 0, Side::east) ||
+                                 fixed(c, r, 0, -1, Side::north) || fixed(c, r, 0, 1, Side::south)))
         coast_cells_.push_back(static_cast<std::int64_t>(i));
     }
 }
 
 double Simulation::coast_depth(const std::vector<double>& coast_bed) const {
-  // A fixed-level cell g beside active cell a holds its surface at sea_level over a bed no
+  // A fixed-level cell g beside active cell a holds its surface at the level over a bed no
   // higher than a's (boundary.h, initial_state.cpp), so the flow kernel's face depth
-  // h_f = max(eta_g, eta_a) - max(b_g, b_a) = max(sea_level - b_a, d_a).
+  // h_f = max(eta_g, eta_a) - max(b_g, b_a) = max(level - b_a, d_a); the highest level the
+  // stage hydrograph reaches bounds it over the run.
   double h = 0.0;
-  for (const double b : coast_bed) h = std::max(h, params_.boundary.sea_level - b);
+  const double level = highest_boundary_level(params_);
+  for (const double b : coast_bed) h = std::max(h, level - b);
   return h;
 }
 
@@ -354,6 +357,7 @@ StepInputs Simulation::inputs_for(double dt) const {
   const double t_mid = time_ + 0.5 * dt;
   in.rain_rate =
       params_.rain.series.empty() ? params_.rain.rate : series_value(params_.rain.series, t_mid);
+  in.boundary_level = boundary_level(params_, t_mid);
   for (const auto& ic : inflows_) {
     const double q = series_value(params_.inflow[ic.spec].hydrograph, t_mid);
     const double share = q * dt / static_cast<double>(ic.cells.size());

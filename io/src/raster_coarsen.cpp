@@ -109,7 +109,29 @@ Terrain coarsen(const Terrain& fine, int factor) {
         block_mean(v, r, col, out[static_cast<std::size_t>(r) * nx + col]);
     return out;
   };
-  for (const auto& r : parameter_rasters()) t.*r.values = average(fine.*r.values);
+  // Codes (boundary.raster) are not averaged: a block takes its most frequent code over its
+  // valid cells, the larger on a tie (so a block half held at the level is held).
+  auto mode = [&](const std::vector<double>& v) {
+    std::vector<double> out;
+    if (v.empty()) return out;
+    out.assign(c.cells(), 0.0);
+    for (int r = 0; r < ny; ++r)
+      for (int col = 0; col < nx; ++col) {
+        int count[4] = {0, 0, 0, 0};
+        for (int i = 0; i < factor; ++i)
+          for (int j = 0; j < factor; ++j) {
+            const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
+            if (fine.active(k)) ++count[std::clamp(static_cast<int>(v[k]), 0, 3)];
+          }
+        int best = 0;
+        for (int code = 1; code < 4; ++code)
+          if (count[code] >= count[best]) best = code;
+        out[static_cast<std::size_t>(r) * nx + col] = count[best] > 0 ? best : 0;
+      }
+    return out;
+  };
+  for (const auto& r : parameter_rasters())
+    t.*r.values = r.categorical ? mode(fine.*r.values) : average(fine.*r.values);
   return t;
 }
 

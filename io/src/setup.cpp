@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "erodem/backends.hpp"
+#include "erodem/boundary_codes.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/parameter_rasters.hpp"
@@ -44,7 +45,9 @@ Terrain load_terrain(const Params& p) {
     if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);
   }
   const int factor = resample_factor(p.dem, t.grid);
-  return factor > 1 ? coarsen(t, factor) : t;
+  if (factor > 1) t = coarsen(t, factor);
+  apply_boundary_codes(t, p.boundary.raster);
+  return t;
 }
 
 Simulation make_simulation(const Params& p, const std::string& backend) {

@@ -53,6 +53,25 @@ ERODEM_FN void boundary_fill_cell(int x, int y, int W, int H, GLOBAL const erode
   }
 }
 
+/* With a stage hydrograph (boundary.stage; the generic sweep "boundary_level", after the
+ * halo's): a fixed-level cell inside the grid (a sea nodata cell, or one boundary.raster holds
+ * at the level) takes the step's level over its bed, depth max(level - bed, 0), holding c_b of
+ * it as sediment; every other cell keeps its state. (Without a stage the level is constant and
+ * these cells keep what the initial state gave them.) */
+ERODEM_FN void boundary_level_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                         GLOBAL const real* bed, GLOBAL real* depth,
+                                         GLOBAL real* sediment, GLOBAL const real* area, real dt,
+                                         ERODEM_P(BoundaryParams) p) {
+  const int i = x + y * W;
+  const int held = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_FIXED);
+  const real d = p.sea_level - bed[i] > (real)0 ? p.sea_level - bed[i] : (real)0;
+  const real d_old = depth[i], s_old = sediment[i];
+  depth[i] = held ? d : d_old;
+  sediment[i] = held ? p.sediment_concentration * d : s_old;
+  (void)area;
+  (void)dt;
+}
+
 ERODEM_END_NAMESPACE
 
 #endif

@@ -87,6 +87,7 @@ void CpuBackend<Real>::begin_step(const StepInputs& in) {
   step_inputs_ = in;
   step_tally_ = StepTally{};
   in_step_ = true;
+  cell_.boundary.sea_level = static_cast<Real>(step_level(in, params_));
 }
 
 template <class Real>

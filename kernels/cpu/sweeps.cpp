@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "common/boundary.h"
 #include "common/infiltration.h"
 #include "common/shallow_water.h"
 #include "common/snow.h"
@@ -130,6 +131,7 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
       {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
       {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
       {"infiltration", &CpuBackend::cell_sweep<&cell::infiltration_sweep_cell<Real>>},
+      {"boundary_level", &CpuBackend::cell_sweep<&cell::boundary_level_sweep_cell<Real>>},
       {"shallow_water_velocity",
        &CpuBackend::cell_sweep<&cell::shallow_water_velocity_sweep_cell<Real>>},
   };

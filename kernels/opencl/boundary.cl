@@ -28,3 +28,17 @@ __kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
   }
   boundary_fill_cell(x, y, W, H, kind, bed, depth, sediment, p);
 }
+
+/* The generic sweep "boundary_level" (a stage hydrograph): one work-item per padded cell of rows
+ * 1 .. H - 2, boundary_level_sweep_cell; no tallies (the arguments of every generic kernel). */
+__kernel void boundary_level(int W, int H, __global const uchar* restrict kind,
+                             __global const real* restrict bed, __global real* restrict depth,
+                             __global real* restrict sediment, __global const real* restrict area,
+                             real dt, BoundaryParams p, __global acc_t* restrict partials,
+                             int stride) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  (void)partials;
+  (void)stride;
+  if (!ERODEM_PAST_ROW(x, W))
+    boundary_level_sweep_cell(x, y, W, kind, bed, depth, sediment, area, dt, p);
+}

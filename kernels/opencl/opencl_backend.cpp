@@ -186,6 +186,7 @@ void OpenClBackend::begin_step(const StepInputs& in) {
   step_inputs_ = in;
   step_tally_ = StepTally{};
   in_step_ = true;
+  cell_.boundary.sea_level = static_cast<Real>(step_level(in, params_));
 }
 
 void OpenClBackend::run(Process p) {

@@ -17,6 +17,8 @@ struct ParameterRaster {
   std::string* (*path)(Params& p);
   std::vector<double> Terrain::*values;  ///< where load_terrain puts it (SI units)
   double lo, hi;                         ///< the range of its active cells' values
+  /// Codes rather than quantities (boundary.raster): whole numbers, never averaged.
+  bool categorical = false;
 };
 
 /// Every parameter raster, in a fixed order.

@@ -193,6 +193,13 @@ struct Params {
     BoundaryKind east = BoundaryKind::closed;
     BoundaryKind west = BoundaryKind::closed;
     double sea_level = 0.0;  ///< level of fixed_level edges and sea nodata cells (m)
+    /// A stage hydrograph: the level (m) of every fixed-level cell over time, in place of
+    /// sea_level; empty: sea_level, constant.
+    Series stage;
+    /// Raster of boundary codes on the DEM grid (0 none, 1 closed, 2 open, 3 fixed_level):
+    /// on an edge cell the condition of the edge there, inside the grid a wall (1) or a cell
+    /// held at the level (3); "" = none.
+    std::string raster;
     /// Volume concentration of solid sediment in the water that fixed_level edges and sea
     /// nodata cells give (1); 0 = clear water.
     double sediment_concentration = 0.0;
