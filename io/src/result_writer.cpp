@@ -183,14 +183,14 @@ struct ResultWriter::Impl {
   /// Writes the buffered rows of a (step, column) group: its steps, times and each series
   /// (`name(k)`: the dataset's name in `group`).
   template <std::size_t N, class Name>
-  void flush_group(const char* group, hid_t step, hid_t time, std::vector<std::int64_t>& steps,
+  void flush_group(const char* group, hid_t step, hid_t times_ds, std::vector<std::int64_t>& steps,
                    std::vector<double>& times, std::array<H5Id, N>& series,
                    std::array<std::vector<double>, N>& rows, Name name) {
     const hsize_t n = times.size();
     if (n == 0) return;
     const std::string g = std::string(group) + "/";
     append_rows(step, H5T_NATIVE_INT64, n, steps.data(), partial, g + "step");
-    append_rows(time, H5T_NATIVE_DOUBLE, n, times.data(), partial, g + "time");
+    append_rows(times_ds, H5T_NATIVE_DOUBLE, n, times.data(), partial, g + "time");
     for (std::size_t k = 0; k < N; ++k) {
       append_rows(series[k], H5T_NATIVE_DOUBLE, n, rows[k].data(), partial, g + name(k));
       rows[k].clear();
