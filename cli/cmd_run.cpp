@@ -186,6 +186,15 @@ int run(const RunOptions& o) {
         L.deposited * tonnes, L.sediment_out * tonnes, L.sediment_out * tonnes / (area * 1e-6),
         area * 1e-6);
   }
+  // The cross-sections and outlets: peak discharge and when, the volumes through them.
+  for (std::size_t k = 0; k < sim.sections().size(); ++k) {
+    const SectionState& st = sim.sections()[k];
+    std::printf(
+        "%s %s: peak %.4g m^3/s at t = %.6g s, volume %.6g m^3, sediment %.4g m^3 (solid)\n",
+        sim.section_layout().outlet[k] ? "outlet" : "section",
+        sim.section_layout().names[k].c_str(), st.peak_discharge, st.peak_time, st.volume,
+        st.sediment_volume);
+  }
   std::printf("ran %ld steps to t = %.6g s in %.3f s wall (%.3g cell-steps/s)\n", sim.steps_done(),
               sim.time(), wall, cells * sim.steps_done() / wall);
   std::printf("wrote %s (%zu snapshots of %zu fields, diagnostics of %ld steps) and %s\n",

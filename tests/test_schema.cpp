@@ -510,7 +510,7 @@ TEST(Dump, DefaultsRoundTrip) {
   const Params back = erodem::params_from_toml(toml::parse(text), "dump");
   EXPECT_TRUE(erodem::params_equal(p, back)) << text;
   for (const std::string& key : erodem::parameter_keys()) {
-    if (key == "inflow") continue;
+    if (key == "inflow" || key == "section" || key == "outlet") continue;  // arrays of tables
     const std::string leaf = key.substr(key.rfind('.') + 1);
     EXPECT_NE(text.find(leaf + " = "), std::string::npos) << key;
     EXPECT_NE(text.find("# " + erodem::parameter_doc(key)), std::string::npos) << key;

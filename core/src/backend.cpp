@@ -16,4 +16,23 @@ void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const c
                               ny, n - 1));
 }
 
+std::vector<int> padded_faces(const std::vector<Face>& faces, int nx, int ny) {
+  std::vector<int> out;
+  out.reserve(faces.size());
+  for (const Face& f : faces) {
+    const bool ok = f.axis == 0   ? f.col >= -1 && f.col < nx && f.row >= 0 && f.row < ny
+                    : f.axis == 1 ? f.col >= 0 && f.col < nx && f.row >= -1 && f.row < ny
+                                  : false;
+    if (!ok)
+      throw Error(ExitCode::usage,
+                  fmt::format("faces: face (col {}, row {}, axis {}) is not on the grid of {} x {}",
+                              f.col, f.row, f.axis, nx, ny));
+    const std::int64_t i =
+        static_cast<std::int64_t>(f.col + 1) +
+        static_cast<std::int64_t>(f.row + 1) * (static_cast<std::int64_t>(nx) + 2);
+    out.push_back(static_cast<int>(2 * i + f.axis));
+  }
+  return out;
+}
+
 }  // namespace erodem

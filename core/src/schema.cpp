@@ -215,10 +215,10 @@ void validate(const Params& p, const std::string& source_name) {
 std::string dump_toml(const Params& p) {
   std::string out = "# erodem configuration, fully resolved (values in SI units)\n";
   std::string section = "-";
-  const Descriptor* inflow = nullptr;
+  std::vector<const Descriptor*> tables;  // arrays of tables, after every [section]
   for (const Descriptor& d : descriptor_table()) {
-    if (d.type == "inflow list") {
-      inflow = &d;
+    if (d.tables) {
+      tables.push_back(&d);
       continue;
     }
     const std::string s = d.key.substr(0, d.key.rfind('.'));  // erosion.soil for its keys
@@ -234,7 +234,7 @@ std::string dump_toml(const Params& p) {
       out += "# " + leaf_of(d.key) + " = (not set)\n";
     }
   }
-  if (inflow) out += format_inflow_tables(p.inflow, inflow->doc);
+  for (const Descriptor* d : tables) out += d->tables(p);
   return out;
 }
 
@@ -257,7 +257,7 @@ ParameterInfo parameter_info(const std::string& key) {
   info.unit = d.dim == Dimension::dimensionless ? "" : si_unit(d.dim);
   info.accepted = d.accepted;
   const Params defaults;
-  if (d.type == "inflow list") {
+  if (d.tables) {
     info.default_value = "[]";
   } else {
     info.default_value = d.format(defaults).value_or("(not set)");

@@ -31,6 +31,9 @@ struct Descriptor {
   /// TOML value text; nullopt for an unset optional value.
   std::function<std::optional<std::string>(const Params&)> format;
   std::function<void(Params&)> reset;  ///< back to the default
+  /// Arrays of tables ([[inflow]], [[section]], [[outlet]]): their dump_toml text (`format`
+  /// gives nullopt); null for every other key.
+  std::function<std::string(const Params&)> tables;
 };
 
 /// Common part of all descriptors: the reset to the default-constructed value.
@@ -339,8 +342,11 @@ Descriptor hardness_descriptor(const char* key, const char* doc);
 /// [[inflow]]: point or line inflows, each with a hydrograph.
 Descriptor inflow_descriptor(const char* key, const char* doc);
 
-/// The [[inflow]] tables of dump_toml.
-std::string format_inflow_tables(const std::vector<InflowSpec>& list, const std::string& doc);
+/// [[section]]: named cross-section polylines (sections.hpp).
+Descriptor section_descriptor(const char* key, const char* doc);
+
+/// [[outlet]]: named outlets, a whole boundary edge or one cell's faces with the outside.
+Descriptor outlet_descriptor(const char* key, const char* doc);
 
 /// Every parameter, grouped by section (sections must be contiguous for dump_toml).
 const std::vector<Descriptor>& descriptor_table();

@@ -117,6 +117,12 @@ const std::vector<Descriptor>& descriptor_table() {
 
       inflow_descriptor("inflow",
                         "point or line inflows with a hydrograph [[time (s), discharge (m^3/s)]]"),
+      section_descriptor("section",
+                         "cross-sections: the discharge (m^3/s) and sediment flux (m^3/s of "
+                         "solid) through a polyline, every step (results.md, sections/)"),
+      outlet_descriptor("outlet",
+                        "outlets: the discharge (m^3/s) and sediment flux (m^3/s of solid) "
+                        "out of the grid through an edge or a cell's outer faces, every step"),
 
       boolean(ERODEM_FIELD(erosion.enabled), "hydraulic erosion and deposition"),
       choice(ERODEM_FIELD(erosion.law),

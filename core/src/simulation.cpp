@@ -136,6 +136,9 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
       rain_factor_max_ = std::max(rain_factor_max_, factor);
     }
   resolve_inflows();
+  sections_ = layout_sections(terrain_, params_);
+  section_state_.assign(sections_.names.size(), SectionState{});
+  if (!sections_.faces.empty()) backend_->set_faces(sections_.faces);
   find_coast_cells();
   // the initial values of the fields the processes own (process.hpp ProcessInfo::initial)
   for (const Process p : step_sequence(params_))
@@ -417,6 +420,7 @@ void Simulation::step() {
   stale_ = false;  // (coast_depth_ keeps the bed of the last refresh: see model.md section 5)
   probes_ = std::move(result.probes);
   probes_current_ = true;
+  measure_sections(result, dt);
 
   double added = 0.0, sediment_added = 0.0;
   for (const auto& p : in.points) added += p.volume, sediment_added += p.sediment;
@@ -430,6 +434,29 @@ void Simulation::step() {
   diag_ = diagnostics_now(dt);
   // Check after the books are updated, so a caller catching the error sees this step.
   check_stability(dt);
+}
+
+void Simulation::measure_sections(const StepResult& result, double dt) {
+  if (section_state_.empty()) return;
+  std::vector<double> q(section_state_.size(), 0.0), qs(section_state_.size(), 0.0);
+  const auto& faces = sections_.faces;
+  for (std::size_t j = 0; j < faces.size() && j < result.face_water.size(); ++j) {
+    const auto s = static_cast<std::size_t>(sections_.section[j]);
+    q[s] += sections_.sign[j] * result.face_water[j];
+    qs[s] += sections_.sign[j] * result.face_sediment[j];
+  }
+  for (std::size_t s = 0; s < section_state_.size(); ++s) {
+    SectionState& st = section_state_[s];
+    st.discharge = q[s];
+    st.sediment_flux = qs[s];
+    st.volume += q[s] * dt;
+    st.sediment_volume += qs[s] * dt;
+    if (!sections_measured_ || q[s] > st.peak_discharge) {
+      st.peak_discharge = q[s];
+      st.peak_time = time_;
+    }
+  }
+  sections_measured_ = true;
 }
 
 void Simulation::step(long n) {

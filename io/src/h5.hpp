@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "erodem/sections.hpp"
+
 namespace erodem::io {
 
 // ---- HDF5 handles and errors --------------------------------------------------------------
@@ -127,5 +129,21 @@ bool exists(hid_t loc, const std::string& path);
 
 /// The series of gauges/, in the order of GaugeSeries (the writer's and the reader's).
 constexpr const char* kGaugeSeries[] = {"water_depth", "water_level", "speed"};
+
+/// The per-step series of sections/, (step, section), in file order (sections.hpp).
+struct SectionSeriesInfo {
+  const char* name;
+  double SectionState::*member;
+  const char* units;
+  const char* long_name;
+};
+inline constexpr SectionSeriesInfo kSectionSeries[] = {
+    {"discharge", &SectionState::discharge, "m3 s-1", "discharge through the section in the step"},
+    {"sediment_flux", &SectionState::sediment_flux, "m3 s-1",
+     "solid sediment volume per second through the section in the step"},
+    {"volume", &SectionState::volume, "m3", "cumulative water volume through the section"},
+    {"sediment_volume", &SectionState::sediment_volume, "m3",
+     "cumulative solid sediment volume through the section"},
+};
 
 }  // namespace erodem::io

@@ -123,6 +123,13 @@ struct ResultWriter::Impl {
   std::vector<double> pending_gauge_time;
   std::array<std::vector<double>, 3> pending_gauge;  // [series][row * n + gauge]
   std::vector<std::int64_t> pending_gauge_steps;
+  // sections/: the [[section]] and [[outlet]] measures, one row per step
+  std::size_t section_count = 0;
+  H5Id section_step, section_time;
+  std::array<H5Id, 4> section;
+  std::vector<double> pending_section_time;
+  std::array<std::vector<double>, 4> pending_section;  // [series][row * n + section]
+  std::vector<std::int64_t> pending_section_steps;
   // restart/: the full state at every snapshot (output.restart_state)
   bool restart = false;
   bool restart_f64 = false;          // float64 runs keep their state in float64
@@ -173,7 +180,26 @@ struct ResultWriter::Impl {
     return ds;
   }
 
-  /// Writes the buffered diagnostics and gauge rows.
+  /// Writes the buffered rows of a (step, column) group: its steps, times and each series
+  /// (`name(k)`: the dataset's name in `group`).
+  template <std::size_t N, class Name>
+  void flush_group(const char* group, hid_t step, hid_t times_ds, std::vector<std::int64_t>& steps,
+                   std::vector<double>& times, std::array<H5Id, N>& series,
+                   std::array<std::vector<double>, N>& rows, Name name) {
+    const hsize_t n = times.size();
+    if (n == 0) return;
+    const std::string g = std::string(group) + "/";
+    append_rows(step, H5T_NATIVE_INT64, n, steps.data(), partial, g + "step");
+    append_rows(times_ds, H5T_NATIVE_DOUBLE, n, times.data(), partial, g + "time");
+    for (std::size_t k = 0; k < N; ++k) {
+      append_rows(series[k], H5T_NATIVE_DOUBLE, n, rows[k].data(), partial, g + name(k));
+      rows[k].clear();
+    }
+    times.clear();
+    steps.clear();
+  }
+
+  /// Writes the buffered diagnostics, gauge and section rows.
   void flush_pending() {
     const hsize_t rows = pending.size();
     if (rows > 0) {
@@ -189,26 +215,19 @@ struct ResultWriter::Impl {
       pending.clear();
       pending_steps.clear();
     }
-    const hsize_t grows = pending_gauge_time.size();
-    if (grows > 0) {
-      append_rows(gauge_step, H5T_NATIVE_INT64, grows, pending_gauge_steps.data(), partial,
-                  "gauges/step");
-      append_rows(gauge_time, H5T_NATIVE_DOUBLE, grows, pending_gauge_time.data(), partial,
-                  "gauges/time");
-      for (std::size_t k = 0; k < gauge.size(); ++k) {
-        append_rows(gauge[k], H5T_NATIVE_DOUBLE, grows, pending_gauge[k].data(), partial,
-                    std::string("gauges/") + kGaugeSeries[k]);
-        pending_gauge[k].clear();
-      }
-      pending_gauge_time.clear();
-      pending_gauge_steps.clear();
-    }
+    flush_group("gauges", gauge_step, gauge_time, pending_gauge_steps, pending_gauge_time, gauge,
+                pending_gauge, [](std::size_t k) { return kGaugeSeries[k]; });
+    flush_group("sections", section_step, section_time, pending_section_steps, pending_section_time,
+                section, pending_section, [](std::size_t k) { return kSectionSeries[k].name; });
   }
 
   void close() {
     for (auto& f : fields) f.second.reset();
     for (auto& d : diag) d.reset();
     for (auto& g : gauge) g.reset();
+    for (auto& g : section) g.reset();
+    section_step.reset();
+    section_time.reset();
     for (auto& d : restart_fields) d.reset();
     for (auto& d : restart_ledger) d.reset();
     restart_steps.reset();
@@ -453,6 +472,44 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     for (std::size_t k = 0; k < m.gauge.size(); ++k)
       m.gauge[k] = m.series(group, kGaugeSeries[k], m.gauge_step, gauge, n, gunits[k], glong[k]);
   }
+  // sections/: one row per step, one column per section or outlet (sections.hpp).
+  m.section_count = params.section.size() + params.outlet.size();
+  if (m.section_count > 0) {
+    H5Id group = m.create_group("sections");
+    put_text(group, "comment",
+             "discharge and sediment flux through the cross-sections ([[section]]: positive "
+             "from the left to the right of the line, walking from its first vertex) and "
+             "outlets ([[outlet]]: positive out of the grid), one row per step",
+             partial_);
+    const hsize_t n = m.section_count;
+    std::vector<std::int32_t> ids(n), outlet(n);
+    std::string names;
+    for (std::size_t i = 0; i < n; ++i) {
+      ids[i] = static_cast<std::int32_t>(i);
+      outlet[i] = i >= params.section.size();
+      names += (i ? "," : "") +
+               (outlet[i] ? params.outlet[i - params.section.size()].name : params.section[i].name);
+    }
+    // the names, comma-separated (a name has no comma: schema), in the section order
+    put_text(group, "section_names", names, partial_);
+    H5Id sec = m.coordinate(group, "section", H5T_STD_I32LE, ids.data(), n, false);
+    put_text(sec, "long_name", "section index: the [[section]] tables, then the [[outlet]] tables",
+             partial_);
+    H5Id is_outlet =
+        create_dataset(group, "outlet", H5T_STD_I32LE, {n}, {n}, {}, false, nullptr, partial_);
+    checked(H5Dwrite(is_outlet, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, outlet.data()),
+            partial_, "sections/outlet");
+    checked(H5DSattach_scale(is_outlet, sec, 0), partial_, "sections/outlet");
+    put_text(is_outlet, "units", "1", partial_);
+    put_text(is_outlet, "long_name", "1 for an [[outlet]], 0 for a [[section]]", partial_);
+    m.section_step = m.coordinate(group, "step", H5T_STD_I64LE, nullptr, 0, true);
+    put_text(m.section_step, "long_name", "number of steps done", partial_);
+    m.section_time = m.series(group, "time", m.section_step, -1, 0, "s",
+                              "time since the start of the run, at the end of the step");
+    for (std::size_t k = 0; k < m.section.size(); ++k)
+      m.section[k] = m.series(group, kSectionSeries[k].name, m.section_step, sec, n,
+                              kSectionSeries[k].units, kSectionSeries[k].long_name);
+  }
   checked(H5Fflush(m.file, H5F_SCOPE_GLOBAL), partial_, "(flushing)");
   impl_ = std::move(impl);
 }
@@ -522,6 +579,13 @@ void ResultWriter::record_step(const Simulation& sim) {
   Impl& m = *impl_;
   m.pending.push_back(sim.diagnostics());
   m.pending_steps.push_back(sim.steps_done());
+  if (m.section_count > 0 && sim.sections().size() == m.section_count) {
+    m.pending_section_time.push_back(sim.time());
+    m.pending_section_steps.push_back(sim.steps_done());
+    for (const SectionState& st : sim.sections())
+      for (std::size_t k = 0; k < m.section.size(); ++k)
+        m.pending_section[k].push_back(st.*kSectionSeries[k].member);
+  }
   if (m.gauge_cells.empty()) return;
   // The gauge fields at the gauge cells: the step's probes where the simulation took them for
   // these gauges (RunSession registers them: Simulation::set_probes), else sampled now; no

@@ -11,6 +11,7 @@
 #include <omp.h>
 #endif
 
+#include "common/sections.h"
 #include "common/stats.h"
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
@@ -86,6 +87,8 @@ template <class Real>
 void CpuBackend<Real>::begin_step(const StepInputs& in) {
   step_inputs_ = in;
   step_tally_ = StepTally{};
+  face_water_.assign(face_codes_.size(), 0.0);
+  face_sediment_.assign(face_codes_.size(), 0.0);
   in_step_ = true;
   cell_.boundary.sea_level = static_cast<Real>(step_level(in, params_));
 }
@@ -107,12 +110,14 @@ void CpuBackend<Real>::run(Process p) {
       run_flow(dt);
       break;
     case Process::water:
+      measure_water_faces();
       run_water(dt, tally);
       break;
     case Process::erosion:
       run_erosion(dt, tally);
       break;
     case Process::transport:
+      measure_sediment_faces();
       run_transport(dt, tally);
       break;
     case Process::thermal:
@@ -139,7 +144,35 @@ StepResult CpuBackend<Real>::end_step() {
     const Field* src = const_cast<CpuBackend*>(this)->field_storage(id);
     for (const std::size_t p : probe_cells_) r.probes.push_back(value_at(id, src, p));
   }
+  r.face_water = face_water_;
+  r.face_sediment = face_sediment_;
   return r;
+}
+
+template <class Real>
+void CpuBackend<Real>::set_faces(const std::vector<Face>& faces) {
+  face_codes_ = padded_faces(faces, nx_, ny_);
+  face_water_.assign(face_codes_.size(), 0.0);
+  face_sediment_.assign(face_codes_.size(), 0.0);
+}
+
+template <class Real>
+void CpuBackend<Real>::measure_water_faces() {
+  const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
+             *fb = flux_[3].data();
+  for (std::size_t j = 0; j < face_codes_.size(); ++j)
+    face_water_[j] = cell::section_face_water(face_codes_[j], W_, fl, fr, ft, fb);
+}
+
+template <class Real>
+void CpuBackend<Real>::measure_sediment_faces() {
+  // before the transport: the sediment it starts from, the depth the flow step limited the
+  // outflows by (depth_next_ after the water update's swap) and the outflows
+  const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
+             *fb = flux_[3].data();
+  for (std::size_t j = 0; j < face_codes_.size(); ++j)
+    face_sediment_[j] = cell::section_face_sediment(face_codes_[j], W_, sediment_.data(),
+                                                    depth_next_.data(), fl, fr, ft, fb);
 }
 
 template <class Real>

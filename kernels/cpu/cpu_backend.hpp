@@ -54,6 +54,7 @@ class CpuBackend final : public Backend {
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,
                   const std::vector<FieldId>& fields) override;
+  void set_faces(const std::vector<Face>& faces) override;
   std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   std::vector<double> field(FieldId id) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
@@ -180,6 +181,13 @@ class CpuBackend final : public Backend {
   // The probes (set_probes): padded cells and the fields end_step samples at them.
   std::vector<std::size_t> probe_cells_;
   std::vector<FieldId> probe_fields_;
+  // The faces of the sections and outlets (set_faces, common/sections.h): their codes and
+  // what the step moved through them, measured before the water update and the transport
+  // from the arrays those read.
+  std::vector<int> face_codes_;
+  std::vector<double> face_water_, face_sediment_;
+  void measure_water_faces();
+  void measure_sediment_faces();
 };
 
 }  // namespace ERODEM_CPU_NAMESPACE

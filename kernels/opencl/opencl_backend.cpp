@@ -185,6 +185,7 @@ void OpenClBackend::begin_step(const StepInputs& in) {
   pending_tally_ = nullptr;
   step_inputs_ = in;
   step_tally_ = StepTally{};
+  face_water_done_ = face_sediment_done_ = false;
   in_step_ = true;
   cell_.boundary.sea_level = static_cast<Real>(step_level(in, params_));
 }
@@ -205,12 +206,14 @@ void OpenClBackend::run(Process p) {
       run_flow(dt);
       break;
     case Process::water:
+      measure_faces(false);
       run_water(dt, tally);
       break;
     case Process::erosion:
       run_erosion(dt, tally);
       break;
     case Process::transport:
+      measure_faces(true);
       run_transport(dt, tally);
       break;
     case Process::thermal:
@@ -230,7 +233,36 @@ StepResult OpenClBackend::end_step() {
   StepResult r;
   r.stats = collect(&r.probes);  // delivers the step's tallies to step_tally_
   r.tally = step_tally_;
+  // the faces' values, read in collect's batch; 0 where the step did not measure them
+  r.face_water.assign(face_count_, 0.0);
+  r.face_sediment.assign(face_count_, 0.0);
+  for (std::size_t j = 0; j < face_count_; ++j) {
+    if (face_water_done_) r.face_water[j] = face_water_raw_[j];
+    if (face_sediment_done_) r.face_sediment[j] = face_sediment_raw_[j];
+  }
   return r;
+}
+
+void OpenClBackend::set_faces(const std::vector<Face>& faces) {
+  const std::vector<int> codes = padded_faces(faces, nx_, ny_);
+  face_count_ = codes.size();
+  if (codes.empty()) return;
+  face_codes_ = upload(std::vector<cl_int>(codes.begin(), codes.end()));
+  face_water_out_ = make_buffer(face_count_ * sizeof(Real));
+  face_sediment_out_ = make_buffer(face_count_ * sizeof(Real));
+}
+
+void OpenClBackend::measure_faces(bool sediment) {
+  if (face_count_ == 0) return;
+  // before the water update or the transport: the arrays they read (sections.h)
+  cl_kernel k = kernel("section_faces");
+  set_args(k, static_cast<cl_int>(face_count_), cl_int{W_}, cl_int{sediment ? 1 : 0}, face_codes_,
+           sediment_, depth_next_, flux_[0], flux_[1], flux_[2], flux_[3],
+           sediment ? face_sediment_out_ : face_water_out_);
+  const std::size_t global = face_count_;
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(section_faces)");
+  (sediment ? face_sediment_done_ : face_water_done_) = true;
 }
 
 void OpenClBackend::run_boundary() {
@@ -467,6 +499,14 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
     enqueue_gather(probe_cells_, probe_count_, probe_fields_, probe_out_);
     probe_raw_.resize(part_count(probe_fields_) * probe_count_);
     read(probe_out_, probe_raw_.size() * sizeof(float), probe_raw_.data(), false);
+  }
+  if (probes && face_water_done_) {  // a step's faces (end_step), in the same batch
+    face_water_raw_.resize(face_count_);
+    read(face_water_out_, face_count_ * sizeof(Real), face_water_raw_.data(), false);
+  }
+  if (probes && face_sediment_done_) {
+    face_sediment_raw_.resize(face_count_);
+    read(face_sediment_out_, face_count_ * sizeof(Real), face_sediment_raw_.data(), false);
   }
   stats_sums_raw_.resize(static_cast<std::size_t>(rows) * 6 * acc_size_);
   read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);

@@ -138,6 +138,7 @@ class OpenClBackend final : public Backend {
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,
                   const std::vector<FieldId>& fields) override;
+  void set_faces(const std::vector<Face>& faces) override;
   std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   void finish() override;
   std::vector<double> field(FieldId id) const override;
@@ -262,6 +263,16 @@ class OpenClBackend final : public Backend {
   std::size_t probe_count_ = 0;
   std::vector<FieldId> probe_fields_;
   std::vector<float> probe_raw_;
+  // The faces of the sections and outlets (set_faces, common/sections.h): their codes on the
+  // device, what the step moved through them (section_faces in stats.cl, enqueued before the
+  // water update and the transport, read with the step's statistics) and whether this step
+  // measured each.
+  Buffer face_codes_, face_water_out_, face_sediment_out_;
+  std::size_t face_count_ = 0;
+  bool face_water_done_ = false, face_sediment_done_ = false;
+  std::vector<float> face_water_raw_, face_sediment_raw_;
+  /// Enqueues section_faces for the water (sediment = false) or the sediment.
+  void measure_faces(bool sediment);
   Buffer point_cells_, point_amounts_;
   std::size_t point_capacity_ = 0;
   std::vector<cl_int> point_cells_host_;  // the sources of an upload that may be in flight

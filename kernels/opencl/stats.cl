@@ -6,6 +6,7 @@
  * work-items, each work-item first walking its cells with a fixed stride; field_stats is a
  * cell kernel (one work-item per cell). gather_cells, at the end, reads single cells. */
 #pragma OPENCL FP_CONTRACT OFF
+#include "sections.h"
 #include "stats.h"
 /* acc_t, the tally slots and the cell kernels' group sums: reduce.cl. */
 
@@ -279,4 +280,18 @@ __kernel void gather_cells(int n, int count, __global const int* restrict cells,
   if (count > 3) o[3 * n] = p3[c];
   if (count > 4) o[4 * n] = p4[c];
   if (count > 5) o[5 * n] = p5[c];
+}
+
+/* The faces of the sections and outlets (sections.h): out[j] = what crosses face codes[j],
+ * the water (sediment = 0) or the sediment (1), read with the step's statistics. */
+__kernel void section_faces(int n, int W, int sediment, __global const int* restrict codes,
+                            __global const real* sed, __global const real* depth_flow,
+                            __global const real* f_left, __global const real* f_right,
+                            __global const real* f_top, __global const real* f_bottom,
+                            __global real* restrict out) {
+  const int j = (int)get_global_id(0);
+  if (j >= n) return;
+  const int c = codes[j];
+  out[j] = sediment ? section_face_sediment(c, W, sed, depth_flow, f_left, f_right, f_top, f_bottom)
+                    : section_face_water(c, W, f_left, f_right, f_top, f_bottom);
 }

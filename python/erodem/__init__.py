@@ -6,7 +6,7 @@ config and ``erodem run --set``), the simulation runs in C++ with the GIL releas
 result files are written by the same writer as ``erodem run``.
 
 Public API (``docs/python.md``): :func:`read_dem`, :class:`DEM`, :class:`Simulation`,
-:func:`open_run`, :func:`sweep`, :func:`parameter_keys`, :func:`parameter_info`,
+:func:`open_run`, :func:`read_sections`, :func:`sweep`, :func:`parameter_keys`, :func:`parameter_info`,
 :exc:`UnstableError`.
 """
 
@@ -16,7 +16,7 @@ from . import _erodem
 from ._erodem import UnstableError
 from ._params import parameter_info, parameter_keys
 from .dem import DEM, read_dem
-from .results import open_run
+from .results import open_run, read_sections
 from .simulation import Simulation
 
 __all__ = [
@@ -24,6 +24,7 @@ __all__ = [
     "Simulation",
     "UnstableError",
     "open_run",
+    "read_sections",
     "parameter_info",
     "parameter_keys",
     "read_dem",
@@ -37,7 +38,7 @@ FIELDS = tuple(_erodem.field_names())
 
 # Named as before the split into modules, so that pickles (a DEM pickles as erodem.DEM),
 # reprs and help() read as they did.
-for _obj in (DEM, Simulation, open_run, parameter_info, parameter_keys, read_dem):
+for _obj in (DEM, Simulation, open_run, parameter_info, parameter_keys, read_dem, read_sections):
     _obj.__module__ = __name__
 del _obj
 

@@ -87,6 +87,8 @@ class Simulation:
     def ledger(self) -> Dict[str, float]: ...
     @property
     def diagnostics(self) -> Dict[str, float]: ...
+    @property
+    def sections(self) -> Dict[str, Dict[str, float]]: ...
     def erosion_volumes(self) -> Tuple[float, float]: ...
     @property
     def peak_depth(self) -> float: ...
@@ -109,6 +111,9 @@ class Simulation:
 
 def open_run(path: _Path, group: Optional[str] = ...) -> Any:
     """An xarray.Dataset of the result file."""
+
+def read_sections(path: _Path) -> Any:
+    """A pandas.DataFrame of the result file's cross-sections and outlets."""
 
 def sweep(
     dem: Union[DEM, _Path],

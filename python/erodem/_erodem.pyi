@@ -1,7 +1,7 @@
 """Type stubs of the extension module erodem._erodem (the C++ core). Use the package
 ``erodem``; these are its building blocks."""
 
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 import numpy.typing as npt
@@ -138,6 +138,8 @@ class Simulation:
     def ledger_text(self) -> str: ...
     @property
     def diagnostics(self) -> Dict[str, float]: ...
+    @property
+    def sections(self) -> Dict[str, Dict[str, Any]]: ...
     @property
     def backend(self) -> str: ...
     @property

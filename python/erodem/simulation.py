@@ -333,6 +333,17 @@ class Simulation:
         """The last step's diagnostics row (as in the result file's ``diagnostics``)."""
         return dict(self._sim.diagnostics)
 
+    @property
+    def sections(self) -> Dict[str, Dict[str, float]]:
+        """The cross-sections and outlets after the last step, by name (config order:
+        the ``[[section]]`` tables, then the ``[[outlet]]`` tables): ``discharge`` (m^3/s)
+        and ``sediment_flux`` (m^3/s of solid) in the step, the cumulative ``volume`` and
+        ``sediment_volume`` (m^3), ``peak_discharge`` (m^3/s) and its ``peak_time`` (s, the
+        end of its step), and ``outlet`` (bool). Sections count positive from the left to
+        the right of the line (walking from its first vertex), outlets out of the grid. The
+        result file's ``sections`` group holds every step (:func:`erodem.read_sections`)."""
+        return {k: dict(v) for k, v in self._sim.sections.items()}
+
     def erosion_volumes(self) -> Tuple[float, float]:
         """``(eroded, deposited)`` volume (m^3) so far: sums of the positive and negative
         parts of :attr:`erosion` times the cell areas, over active cells."""

@@ -273,6 +273,24 @@ void add_simulation_bindings(py::module_& m) {
       .def_property_readonly(
           "diagnostics",
           [](const PySimulation& s) { return diagnostics_dict(s.sim().diagnostics()); })
+      .def_property_readonly("sections",
+                             [](const PySimulation& s) {
+                               py::dict d;
+                               const Simulation& sim = s.sim();
+                               for (std::size_t k = 0; k < sim.sections().size(); ++k) {
+                                 const SectionState& st = sim.sections()[k];
+                                 py::dict row;
+                                 row["discharge"] = st.discharge;
+                                 row["sediment_flux"] = st.sediment_flux;
+                                 row["volume"] = st.volume;
+                                 row["sediment_volume"] = st.sediment_volume;
+                                 row["peak_discharge"] = st.peak_discharge;
+                                 row["peak_time"] = st.peak_time;
+                                 row["outlet"] = static_cast<bool>(sim.section_layout().outlet[k]);
+                                 d[py::str(sim.section_layout().names[k])] = row;
+                               }
+                               return d;
+                             })
       .def_property_readonly("backend",
                              [](const PySimulation& s) { return s.sim().backend().name(); })
       .def_property_readonly("device",

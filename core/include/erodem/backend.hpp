@@ -60,6 +60,16 @@ struct FieldStats {
   std::int64_t bad_cell = -1;  ///< first cell with NaN, infinite or negative state; -1: none
 };
 
+/// A face of the grid that a section or outlet measures (sections.hpp): the east face
+/// (axis 0) or the south face (axis 1) of DEM cell (col, row). col = -1 (axis 0) or row = -1
+/// (axis 1) is the ghost beyond the west or north edge, so every face of the grid, the edge
+/// faces included, has one name. Positive through it: eastwards (axis 0), southwards (axis 1).
+struct Face {
+  int col = 0;
+  int row = 0;
+  int axis = 0;
+};
+
 /// What one step gives back (Backend::end_step): its tallies, the statistics of the state it
 /// ends in, and the probe fields at the probe cells (Backend::set_probes).
 struct StepResult {
@@ -68,6 +78,12 @@ struct StepResult {
   /// probes[k * cells + j]: probe field k at probe cell j, as field(id)[cell] would give it
   /// (the bed with its residual); empty without probes.
   std::vector<double> probes;
+  /// face_water[j]: the net discharge (m^3/s) the water update moved through face j of
+  /// Backend::set_faces (positive eastwards / southwards), from the outflows it applied;
+  /// face_sediment[j]: the sediment flux (m^3/s of solid) through it, from the face fluxes
+  /// and concentrations the transport reads (0 in a step without transport). Empty without
+  /// faces.
+  std::vector<double> face_water, face_sediment;
 };
 
 /// Where a backend keeps a field of the DEM grid in host memory (the CPU reference does):
@@ -83,6 +99,11 @@ struct HostView {
 /// Checks that every cell of `cells` is a DEM cell of an nx x ny grid (0 <= cell < nx ny):
 /// Error(ExitCode::usage) naming `what` and the first cell that is not.
 void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const char* what);
+
+/// The faces as the backends index them: 2 * (padded cell index) + axis, with the padded
+/// index (col + 1) + (row + 1) * (nx + 2) of the cell west or north of the face.
+/// Error(ExitCode::usage) for a face off the grid.
+std::vector<int> padded_faces(const std::vector<Face>& faces, int nx, int ny);
 
 class Backend {
  public:
@@ -110,6 +131,9 @@ class Backend {
   /// the earlier probes; empty lists: none. A cell off the grid: Error(ExitCode::usage).
   virtual void set_probes(const std::vector<std::int64_t>& cells,
                           const std::vector<FieldId>& fields) = 0;
+  /// Registers the faces every step measures (StepResult::face_water, face_sediment).
+  /// Replaces the earlier ones; empty: none. A face off the grid: Error(ExitCode::usage).
+  virtual void set_faces(const std::vector<Face>& faces) = 0;
   /// `id` at the DEM cells `cells` now, each as field(id)[cell] gives it, without reading
   /// the whole field (a wait for the device on OpenCL). A cell off the grid:
   /// Error(ExitCode::usage).

@@ -66,6 +66,21 @@ struct InflowSpec {
   double sediment_concentration = 0.0;
 };
 
+/// A cross-section ([[section]]): a polyline in the DEM's CRS across which the discharge and
+/// the sediment flux are measured every step (sections.hpp).
+struct SectionSpec {
+  std::string name;                             ///< unique among sections and outlets
+  std::vector<std::array<double, 2>> vertices;  ///< x, y in the DEM's CRS, two or more
+};
+
+/// An outlet ([[outlet]]): what leaves the grid through a whole boundary edge, or through
+/// the faces one cell shares with the outside (the grid's edge or a nodata cell).
+struct OutletSpec {
+  std::string name;                   ///< unique among sections and outlets
+  std::string edge;                   ///< "north", "south", "east", "west", or "" for a point
+  std::array<double, 2> point{0, 0};  ///< x, y in the DEM's CRS (when edge is "")
+};
+
 struct Params {
   struct Dem {
     std::string path;       ///< DEM file (GDAL raster); empty when `synthetic` is set
@@ -115,6 +130,8 @@ struct Params {
   } rain;
 
   std::vector<InflowSpec> inflow;
+  std::vector<SectionSpec> section;  ///< [[section]] tables
+  std::vector<OutletSpec> outlet;    ///< [[outlet]] tables
 
   struct Erosion {
     bool enabled = false;

@@ -13,6 +13,7 @@
 #include "erodem/grid.hpp"
 #include "erodem/ledger.hpp"
 #include "erodem/params.hpp"
+#include "erodem/sections.hpp"
 
 namespace erodem {
 
@@ -110,6 +111,12 @@ class Simulation {
     return backend_->sample(cells, id);
   }
 
+  /// The faces of the cross-sections and outlets (params' [[section]], [[outlet]]).
+  const SectionLayout& section_layout() const { return sections_; }
+  /// Each section's and outlet's measure after the latest step (section_layout().names'
+  /// order): what the step's water update and transport moved through its faces, summed in
+  /// double in face order, and the running volumes and peak. All 0 before the first step.
+  const std::vector<SectionState>& sections() const { return section_state_; }
   double time() const { return time_; }
   long steps_done() const { return steps_; }
   const Ledger& ledger() const { return ledger_; }
@@ -188,6 +195,11 @@ class Simulation {
   std::vector<FieldId> probe_fields_;
   std::vector<double> probes_;
   bool probes_current_ = false;
+  SectionLayout sections_;
+  std::vector<SectionState> section_state_;
+  bool sections_measured_ = false;  // a step has set the peaks
+  /// Sums a step's face values into section_state_.
+  void measure_sections(const StepResult& result, double dt);
 };
 
 }  // namespace erodem
