@@ -39,6 +39,7 @@ class FieldRegistry {
     put(FieldId::hardness, &b.hardness_);
     put(FieldId::wetness, &b.wetness_);
     put(FieldId::manning_n, &b.manning_);
+    put(FieldId::rain_factor, &b.rain_factor_);
     put(FieldId::initial_bed, &b.bed0_);
     put(FieldId::bed_residual, &b.bed_residual_);
     for (const auto& f : field_table()) {

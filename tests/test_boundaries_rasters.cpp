@@ -623,6 +623,73 @@ TEST_P(RasterParameters, InfiltrationRastersGiveEachCellItsSoil) {
   EXPECT_EQ(rock_wet, 0);
 }
 
+TEST_P(RasterParameters, GriddedRainVariesInSpaceAndTime) {
+  // rain.grids: a three-band GeoTIFF (bands at 0, 1 h and 2 h, in mm/h) on two closed basins
+  // split by a nodata row (rows 0-4 and 6-9 of a 12 x 10 grid of 10 m, a bumpy bed): the
+  // north basin 10 mm/h, 0, 0; the south basin 0, 20 mm/h, 20 mm/h (the bands interpolated
+  // linearly in time, held after the last). After 3 h the north basin holds 5 mm (the first
+  // hour's mean) and the south 10 + 20 + 20 = 50 mm over its area (the ramp's mean, then the
+  // held band); the ledger's rain is their sum. Steps of 5 s (Courant 0.5 where the bumps pond 0.1
+  // m). Bounds: float64 1e-12; float32 1e-4: 2160 additions of a step's rain to a depth of a few
+  // mm, each rounded to half an ulp (2.3e-10 m at 5 mm), are at worst 5e-7 m, 1e-4 of the north
+  // basin's 5 mm, and in practice a random walk well below. The ledger (double) 1e-12. Bands
+  // read in the wrong order, not interpolated (held until the next band: 10 and 40 mm) or in
+  // the wrong units miss by 25 % or more.
+  TempDir dir;
+  const int nx = 12, ny = 10;
+  const double dx = 10.0, dt = 5.0, mm_h = 1e-3 / 3600.0;
+  const Grid g = Grid::uniform(nx, ny, dx);
+  std::vector<double> bed(g.cells());
+  std::vector<std::vector<float>> bands(3, std::vector<float>(g.cells()));
+  const float north[3] = {10, 0, 0}, south[3] = {0, 20, 20};
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx + c;
+      bed[i] = r == 5 ? kNaN : 1.0 + 0.2 * std::sin(0.8 * c) * std::cos(0.7 * r);
+      for (int b = 0; b < 3; ++b) bands[b][i] = r < 5 ? north[b] : r > 5 ? south[b] : NAN;
+    }
+  write_raster(dir.file("dem.tif"), g, bed);
+  Grid gr = g;
+  gr.georef.has_transform = true;
+  io::write_geotiff_bands(dir.file("radar.tif"), gr, bands, "rain (mm/h)");
+  Params p = quiet_params(FlowScheme::local_inertial, dt);
+  p.dem.path = dir.file("dem.tif");
+  p.rain.grids = dir.file("radar.tif");
+  p.rain.grid_interval = 3600.0;
+  p.flow.manning_n.value = 0.03;
+  p.time.duration = 3 * 3600.0;
+  auto sim = make_simulation(io::load_terrain(p), p, target());
+  sim.run();
+  const auto d = sim.field(FieldId::water_depth);
+  double volume[2] = {0, 0}, area[2] = {0, 0};
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      if (r == 5) continue;
+      volume[r > 5] += d[static_cast<std::size_t>(r) * nx + c] * g.area[r];
+      area[r > 5] += g.area[r];
+    }
+  const double expect[2] = {5.0 * 3600 * mm_h * area[0], 50.0 * 3600 * mm_h * area[1]};
+  double worst = 0;
+  for (int k = 0; k < 2; ++k) {
+    const double e = std::abs(volume[k] - expect[k]) / expect[k];
+    worst = std::max(worst, e);
+    std::printf(
+        "[rain grids] %s: %s basin holds %.6g m^3, the bands' integral %.6g m^3 "
+        "(relative %.2e, bound %.0e)\n",
+        target().label().c_str(), k ? "south" : "north", volume[k], expect[k], e,
+        bound(1e-12, 1e-4));
+  }
+  const double e_ledger =
+      std::abs(sim.ledger().rain - expect[0] - expect[1]) / (expect[0] + expect[1]);
+  std::printf("[rain grids] %s: ledger rain %.6g m^3 (relative %.1e, bound 1e-12)\n",
+              target().label().c_str(), sim.ledger().rain, e_ledger);
+  vr::expect_below(figure("raster_parameters", "local_inertial",
+                          "rain grids: |water / integral of the bands - 1|", dx,
+                          "water = the time integral of the interpolated bands per basin"),
+                   worst, bound(1e-12, 1e-4));
+  EXPECT_LT(e_ledger, 1e-12);
+}
+
 // ==== the stage hydrograph and boundary.raster's codes =====================================
 
 class Stage : public TargetTest {};

@@ -34,7 +34,7 @@ bool infiltration_on(const Params& p) {
   return p.infiltration.enabled;
 }
 bool rains(const Params& p) {
-  return p.rain.rate > 0 || !p.rain.series.empty();
+  return p.rain.rate > 0 || !p.rain.series.empty() || !p.rain.grids.empty();
 }
 
 /// A sweep the backends run through their generic cell loop (SweepInfo::generic): its cell

@@ -152,6 +152,8 @@ void check_cross_fields(const Params& p, const std::string& source) {
       (p.initial.water_depth.is_raster() || p.initial.water_depth.value != 0.0)) {
     throw fail("initial.water_level", "give initial.water_level or initial.water_depth, not both");
   }
+  if (!p.rain.grids.empty() && (p.rain.rate != 0.0 || !p.rain.series.empty()))
+    throw fail("rain.grids", "give rain.grids or rain.rate / rain.series, not both");
   if (p.rain.rate != 0.0 && !p.rain.series.empty()) {
     throw fail("rain.rate", "give rain.rate or rain.series, not both");
   }

@@ -114,6 +114,14 @@ const std::vector<Descriptor>& descriptor_table() {
              "rain rate series [[time (s), rate (m/s)], ...], linear in between, held at the end "
              "values outside"),
       text(ERODEM_FIELD(rain.raster), "raster path of a spatial rain multiplier (1); \"\" = none"),
+      text(ERODEM_FIELD(rain.grids),
+           "multi-band raster path of gridded rain on the DEM grid (radar): band k is the rate "
+           "at rain.grid_start + k rain.grid_interval, linear in between, held at the ends; "
+           "\"\" = none"),
+      number(ERODEM_FIELD(rain.grid_start), D::time, any_finite(), "time of the first band (s)"),
+      number(ERODEM_FIELD(rain.grid_interval), D::time, above(0), "time between bands (s)"),
+      number(ERODEM_FIELD(rain.grid_scale), D::speed, above(0),
+             "the rain rate one unit of the bands' values stands for (m/s; default '1 mm/h')"),
 
       inflow_descriptor("inflow",
                         "point or line inflows with a hydrograph [[time (s), discharge (m^3/s)]]"),

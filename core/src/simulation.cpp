@@ -135,6 +135,27 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
       rain_area_ += g.area[r] * factor;
       rain_factor_max_ = std::max(rain_factor_max_, factor);
     }
+  if (!terrain_.rain_grids.empty()) {
+    const double scale = params_.rain.grid_scale;
+    for (const auto& band : terrain_.rain_grids) {
+      if (band.size() != terrain_.bed.size())
+        throw Error(ExitCode::data, "rain.grids: a band's size differs from the grid's");
+      std::vector<double> rate(band.size(), 0.0);
+      double volume = 0.0, top = 0.0;
+      for (int r = 0; r < g.ny; ++r)
+        for (int c = 0; c < g.nx; ++c) {
+          const auto i = static_cast<std::size_t>(r) * g.nx + c;
+          if (!terrain_.active(i)) continue;
+          rate[i] =
+              band[i] * scale * (terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[i]);
+          volume += rate[i] * g.area[r];
+          top = std::max(top, rate[i]);
+        }
+      rain_bands_.push_back(std::move(rate));
+      rain_band_volume_.push_back(volume);
+      rain_band_max_.push_back(top);
+    }
+  }
   resolve_inflows();
   sections_ = layout_sections(terrain_, params_);
   section_state_.assign(sections_.names.size(), SectionState{});
@@ -248,11 +269,46 @@ void Simulation::set_probes(const std::vector<std::int64_t>& cells,
   probes_current_ = false;
 }
 
+std::pair<std::size_t, double> Simulation::rain_band_at(double t) const {
+  const std::size_t last = rain_bands_.size() - 1;
+  const double s = (t - params_.rain.grid_start) / params_.rain.grid_interval;
+  if (!(s > 0)) return {0, 0.0};
+  if (s >= static_cast<double>(last)) return {last, 0.0};
+  const auto k = static_cast<std::size_t>(s);
+  return {k, s - static_cast<double>(k)};
+}
+
+double Simulation::set_rain_grid(double t) {
+  const auto [k, w] = rain_band_at(t);
+  const double volume =
+      w > 0 ? (1 - w) * rain_band_volume_[k] + w * rain_band_volume_[k + 1] : rain_band_volume_[k];
+  if (k == rain_band_now_ && w == rain_weight_now_) return volume;
+  std::vector<double> rate = rain_bands_[k];
+  if (w > 0)
+    for (std::size_t i = 0; i < rate.size(); ++i)
+      rate[i] = (1 - w) * rate[i] + w * rain_bands_[k + 1][i];
+  backend_->set_field(FieldId::rain_factor, rate);
+  rain_band_now_ = k;
+  rain_weight_now_ = w;
+  return volume;
+}
+
 double Simulation::source_rise_rate() const {
   // Inputs are taken at the step's midpoint t + dt / 2 (inputs_for), within [t, t + dt_max / 2].
   const double t0 = time_, t1 = time_ + 0.5 * params_.time.dt_max;
   const auto& rain = params_.rain;
+  if (!rain_bands_.empty()) {  // the largest rate of the bands the window touches
+    const std::size_t k0 = rain_band_at(t0).first;
+    const std::size_t k1 = std::min(rain_band_at(t1).first + 1, rain_bands_.size() - 1);
+    double top = 0.0;
+    for (std::size_t k = k0; k <= k1; ++k) top = std::max(top, rain_band_max_[k]);
+    return top + source_rise_rate_of_inflows(t0, t1);
+  }
   const double rain_rate = rain.series.empty() ? rain.rate : series_max(rain.series, t0, t1);
+  return std::max(rain_rate, 0.0) * rain_factor_max_ + source_rise_rate_of_inflows(t0, t1);
+}
+
+double Simulation::source_rise_rate_of_inflows(double t0, double t1) const {
   double per_cell_max = 0.0;  // the largest inflow rise rate of one cell (m/s)
   std::vector<double> q(inflows_.size());
   for (std::size_t k = 0; k < inflows_.size(); ++k)
@@ -263,7 +319,7 @@ double Simulation::source_rise_rate() const {
     for (auto k : sc.inflows) sum += q[k];
     per_cell_max = std::max(per_cell_max, sum / sc.area);
   }
-  return std::max(rain_rate, 0.0) * rain_factor_max_ + per_cell_max;
+  return per_cell_max;
 }
 
 std::vector<Process> Simulation::sequence() const {
@@ -361,6 +417,7 @@ StepInputs Simulation::inputs_for(double dt) const {
   in.rain_rate =
       params_.rain.series.empty() ? params_.rain.rate : series_value(params_.rain.series, t_mid);
   in.boundary_level = boundary_level(params_, t_mid);
+  if (!rain_bands_.empty()) in.rain_rate = 1.0;  // the rain_factor field holds the rate (m/s)
   for (const auto& ic : inflows_) {
     const double q = series_value(params_.inflow[ic.spec].hydrograph, t_mid);
     const double share = q * dt / static_cast<double>(ic.cells.size());
@@ -410,6 +467,8 @@ void Simulation::step() {
   const double dt = next_dt();
   if (!(dt > 0)) throw Error(ExitCode::internal, "time step is not positive");
   const StepInputs in = inputs_for(dt);
+  // gridded rain: the rate of the step's midpoint in the rain_factor field, and its volume
+  const double rain_volume_rate = rain_bands_.empty() ? 0.0 : set_rain_grid(time_ + 0.5 * dt);
   backend_->begin_step(in);
   for (Process p : sequence()) backend_->run(p);
   StepResult result = backend_->end_step();  // the step's one wait
@@ -424,7 +483,7 @@ void Simulation::step() {
 
   double added = 0.0, sediment_added = 0.0;
   for (const auto& p : in.points) added += p.volume, sediment_added += p.sediment;
-  ledger_.rain += in.rain_rate * dt * rain_area_;
+  ledger_.rain += rain_bands_.empty() ? in.rain_rate * dt * rain_area_ : rain_volume_rate * dt;
   ledger_.inflow += added;
   ledger_.sediment_inflow += sediment_added;
   for (const auto& t : tally_table()) ledger_.*t.ledger += tally.*t.step;

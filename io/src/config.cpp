@@ -45,6 +45,7 @@ void resolve_relative_paths(Params& p, const std::string& base_dir) {
   p.dem.path = resolve_against(p.dem.path, base);
   for (const auto& r : parameter_rasters())
     if (std::string* path = r.path(p)) *path = resolve_against(*path, base);
+  p.rain.grids = resolve_against(p.rain.grids, base);
 }
 
 Params load_config(const std::string& path) {

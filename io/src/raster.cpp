@@ -87,14 +87,15 @@ std::array<int, 4> checked_window(GDALDatasetH ds, const std::optional<std::arra
 
 std::vector<double> read_band(GDALDatasetH ds, const std::array<int, 4>& w,
                               std::vector<std::uint8_t>& valid, const std::string& prefix,
-                              const std::string& path) {
-  GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+                              const std::string& path, int band_index) {
+  GDALRasterBandH band = GDALGetRasterBand(ds, band_index);
   const std::size_t n = static_cast<std::size_t>(w[2]) * static_cast<std::size_t>(w[3]);
   std::vector<double> v(n);
   CPLErrorReset();
   if (GDALRasterIO(band, GF_Read, w[0], w[1], w[2], w[3], v.data(), w[2], w[3], GDT_Float64, 0,
                    0) != CE_None)
-    throw Error(ExitCode::data, prefix + path + ": cannot read band 1" + gdal_reason());
+    throw Error(ExitCode::data,
+                prefix + path + ": cannot read band " + std::to_string(band_index) + gdal_reason());
 
   valid.assign(n, 1);
   const int flags = GDALGetMaskFlags(band);
@@ -157,9 +158,9 @@ RasterHeader read_raster_header(const std::string& path) {
   return r;
 }
 
-std::vector<double> read_raster_on_grid(const std::string& path, const Grid& grid,
-                                        const std::optional<std::array<int, 4>>& window,
-                                        const std::string& what) {
+std::vector<std::vector<double>> read_raster_bands_on_grid(
+    const std::string& path, const Grid& grid, const std::optional<std::array<int, 4>>& window,
+    const std::string& what, bool all_bands) {
   ensure_gdal();
   QuietGdal quiet;
   const std::string prefix = what + ": ";
@@ -188,7 +189,16 @@ std::vector<double> read_raster_on_grid(const std::string& path, const Grid& gri
     }
   }
   std::vector<std::uint8_t> valid;
-  return read_band(h, w, valid, prefix, path);
+  std::vector<std::vector<double>> bands;
+  const int count = all_bands ? GDALGetRasterCount(h) : 1;
+  for (int b = 1; b <= count; ++b) bands.push_back(read_band(h, w, valid, prefix, path, b));
+  return bands;
+}
+
+std::vector<double> read_raster_on_grid(const std::string& path, const Grid& grid,
+                                        const std::optional<std::array<int, 4>>& window,
+                                        const std::string& what) {
+  return std::move(read_raster_bands_on_grid(path, grid, window, what, false).front());
 }
 
 }  // namespace erodem::io

@@ -132,6 +132,7 @@ Terrain coarsen(const Terrain& fine, int factor) {
   };
   for (const auto& r : parameter_rasters())
     t.*r.values = r.categorical ? mode(fine.*r.values) : average(fine.*r.values);
+  for (const auto& band : fine.rain_grids) t.rain_grids.push_back(average(band));
   return t;
 }
 

@@ -71,11 +71,11 @@ Dataset open_raster(const std::string& path, const std::string& prefix);
 std::array<int, 4> checked_window(GDALDatasetH ds, const std::optional<std::array<int, 4>>& window,
                                   const std::string& prefix, const std::string& path);
 
-/// Band 1 of the window as double, with the band's scale and offset applied; `valid`
-/// receives 1 for valid cells and 0 for nodata / masked / non-finite ones.
+/// Band `band_index` (1-based) of the window as double, with the band's scale and offset
+/// applied; `valid` receives 1 for valid cells and 0 for nodata / masked / non-finite ones.
 std::vector<double> read_band(GDALDatasetH ds, const std::array<int, 4>& w,
                               std::vector<std::uint8_t>& valid, const std::string& prefix,
-                              const std::string& path);
+                              const std::string& path, int band_index = 1);
 
 /// The geotransform shifted to the top-left corner of pixel (col, row).
 std::array<double, 6> shifted(const std::array<double, 6>& t, int col, int row);

@@ -18,11 +18,19 @@ namespace fs = std::filesystem;
 
 void write_geotiff(const std::string& path, const Grid& grid, const std::vector<float>& values,
                    const std::string& description, double nodata) {
+  write_geotiff_bands(path, grid, {values}, description, nodata);
+}
+
+void write_geotiff_bands(const std::string& path, const Grid& grid,
+                         const std::vector<std::vector<float>>& bands,
+                         const std::string& description, double nodata) {
   ensure_gdal();
   QuietGdal quiet;
-  if (grid.nx < 1 || grid.ny < 1 || values.size() != grid.cells())
-    throw Error(ExitCode::internal, path + ": " + std::to_string(values.size()) + " values for a " +
-                                        size_text(grid.nx, grid.ny) + " grid");
+  for (const auto& values : bands)
+    if (grid.nx < 1 || grid.ny < 1 || values.size() != grid.cells())
+      throw Error(ExitCode::internal, path + ": " + std::to_string(values.size()) +
+                                          " values for a " + size_text(grid.nx, grid.ny) + " grid");
+  if (bands.empty()) throw Error(ExitCode::internal, path + ": no band to write");
   const fs::path target(path);
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
@@ -56,8 +64,8 @@ void write_geotiff(const std::string& path, const Grid& grid, const std::vector<
   const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=3", "TILED=YES", "BIGTIFF=IF_SAFER",
                            nullptr};
   CPLErrorReset();
-  Dataset ds(GDALCreate(drv, tmp_s.c_str(), grid.nx, grid.ny, 1, GDT_Float32,
-                        const_cast<char**>(options)));
+  Dataset ds(GDALCreate(drv, tmp_s.c_str(), grid.nx, grid.ny, static_cast<int>(bands.size()),
+                        GDT_Float32, const_cast<char**>(options)));
   if (!ds) throw Error(ExitCode::cant_create, path + ": cannot create" + gdal_reason());
   GDALDatasetH h = ds.get();
 
@@ -70,14 +78,15 @@ void write_geotiff(const std::string& path, const Grid& grid, const std::vector<
   if (!description.empty())
     ok = ok && GDALSetMetadataItem(h, "TIFFTAG_IMAGEDESCRIPTION", description.c_str(), nullptr) ==
                    CE_None;
-  GDALRasterBandH band = GDALGetRasterBand(h, 1);
-  if (!description.empty()) GDALSetDescription(band, description.c_str());
-  ok = ok && GDALSetRasterNoDataValue(band, nodata) == CE_None;
-  if (!ok) throw Error(ExitCode::io, path + ": cannot write georeferencing" + gdal_reason());
-
-  if (GDALRasterIO(band, GF_Write, 0, 0, grid.nx, grid.ny, const_cast<float*>(values.data()),
-                   grid.nx, grid.ny, GDT_Float32, 0, 0) != CE_None)
-    throw Error(ExitCode::io, path + ": write failed" + gdal_reason());
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    GDALRasterBandH band = GDALGetRasterBand(h, static_cast<int>(b) + 1);
+    if (!description.empty()) GDALSetDescription(band, description.c_str());
+    ok = ok && GDALSetRasterNoDataValue(band, nodata) == CE_None;
+    if (!ok) throw Error(ExitCode::io, path + ": cannot write georeferencing" + gdal_reason());
+    if (GDALRasterIO(band, GF_Write, 0, 0, grid.nx, grid.ny, const_cast<float*>(bands[b].data()),
+                     grid.nx, grid.ny, GDT_Float32, 0, 0) != CE_None)
+      throw Error(ExitCode::io, path + ": write failed" + gdal_reason());
+  }
   CPLErrorReset();
   GDALFlushCache(h);
   ds.reset();  // GDAL 3.6's GDALClose returns nothing: check the error state instead

@@ -44,6 +44,17 @@ Terrain load_terrain(const Params& p) {
     const std::string path = parameter_raster_path(r, p);
     if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);
   }
+  if (!p.rain.grids.empty()) {
+    t.rain_grids = read_raster_bands_on_grid(p.rain.grids, t.grid, p.dem.window, "rain.grids");
+    for (std::size_t b = 0; b < t.rain_grids.size(); ++b)
+      for (std::size_t i = 0; i < t.bed.size(); ++i)
+        if (t.active(i) && !(std::isfinite(t.rain_grids[b][i]) && t.rain_grids[b][i] >= 0))
+          throw Error(ExitCode::data, p.rain.grids + ": 'rain.grids' band " +
+                                          std::to_string(b + 1) + " value " +
+                                          std::to_string(t.rain_grids[b][i]) + " at cell " +
+                                          std::to_string(i % t.grid.nx) + ", " +
+                                          std::to_string(i / t.grid.nx) + " is not a rate >= 0");
+  }
   const int factor = resample_factor(p.dem, t.grid);
   if (factor > 1) t = coarsen(t, factor);
   apply_boundary_codes(t, p.boundary.raster);

@@ -36,6 +36,8 @@ enum FieldFlag : unsigned {
   /* derived: initial bed - bed (m); negative = deposition */                                      \
   X(erosion, "m", "cumulative net erosion (negative: deposition)", kOutputField | kDerivedField)   \
   X(manning_n, "s m-1/3", "Manning roughness coefficient", 0u)                                     \
+  /* rain.raster's multiplier (1), or with rain.grids the step's rain rate (m/s) */                \
+  X(rain_factor, "1", "rain multiplier", 0u)                                                       \
   /* the bed at the start of the run (m); erosion = initial_bed - bed */                           \
   X(initial_bed, "m", "bed elevation at the start of the run", kStateField)                        \
   /* the part of the bed below the precision of `bed` (m; compensated.h) */                        \

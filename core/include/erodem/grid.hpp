@@ -60,8 +60,10 @@ struct Terrain {
   std::vector<double> moisture_deficit;  ///< infiltration delta theta (1)
   std::vector<double> soil_depth;        ///< infiltration soil depth L (m)
   std::vector<double> boundary_code;     ///< boundary.raster's codes (boundary_codes.hpp)
-  std::string source;                    ///< DEM path or generator description
-  std::string source_sha256;             ///< checksum of the DEM file, when read from one
+  /// rain.grids' bands, each a rate in the bands' units (times rain.grid_scale: m/s)
+  std::vector<std::vector<double>> rain_grids;
+  std::string source;         ///< DEM path or generator description
+  std::string source_sha256;  ///< checksum of the DEM file, when read from one
 
   bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
 };

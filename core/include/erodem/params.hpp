@@ -127,6 +127,13 @@ struct Params {
     double rate = 0.0;  ///< uniform rate (m/s), used when `series` is empty
     Series series;      ///< time (s), rate (m/s), linear in between, held at the end values outside
     std::string raster;  ///< optional spatial multiplier raster (1)
+    /// Gridded rain that varies in time (radar, reanalysis): a multi-band raster on the DEM
+    /// grid, band k the rate at grid_start + k grid_interval, linear in between, held at the
+    /// ends; "" = none (rate or series instead).
+    std::string grids;
+    double grid_start = 0.0;              ///< time of band 1 (s)
+    double grid_interval = 3600.0;        ///< time between bands (s)
+    double grid_scale = 1.0e-3 / 3600.0;  ///< the rate one unit of the bands stands for (m/s)
   } rain;
 
   std::vector<InflowSpec> inflow;

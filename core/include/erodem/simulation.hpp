@@ -159,6 +159,8 @@ class Simulation {
   /// An upper bound of the depth per second (m/s) that this step's rain and inflows add to
   /// any one cell, for any step starting now no longer than time.dt_max.
   double source_rise_rate() const;
+  /// The largest rise rate one cell takes from the inflows over [t0, t1] (m/s).
+  double source_rise_rate_of_inflows(double t0, double t1) const;
   /// What to change when a run goes unstable (time.cfl / time.dt_max, or time.dt).
   std::string stability_advice() const;
   void check_stability(double dt) const;
@@ -178,6 +180,19 @@ class Simulation {
   std::vector<SourceCell> source_cells_;
   double rain_area_ = 0.0;        ///< sum(rain_factor * area) over active cells (m^2)
   double rain_factor_max_ = 0.0;  ///< largest rain_factor over active cells (1)
+  /// rain.grids: each band's rate (m/s) times the rain factor on the DEM cells, its volume rate
+  /// sum(rate area) over the active cells (m^3/s) and its largest rate (m/s); the band and
+  /// weight the backend's rain_factor field holds now.
+  std::vector<std::vector<double>> rain_bands_;
+  std::vector<double> rain_band_volume_, rain_band_max_;
+  std::size_t rain_band_now_ = static_cast<std::size_t>(-1);
+  double rain_weight_now_ = -1.0;
+  /// The band k and weight w of rain.grids at time t (s): the rate is (1 - w) band k + w band
+  /// k + 1, held at the ends.
+  std::pair<std::size_t, double> rain_band_at(double t) const;
+  /// Gives the backend the gridded rain of time t (s) when it changed; returns its volume rate
+  /// (m^3/s).
+  double set_rain_grid(double t);
   /// Active DEM cells beside a fixed-level cell (an edge ghost or a sea nodata cell).
   std::vector<std::int64_t> coast_cells_;
   double time_ = 0.0;

@@ -113,6 +113,12 @@ std::vector<double> read_raster_on_grid(const std::string& path, const Grid& gri
                                         const std::optional<std::array<int, 4>>& window,
                                         const std::string& what);
 
+/// Every band of a raster on `grid` (as read_raster_on_grid reads band 1), in band order; with
+/// `all_bands` false, band 1 only.
+std::vector<std::vector<double>> read_raster_bands_on_grid(
+    const std::string& path, const Grid& grid, const std::optional<std::array<int, 4>>& window,
+    const std::string& what, bool all_bands = true);
+
 /// Writes `values` (grid.nx * grid.ny, row-major, row 0 north) as a float32 GeoTIFF with
 /// the grid's geotransform and CRS (WKT), DEFLATE-compressed (floating-point predictor,
 /// tiled, BigTIFF when needed). `description` becomes the band description and the
@@ -127,6 +133,13 @@ std::vector<double> read_raster_on_grid(const std::string& path, const Grid& gri
 void write_geotiff(const std::string& path, const Grid& grid, const std::vector<float>& values,
                    const std::string& description,
                    double nodata = std::numeric_limits<double>::quiet_NaN());
+
+/// write_geotiff with several bands (a time series of rasters: rain.grids), each
+/// grid.nx * grid.ny values.
+void write_geotiff_bands(const std::string& path, const Grid& grid,
+                         const std::vector<std::vector<float>>& bands,
+                         const std::string& description,
+                         double nodata = std::numeric_limits<double>::quiet_NaN());
 
 /// SHA-256 of a file's bytes as 64 lower-case hex digits (GDAL /vsi paths work too).
 /// Throws Error(ExitCode::no_input) when the file cannot be opened, Error(ExitCode::io)
