@@ -319,6 +319,15 @@ TEST(Schema, InflowSedimentAndErosionLayers) {
     validate(q, "test");
   });
   EXPECT_NE(msg.find("erosion.enabled"), std::string::npos) << msg;
+  // the boundary's sediment too: without erosion it is refused, not silently dropped
+  msg = config_error_message([] {
+    Params q = from_text(
+        "[dem]\nsynthetic = \"hill\"\n[boundary]\nwest = \"fixed_level\"\n"
+        "sediment_concentration = 0.02\n");
+    validate(q, "test");
+  });
+  EXPECT_NE(msg.find("'boundary.sediment_concentration'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("erosion.enabled"), std::string::npos) << msg;
   msg = config_error_message([] { from_text("[erosion.soil]\ncritical_shear = \"2 m\"\n"); });
   EXPECT_NE(msg.find("'erosion.soil.critical_shear'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("Pa"), std::string::npos) << msg;

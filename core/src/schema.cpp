@@ -163,6 +163,10 @@ void check_cross_fields(const Params& p, const std::string& source) {
       throw fail(fmt::format("inflow[{}].sediment_concentration", k),
                  "sediment enters only with erosion.enabled = true (the sediment it carries moves "
                  "and settles with erosion and transport)");
+  if (p.boundary.sediment_concentration > 0 && !p.erosion.enabled)
+    throw fail("boundary.sediment_concentration",
+               "sediment enters only with erosion.enabled = true (as inflow[k]'s: the sediment the "
+               "boundary's water carries moves and settles with erosion and transport)");
   if (p.erosion.bedrock_level && p.erosion.soil_thickness.is_raster())
     throw fail("erosion.bedrock_level",
                "give erosion.bedrock_level or a raster erosion.soil_thickness, not both (the "
