@@ -13,7 +13,10 @@ Cases (docs/experiments/erosion.md records a run):
     its tuned constants, slope collapse on, fixed-level edges, the sea at 0 m), and the same with
     erosion.law = physical (the Mei constants are then unused).
 Every run is the CPU reference with one thread (numerics.threads = 1), float32 unless said.
-There is no infiltration yet: all the rain runs off.
+The runs of the first study have no infiltration (infiltration.enabled = false: all the rain
+runs off, as before issue 18); the *_inf runs repeat the physical law's with Green-Ampt
+infiltration into a loam 1 m deep (Rawls et al. 1983's K_sat 0.34 cm/h, psi 8.89 cm, delta
+theta 0.3: the main job's soil).
 
 Yields: the ledger's "sediment out" (what left through the edges and into the sea). The
 physical law books solid volumes (m^3 of grains): tonnes = m^3 * rho_s, rho_s = 2650 kg/m^3.
@@ -65,7 +68,7 @@ CASES = {
         "title": "Puget Sound main job (45 mm over 2 h, peak 30 mm/h, 3 h)",
     },
 }
-# (name, case, resample factor, law, precision)
+# (name, case, resample factor, law, precision[, infiltration])
 RUNS = [
     ("tujunga_physical_r1", "tujunga", 1, "physical", "float32"),
     ("tujunga_mei_r1", "tujunga", 1, "mei", "float32"),
@@ -77,7 +80,13 @@ RUNS = [
     ("puget_mei_r2", "puget", 2, "mei", "float32"),
     ("tujunga_physical_r1_f64", "tujunga", 1, "physical", "float64"),
     ("tujunga_mei_r1_f64", "tujunga", 1, "mei", "float64"),
+    ("tujunga_physical_r1_inf", "tujunga", 1, "physical", "float32", True),
+    ("tujunga_physical_r2_inf", "tujunga", 2, "physical", "float32", True),
+    ("puget_physical_r1_inf", "puget", 1, "physical", "float32", True),
+    ("puget_physical_r2_inf", "puget", 2, "physical", "float32", True),
 ]
+# the soil of the *_inf runs (the main job's)
+SOIL = ["infiltration.moisture_deficit=0.3", "infiltration.soil_depth=1.0"]
 # (float64 reference, float32 run): the physical default, and Mei's law as the yardstick of the
 # validation issue's check
 PRECISION_PAIRS = [("tujunga_physical_r1_f64", "tujunga_physical_r1"),
@@ -98,10 +107,14 @@ BANDS = {"tujunga": ("San Gabriel Mts., annual (Lavé & Burbank 2004)", SAN_GABR
 
 
 def command(name, erodem):
-    _, case, factor, law, precision = next(r for r in RUNS if r[0] == name)
+    _, case, factor, law, precision, *rest = next(r for r in RUNS if r[0] == name)
+    infiltration = bool(rest and rest[0])
     c = CASES[case]
     out = os.path.join(ROOT, "out", "erosion", name + ".h5")
     sets = c["sets"] + COMMON + ["erosion.law=%s" % law, "numerics.precision=%s" % precision]
+    sets += ["infiltration.enabled=%s" % ("true" if infiltration else "false")]
+    if infiltration:
+        sets += SOIL
     if factor > 1:
         sets.append("dem.resample=%d" % factor)
     cmd = [erodem, "run", c["config"], "--backend", "cpu", "--output", out, "--overwrite"]
@@ -190,8 +203,9 @@ def read_h5(path):
 
 
 def summarise(name, path, logfile):
-    _, case, factor, law, precision = next(r for r in RUNS if r[0] == name)
-    r = {"case": case, "resample": factor, "law": law, "precision": precision}
+    _, case, factor, law, precision, *rest = next(r for r in RUNS if r[0] == name)
+    r = {"case": case, "resample": factor, "law": law, "precision": precision,
+         "infiltration": bool(rest and rest[0])}
     r.update(parse_log(logfile))
     r.update(read_h5(path))
     # tonnes per kg/m^3 of the ledger's volumes: solid volumes (physical), bed volumes with no
@@ -248,16 +262,17 @@ def precision(rows, paths, erodem, a, b):
 
 
 def table(rows):
-    print("| catchment | cell | law | rain (m^3) | water out / rain | eroded (t) | deposited (t) "
+    print("| catchment | cell | law | infiltration | rain (m^3) | water out / rain | eroded (t) | deposited (t) "
           "| out (t) | out (t/km^2) | eroded (t/km^2) | mean bed lowering (mm) | deepest "
           "erosion (m) | max speed (m/s) | steps | wall (s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, r in rows.items():
         if r["precision"] != "float32":
             continue
-        print("| %s | %.0f m | %s | %.3e | %.2f | %.3e | %.3e | %.3e | %.4g | %.4g | %.3g | %.3g "
+        print("| %s | %.0f m | %s | %s | %.3e | %.2f | %.3e | %.3e | %.3e | %.4g | %.4g | %.3g | %.3g "
               "| %.3g | %d | %.0f |"
-              % (r["case"], r["dx_m"], r["law"], r["rain_m3"], r["runoff_out_fraction"],
+              % (r["case"], r["dx_m"], r["law"], "loam" if r["infiltration"] else "none",
+                 r["rain_m3"], r["runoff_out_fraction"],
                  r["eroded_t"], r["deposited_t"], r["sed_out_t"], r["sed_out_t_per_km2"],
                  r["eroded_t_per_km2"], r["mean_lowering_mm"], r["max_erosion_m"],
                  r["max_speed_ms"], r["steps"], r["wall_s"]))
@@ -272,7 +287,7 @@ def figure(rows, path):
     colors = {"physical": "tab:blue", "mei": "tab:red"}
     for ax, case in zip(axes, ("tujunga", "puget")):
         runs = [r for r in rows.values() if r["case"] == case and r["precision"] == "float32"]
-        runs.sort(key=lambda r: (r["law"] != "physical", r["resample"]))
+        runs.sort(key=lambda r: (r["law"] != "physical", r["infiltration"], r["resample"]))
         label, (lo, hi) = BANDS[case]
         ax.axhspan(lo, hi, color="0.8", zorder=0)
         x = np.arange(len(runs))
@@ -284,7 +299,8 @@ def figure(rows, path):
         for xi, v in zip(x - 0.2, out):
             ax.text(xi, v * 1.15, "{:,.0f}".format(v), ha="center", va="bottom", fontsize=6.5)
         ax.set_xticks(x)
-        ax.set_xticklabels(["%s\n%.0f m" % (r["law"], r["dx_m"]) for r in runs], fontsize=8)
+        ax.set_xticklabels(["%s%s\n%.0f m" % (r["law"], " + inf." if r["infiltration"] else "",
+                                                r["dx_m"]) for r in runs], fontsize=8)
         ax.set_yscale("log")
         ax.set_ylim(10, 1e9)
         ax.set_title(CASES[case]["title"], fontsize=9)
