@@ -120,6 +120,10 @@ CellParams<real> cell_params_of(const Params& params) {
   const double pi = 3.14159265358979323846;
   c.thermal.rate = r(params.thermal.rate);
   c.thermal.tan_talus = r(std::tan(params.thermal.talus_angle * pi / 180.0));
+  c.thermal.tan_wet = params.thermal.wet_talus_angle
+                          ? r(std::tan(*params.thermal.wet_talus_angle * pi / 180.0))
+                          : c.thermal.tan_talus;
+  c.thermal.wet_threshold = r(params.thermal.wet_threshold);
 
   c.evaporation.rate = r(params.evaporation.rate);
   c.evaporation.wetness_time = r(params.numerics.wetness_time);
@@ -194,7 +198,7 @@ static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
 static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));
-static_assert(sizeof(cell_params::ThermalParams<float>) == 2 * sizeof(float));
+static_assert(sizeof(cell_params::ThermalParams<float>) == 4 * sizeof(float));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::SnowParams<float>) == 5 * sizeof(float));
 static_assert(sizeof(cell_params::InfiltrationParams<float>) == 2 * sizeof(float) + sizeof(int));

@@ -386,6 +386,58 @@ TEST_P(Analytical, ThermalRelaxesToTalusAngle) {
   vr::expect_below(fig("material drift (relative)"), drift, target().f64() ? 1e-12 : 1e-5);
 }
 
+TEST_P(Analytical, ThermalRelaxesToTheWetTalusAngleOnWetGround) {
+  // Two 20 m blocks of 10 x 10 cells of 1 m (as ThermalRelaxesToTalusAngle's), one on dry ground
+  // (west half, wetness 0) and one on wet ground (east half, wetness 0.5 m, held by a
+  // wetness time of 1e12 s), thermal.talus_angle 35 deg and thermal.wet_talus_angle 25 deg
+  // above a wetness of 1 cm. Each half relaxes to its own angle: the steepest slope left in
+  // the dry half is 35 deg and in the wet half 25 deg, each within 1 deg (the fixed point of the
+  // relaxation, as in the dry test). Without the wet angle both read 35 deg; with it applied
+  // everywhere both read 25.
+  const int n = 80, half = 40;
+  const double dx = 1.0, dry = 35.0, wet = 25.0;
+  Terrain t = flat_terrain(n, n / 2, dx);
+  for (int r = 15; r < 25; ++r)
+    for (int c = 15; c < 25; ++c) {
+      t.bed[static_cast<std::size_t>(r) * n + c] = 20.0;
+      t.bed[static_cast<std::size_t>(r) * n + c + half] = 20.0;
+    }
+  Params p = quiet_params(FlowScheme::pipes, 0.1);
+  p.thermal.enabled = true;
+  p.thermal.talus_angle = dry;
+  p.thermal.wet_talus_angle = wet;
+  p.thermal.wet_threshold = 0.01;
+  p.thermal.rate = 5.0;  // K_t dt = 0.5
+  p.numerics.wetness_time = 1e12;
+  auto sim = make_simulation(t, p, target());
+  std::vector<double> w(t.bed.size(), 0.0);
+  for (int r = 0; r < n / 2; ++r)
+    for (int c = half; c < n; ++c) w[static_cast<std::size_t>(r) * n + c] = 0.5;
+  sim.backend().set_field(FieldId::wetness, w);
+  sim.step(8000);
+  const auto b = sim.field(FieldId::bed);
+  double steepest[2] = {0, 0};
+  for (int r = 0; r < n / 2; ++r)
+    for (int c = 0; c < n; ++c) {
+      const auto i = static_cast<std::size_t>(r) * n + c;
+      const int side = c >= half;
+      if (c + 1 < n && (c + 1 >= half) == side)
+        steepest[side] = std::max(steepest[side], std::abs(b[i] - b[i + 1]) / dx);
+      if (r + 1 < n / 2) steepest[side] = std::max(steepest[side], std::abs(b[i] - b[i + n]) / dx);
+    }
+  const double a_dry = std::atan(steepest[0]) * 180.0 / M_PI;
+  const double a_wet = std::atan(steepest[1]) * 180.0 / M_PI;
+  std::printf(
+      "[thermal wet] %s: steepest slope on dry ground %.4f deg (talus %.0f), on wet "
+      "ground %.4f deg (wet talus %.0f); bounds +-1 deg\n",
+      target().label().c_str(), a_dry, dry, a_wet, wet);
+  auto fig = [&](const char* quantity) {
+    return figure("thermal", "thermal", quantity, dx, "the talus angle of wet and dry ground");
+  };
+  vr::expect_between(fig("steepest slope on dry ground (deg)"), a_dry, dry - 1.0, dry + 1.0);
+  vr::expect_between(fig("steepest slope on wet ground (deg)"), a_wet, wet - 1.0, wet + 1.0);
+}
+
 TEST_P(Analytical, SedimentAdaptsToCapacityAlongUniformFlow) {
   const SedimentAdaptation set;
   const double cap = set.capacity(), duration = 2 * set.length / set.speed;

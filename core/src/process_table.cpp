@@ -206,11 +206,11 @@ std::vector<SweepInfo> thermal_sweeps(const Params&) {
   // it keeps and takes from its neighbours
   return {{"thermal_share",
            Domain::cells,
-           {{"kind", N}, {"bed", N}, {"thermal_share", Wr}},
+           {{"kind", N}, {"bed", N}, {"wetness", R}, {"thermal_share", Wr}},
            {"thermal_share"}},
           {"thermal_apply",
            Domain::cells,
-           {{"kind", N}, {"bed", U}, {"bed_residual", U}, {"thermal_share", N}},
+           {{"kind", N}, {"bed", U}, {"bed_residual", U}, {"wetness", N}, {"thermal_share", N}},
            {"thermal_apply"}}};
 }
 

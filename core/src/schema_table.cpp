@@ -203,6 +203,13 @@ const std::vector<Descriptor>& descriptor_table() {
       boolean(ERODEM_FIELD(thermal.enabled), "thermal erosion (slope collapse)"),
       number(ERODEM_FIELD(thermal.talus_angle), D::angle, open(0, 90), "talus angle (degrees)"),
       number(ERODEM_FIELD(thermal.rate), D::inverse_time, at_least(0), "thermal rate K_t (1/s)"),
+      optional_number(ERODEM_FIELD(thermal.wet_talus_angle), D::angle, open(0, 90),
+                      "talus angle of wet ground (degrees): cells whose wetness exceeds "
+                      "thermal.wet_threshold collapse to it (MODEL.md step 6); not set = "
+                      "thermal.talus_angle everywhere"),
+      number(ERODEM_FIELD(thermal.wet_threshold), D::length, at_least(0),
+             "wetness (m, the running mean of the depth, numerics.wetness_time) above which "
+             "ground is wet"),
 
       number(ERODEM_FIELD(evaporation.rate), D::inverse_time, at_least(0),
              "evaporation rate K_e (1/s)"),

@@ -181,6 +181,10 @@ struct Params {
     bool enabled = false;
     double talus_angle = 35.0;  ///< degrees
     double rate = 0.15;         ///< K_t (1/s)
+    /// talus angle of wet ground (degrees): cells whose wetness is above wet_threshold;
+    /// none = talus_angle everywhere
+    std::optional<double> wet_talus_angle;
+    double wet_threshold = 0.01;  ///< wetness (m, the running mean of the depth) of wet ground
   } thermal;
 
   struct Evaporation {
