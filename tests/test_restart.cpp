@@ -58,7 +58,8 @@ rate = 1e-6
 enabled = true
 initial = "20 mm"
 snow_line = "20 m"
-air_temperature = 3.0
+transition = "10 m"
+air_temperature = [[0, -2.0], [480, 6.0]]
 melt_factor = "100 mm/d"
 [infiltration]
 enabled = true
@@ -72,7 +73,7 @@ sea_level = 1.0
 path = "full.h5"
 interval = "2 min"
 fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness",
-          "snow", "infiltrated"]
+          "snow", "snow_liquid", "infiltrated"]
 )";
 
 /// The same with the shallow-water scheme: its unit discharges are state too.

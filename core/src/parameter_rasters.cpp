@@ -28,6 +28,8 @@ const std::vector<ParameterRaster>& parameter_rasters() {
          return p.infiltration.soil_depth ? &p.infiltration.soil_depth->path : nullptr;
        },
        &Terrain::soil_depth, 0.0, inf},
+      {"snow.initial", [](Params& p) { return &p.snow.initial.path; }, &Terrain::snow_initial, 0.0,
+       inf},
   };
   return table;
 }

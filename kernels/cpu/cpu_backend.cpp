@@ -85,6 +85,7 @@ double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) {
 template <class Real>
 void CpuBackend<Real>::begin_step(const StepInputs& in) {
   step_inputs_ = in;
+  step_cell_params(cell_, in);
   step_tally_ = StepTally{};
   in_step_ = true;
 }

@@ -82,8 +82,11 @@ void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real 
                             sweep.name, sweep.uses.size(), sweep.tallies.size(), nf, nt));
   std::array<void*, nf> fields{};
   for (std::size_t k = 0; k < nf; ++k) {
+    // the grid inputs outside the field table (kind, the rain factor), then the fields
     const std::string name = sweep.uses[k].field;
-    Field* f = name == "kind" ? nullptr : field_storage(field_info(name).id);
+    Field* f = name == "kind"          ? nullptr
+               : name == "rain_factor" ? &rain_factor_
+                                       : field_storage(field_info(name).id);
     if (name != "kind" && !f)
       throw Error(ExitCode::internal,
                   fmt::format("sweep '{}': field '{}' has no storage", sweep.name, name));

@@ -41,6 +41,7 @@ struct StepInputs {
   double t = 0.0;                   ///< time at the start of the step (s)
   double dt = 0.0;                  ///< step (s)
   double rain_rate = 0.0;           ///< uniform rain rate this step (m/s), times the rain factor
+  double air_temperature = 0.0;     ///< snow.air_temperature T_ref this step (degrees C)
   std::vector<PointSource> points;  ///< inflows this step
 };
 

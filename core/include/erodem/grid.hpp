@@ -59,6 +59,7 @@ struct Terrain {
   std::vector<double> suction;           ///< infiltration suction head psi (m)
   std::vector<double> moisture_deficit;  ///< infiltration delta theta (1)
   std::vector<double> soil_depth;        ///< infiltration soil depth L (m)
+  std::vector<double> snow_initial;      ///< the initial snow water equivalent S_0 (m)
   std::string source;                    ///< DEM path or generator description
   std::string source_sha256;             ///< checksum of the DEM file, when read from one
 
