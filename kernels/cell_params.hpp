@@ -141,6 +141,8 @@ CellParams<real> cell_params_of(const Params& params) {
   c.snow.retention = r(sn.retention);
   c.snow.rain_heat = r(kWaterHeatCapacity / kLatentHeatOfFusion);
   c.snow.rain_rate = r(0.0);  // step_cell_params
+  c.snow.tan_slide = r(sn.slide_angle ? std::tan(*sn.slide_angle * pi / 180.0) : 0.0);
+  c.snow.slide_rate = r(sn.slide_rate);
 
   // SWMM's recovery constant sqrt(K_sat / (1 in/h)) / 75 per hour = sqrt(K_sat swmm_scale) /
   // 270000 per second (Rossman 2015, section 4.3)
@@ -208,7 +210,7 @@ static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
 static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));
 static_assert(sizeof(cell_params::ThermalParams<float>) == 2 * sizeof(float));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
-static_assert(sizeof(cell_params::SnowParams<float>) == 9 * sizeof(float));
+static_assert(sizeof(cell_params::SnowParams<float>) == 11 * sizeof(float));
 static_assert(sizeof(cell_params::InfiltrationParams<float>) == 2 * sizeof(float) + sizeof(int));
 
 }  // namespace erodem

@@ -32,7 +32,8 @@ struct AgreementCase {
   ErosionLaw law = ErosionLaw::mei;
   bool infiltration = false;  ///< Green-Ampt on a loam with a 0.2 m soil (its recovery too)
   /// a snow pack above 1200 m (a 200 m band, slopes below 30 degrees) under a warming series
-  /// T_ref(t) at 1000 m: snowfall, rain on snow, melt and liquid water at once
+  /// T_ref(t) at 1000 m: snowfall, rain on snow, melt, liquid water and sliding above 40
+  /// degrees at once
   bool snow = false;
 };
 
@@ -51,6 +52,8 @@ Params agreement_params(const AgreementCase& c) {
   p.snow.reference_elevation = 1000.0;
   p.snow.air_temperature_series = {{0.0, 2.0}, {2000.0, 12.0}};
   p.snow.melt_factor = 50e-3 / 86400.0;
+  p.snow.slide_angle = 40.0;
+  p.snow.slide_rate = 1e-3;
   return p;
 }
 

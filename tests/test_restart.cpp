@@ -21,9 +21,10 @@ namespace {
 
 using erodem::test::run_cli;
 
-/// Local inertial flow, conservative transport, thermal collapse, a melting snow pack above
-/// 20 m, Green-Ampt infiltration into a finite store, an open and a fixed-level edge, a rain
-/// series and adaptive steps: every state field changes.
+/// Local inertial flow, conservative transport, thermal collapse, a snow pack above 20 m (a
+/// temperature series through the snowfall threshold, sliding), Green-Ampt infiltration into a
+/// finite store, an open and a fixed-level edge, a rain series and adaptive steps: every state
+/// field changes.
 const char* kInertial = R"([dem]
 synthetic = "valley"
 size = 48
@@ -59,6 +60,8 @@ enabled = true
 initial = "20 mm"
 snow_line = "20 m"
 transition = "10 m"
+slide_angle = 20.0
+slide_rate = 0.01
 air_temperature = [[0, -2.0], [480, 6.0]]
 melt_factor = "100 mm/d"
 [infiltration]

@@ -483,6 +483,64 @@ TEST_P(Snow, InitialPackFollowsTheTransitionBandAndTheSlopeLimit) {
                            worst, bound);
 }
 
+TEST_P(Snow, PackSlidesDownSlopesSteeperThanTheSlideAngle) {
+  // 8 columns of 10 m, 3 rows: a 60 degree slope falling eastwards over columns 0 .. 5
+  // (17.32 m per column), flat from column 5 on; S_0 = 0.1 m everywhere at -10 degrees C (no
+  // melt), snow.slide_angle 45 degrees; the snow process alone. With slide_rate dt = 1 each
+  // steep cell gives its whole pack to its only lower neighbour (east; the rows are level)
+  // every step: after 5 steps the pack of columns 0 .. 5 lies on column 5 (6 S_0), columns
+  // 0 .. 4 are bare and 6, 7 keep S_0. With slide_rate dt = 1/4, one step: column 0 keeps
+  // 0.75 S_0, 1 .. 4 give and take S_0 / 4, column 5 gets 1.25 S_0. With the slide angle at
+  // 65 degrees (steeper than the ramp) nothing moves. Every cell against these to float64
+  // 1e-14, float32 1e-6 of S_0 (the share's division by the excess drop, 7.3 m, rounds), and
+  // the pack's volume is kept (same bounds, relative). An idle or one-sided sweep fails
+  // column 5 by 5 S_0 or the volume by S_0 per step.
+  const int nx = 8;
+  const double dx = 10.0, s0 = 0.1, drop = dx * std::tan(60.0 * 3.14159265358979323846 / 180.0);
+  Terrain terrain = flat_terrain(nx, 3, dx);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < nx; ++c)
+      terrain.bed[static_cast<std::size_t>(r) * nx + c] = c < 5 ? drop * (5 - c) : 0.0;
+  const double bound = this->bound(1e-14, 1e-6) * s0;
+  struct Case {
+    double angle, rate_dt;
+    long steps;
+    std::vector<double> expect;  // per column, in units of S_0
+  };
+  const Case cases[] = {{45.0, 1.0, 5, {0, 0, 0, 0, 0, 6, 1, 1}},
+                        {45.0, 0.25, 1, {0.75, 1, 1, 1, 1, 1.25, 1, 1}},
+                        {65.0, 1.0, 5, {1, 1, 1, 1, 1, 1, 1, 1}}};
+  for (const Case& k : cases) {
+    const double dt = 3600.0;
+    Params p = snow_params(s0, 4e-3 / kDay, -10.0, 0.0, dt);
+    p.snow.slide_angle = k.angle;
+    p.snow.slide_rate = k.rate_dt / dt;
+    auto sim = make_simulation(terrain, p, target());
+    const auto start = sim.field(FieldId::snow);
+    run_processes(sim, {Process::snow}, dt, k.steps);
+    const auto snow = sim.field(FieldId::snow);
+    double worst = 0.0, before = 0.0, after = 0.0;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < nx; ++c) {
+        const auto i = static_cast<std::size_t>(r) * nx + c;
+        worst = std::max(worst, std::abs(snow[i] - k.expect[static_cast<std::size_t>(c)] * s0));
+        before += start[i];
+        after += snow[i];
+      }
+    const double kept = std::abs(after / before - 1.0);
+    std::printf(
+        "[snow slide] %s: angle %.0f deg, rate dt %.2f, %ld steps: max |snow - expected| %.1e m "
+        "(bound %.1e m), |volume after / before - 1| %.1e (bound %.0e)\n",
+        target().label().c_str(), k.angle, k.rate_dt, k.steps, worst, bound, kept,
+        this->bound(1e-14, 1e-6));
+    auto fig = [&](const char* q) {
+      return figure("snow_slide", "degree_day", q, dx, "pack moved down slopes above the angle");
+    };
+    validation::expect_below(fig("max |snow - expected| (m)"), worst, bound);
+    validation::expect_below(fig("|volume after / before - 1|"), kept, this->bound(1e-14, 1e-6));
+  }
+}
+
 ERODEM_INSTANTIATE_TARGETS(Snow);
 
 }  // namespace

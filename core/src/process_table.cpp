@@ -217,17 +217,31 @@ std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
       {"evaporated"})};
 }
 
-std::vector<SweepInfo> snow_sweeps(const Params&) {
+std::vector<SweepInfo> snow_sweeps(const Params& p) {
+  std::vector<SweepInfo> s;
+  if (p.snow.slide_angle) {
+    // snow_slide_share_sweep_cell then snow_slide_sweep_cell (snow.h): what each pack gives
+    // down slopes steeper than the slide angle, then what it keeps and takes (thermal's
+    // pattern), before the melt
+    s.push_back(generic_sweep(
+        "snow_slide_share",
+        {{"kind", N}, {"bed", N}, {"snow", R}, {"dx", R}, {"dy", R}, {"snow_slide_share", Wr}},
+        {}));
+    s.push_back(generic_sweep(
+        "snow_slide",
+        {{"kind", N}, {"bed", N}, {"snow", U}, {"dx", R}, {"dy", R}, {"snow_slide_share", N}}, {}));
+  }
   // snow_sweep_cell (snow.h): snowfall and rain on snow from the step's rain on the depth,
   // the degree-day melt and the rain's heat, the liquid water beyond retention into the depth
-  return {generic_sweep("snow",
-                        {{"kind", R},
-                         {"bed", R},
-                         {"rain_factor", R},
-                         {"snow", U},
-                         {"snow_liquid", U},
-                         {"water_depth", U}},
-                        {"snowfall", "rain_on_snow", "snow_melted", "snow_runoff"})};
+  s.push_back(generic_sweep("snow",
+                            {{"kind", R},
+                             {"bed", R},
+                             {"rain_factor", R},
+                             {"snow", U},
+                             {"snow_liquid", U},
+                             {"water_depth", U}},
+                            {"snowfall", "rain_on_snow", "snow_melted", "snow_runoff"}));
+  return s;
 }
 
 /// The slope of the bed at DEM cell (col c, row r) in degrees: the angle of the gradient by
@@ -536,6 +550,7 @@ std::vector<std::string> opencl_cell_kernels() {
   Params p;
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
+  p.snow.slide_angle = 45.0;
   for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial, FlowScheme::shallow_water})
     for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian})
       for (auto law : {ErosionLaw::mei, ErosionLaw::physical}) {

@@ -225,6 +225,13 @@ const std::vector<Descriptor>& descriptor_table() {
       number(ERODEM_FIELD(snow.transition), D::length, at_least(0),
              "width of the band centred on snow.snow_line over which the initial pack ramps "
              "linearly from 0 to snow.initial (m); 0 = a sharp line"),
+      optional_number(ERODEM_FIELD(snow.slide_angle), D::angle, open(0, 90),
+                      "the pack slides towards the active neighbours whose bed lies lower than "
+                      "this angle below it (degrees; Bernhardt & Schulz 2010 use 25 - 60); not "
+                      "set = the pack does not move"),
+      number(ERODEM_FIELD(snow.slide_rate), D::inverse_time, at_least(0),
+             "fraction of a sliding cell's pack that moves per second (1/s; min(1, rate dt) "
+             "per step)"),
       optional_number(ERODEM_FIELD(snow.max_slope), D::angle, closed(0, 90),
                       "the initial pack lies only where the bed's slope (central differences) "
                       "is below this (degrees); not set = on any slope"),

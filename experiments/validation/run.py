@@ -169,6 +169,13 @@ CASES = {
         "S(t) = S0 - DDF times the integral of max(0, T_ref): 24.5 mm by 3 d, 172.5 mm by 6 d "
         "(the step-midpoint values integrate the linear series exactly).",
     ),
+    "snow_slide": (
+        "Snow: the pack slides down slopes steeper than the slide angle",
+        "8 columns of 10 m, a 60 degree slope then flat, 0.1 m of snow, slide angle 45 degrees "
+        "(and 65: nothing moves), slide_rate dt 1 (5 steps) and 1/4 (1 step).",
+        "The pack gathers on the first flat column (6 S0) or moves a quarter per step; its "
+        "volume is kept to rounding.",
+    ),
     "snow_initial_rule": (
         "Snow: the initial pack with a transition band and a slope limit",
         "A ramp of 25 m then 60 m per 50 m column, snow line 400 m, band 200 m, max slope 35 "

@@ -25,3 +25,32 @@ __kernel void snow(int W, int H, __global const uchar* restrict kind,
   cell_group_sum2(s_melt, s_out, melted, out, partials + ERODEM_TALLY_SNOW_MELTED * stride + g,
                   partials + ERODEM_TALLY_SNOW_RUNOFF * stride + g);
 }
+
+/* Sliding (snow.slide_angle): pass 1, what each cell gives per metre of excess drop. */
+__kernel void snow_slide_share(int W, int H, __global const uchar* restrict kind,
+                               __global const real* restrict bed,
+                               __global const real* restrict snow, __global const real* restrict dx,
+                               __global const real* restrict dy, __global real* restrict share,
+                               __global const real* restrict area, real dt, SnowParams p,
+                               __global acc_t* restrict partials, int stride) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  (void)H;
+  (void)partials;
+  (void)stride;
+  if (ERODEM_PAST_ROW(x, W)) return;
+  snow_slide_share_sweep_cell(x, y, W, kind, bed, snow, dx, dy, share, area, dt, p);
+}
+
+/* Sliding: pass 2, each pack after what it gave and took. */
+__kernel void snow_slide(int W, int H, __global const uchar* restrict kind,
+                         __global const real* restrict bed, __global real* restrict snow,
+                         __global const real* restrict dx, __global const real* restrict dy,
+                         __global const real* restrict share, __global const real* restrict area,
+                         real dt, SnowParams p, __global acc_t* restrict partials, int stride) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  (void)H;
+  (void)partials;
+  (void)stride;
+  if (ERODEM_PAST_ROW(x, W)) return;
+  snow_slide_sweep_cell(x, y, W, kind, bed, snow, dx, dy, share, area, dt, p);
+}

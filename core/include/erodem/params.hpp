@@ -185,6 +185,11 @@ struct Params {
     double transition = 0.0;
     /// the initial pack lies only where the slope is below this (degrees); none = anywhere
     std::optional<double> max_slope;
+    /// the pack slides towards neighbours lower than this angle below it (degrees); none = no
+    /// sliding
+    std::optional<double> slide_angle;
+    /// the fraction of a sliding cell's pack that moves per second (1/s): 1/h
+    double slide_rate = 1.0 / 3600.0;
   } snow;
 
   /// Green-Ampt infiltration (infiltration.h, docs/model.md section 3.11). The soil's K_sat,
