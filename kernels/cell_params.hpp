@@ -22,6 +22,11 @@
 
 namespace erodem {
 
+/// The specific heat of water c_w (J/kg/K) and the latent heat of fusion of ice L_f (J/kg):
+/// rain at T degrees C on a pack melts c_w T / L_f of snow per unit of rain (snow.h).
+constexpr double kWaterHeatCapacity = 4186.0;
+constexpr double kLatentHeatOfFusion = 334000.0;
+
 /// The run constants of every process, in `real` (float, or double for the CPU's float64).
 template <class real>
 struct CellParams {
@@ -87,7 +92,8 @@ cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
 /// The run constants from the parameters (units in the structs' headers): sea_level;
 /// gravity, theta, dry_depth, pipe_area, pipe_length; velocity_min_depth; the erosion rates,
 /// with -inf for no bedrock level; K_t and tan(talus angle); K_e, the wetness time and
-/// whether it evaporates; the snow pack's DDF, temperatures, reference elevation and lapse rate;
+/// whether it evaporates; the snow pack's DDF, temperatures, reference elevation, lapse rate,
+/// snowfall threshold, retention and c_w / L_f (its T_ref and rain rate: step_cell_params);
 /// infiltration's recovery constant (given, or SWMM's rule from K_sat).
 template <class real>
 CellParams<real> cell_params_of(const Params& params) {
@@ -135,6 +141,12 @@ CellParams<real> cell_params_of(const Params& params) {
   c.snow.air_temperature = r(sn.air_temperature);
   c.snow.reference_elevation = r(sn.reference_elevation);
   c.snow.lapse_rate = r(sn.lapse_rate);
+  c.snow.snowfall_temperature = r(sn.snowfall_temperature);
+  c.snow.retention = r(sn.retention);
+  c.snow.rain_heat = r(kWaterHeatCapacity / kLatentHeatOfFusion);
+  c.snow.rain_rate = r(0.0);  // step_cell_params
+  c.snow.tan_slide = r(sn.slide_angle ? std::tan(*sn.slide_angle * pi / 180.0) : 0.0);
+  c.snow.slide_rate = r(sn.slide_rate);
 
   // SWMM's recovery constant sqrt(K_sat / (1 in/h)) / 75 per hour = sqrt(K_sat swmm_scale) /
   // 270000 per second (Rossman 2015, section 4.3)
@@ -150,6 +162,15 @@ CellParams<real> cell_params_of(const Params& params) {
 /// a step begins.
 inline double step_level(const StepInputs& in, const Params& params) {
   return std::isnan(in.boundary_level) ? params.boundary.sea_level : in.boundary_level;
+}
+
+/// The members of the parameter structs that follow the step (StepInputs), set by the
+/// backends' begin_step: the snow pack's air temperature T_ref (the series' value at the step
+/// midpoint, or the constant) and the step's rain rate.
+template <class real>
+void step_cell_params(CellParams<real>& c, const StepInputs& in) {
+  c.snow.air_temperature = static_cast<real>(in.air_temperature);
+  c.snow.rain_rate = static_cast<real>(in.rain_rate);
 }
 
 /// The bytes of process `p`'s parameter struct in `c` (what the generic sweeps pass to their
@@ -200,7 +221,7 @@ static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
 static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));
 static_assert(sizeof(cell_params::ThermalParams<float>) == 4 * sizeof(float));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
-static_assert(sizeof(cell_params::SnowParams<float>) == 5 * sizeof(float));
+static_assert(sizeof(cell_params::SnowParams<float>) == 11 * sizeof(float));
 static_assert(sizeof(cell_params::InfiltrationParams<float>) == 2 * sizeof(float) + sizeof(int));
 
 }  // namespace erodem

@@ -212,6 +212,7 @@ inline StepTally run_processes(Simulation& sim, const std::vector<Process>& proc
   Backend& be = sim.backend();
   for (long k = 0; k < steps; ++k) {
     in.t = k * dt;
+    in.air_temperature = sim.air_temperature_at(in.t + 0.5 * dt);
     be.begin_step(in);
     for (Process p : processes) be.run(p);
     const StepTally step = be.end_step().tally;

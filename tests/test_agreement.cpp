@@ -31,6 +31,10 @@ struct AgreementCase {
   int order = 1;  ///< flow.order (shallow water)
   ErosionLaw law = ErosionLaw::mei;
   bool infiltration = false;  ///< Green-Ampt on a loam with a 0.2 m soil (its recovery too)
+  /// a snow pack above 1200 m (a 200 m band, slopes below 30 degrees) under a warming series
+  /// T_ref(t) at 1000 m: snowfall, rain on snow, melt, liquid water and sliding above 40
+  /// degrees at once
+  bool snow = false;
 };
 
 Params agreement_params(const AgreementCase& c) {
@@ -40,6 +44,16 @@ Params agreement_params(const AgreementCase& c) {
   p.infiltration.enabled = c.infiltration;
   p.infiltration.ksat.value = 5e-3 / 3600.0;  // 5 mm/h: part of the storm soaks in
   p.infiltration.soil_depth = ScalarOrRaster{0.2, {}};
+  p.snow.enabled = c.snow;
+  p.snow.initial.value = 0.05;
+  p.snow.snow_line = 1200.0;
+  p.snow.transition = 200.0;
+  p.snow.max_slope = 30.0;
+  p.snow.reference_elevation = 1000.0;
+  p.snow.air_temperature_series = {{0.0, 2.0}, {2000.0, 12.0}};
+  p.snow.melt_factor = 50e-3 / 86400.0;
+  p.snow.slide_angle = 40.0;
+  p.snow.slide_rate = 1e-3;
   return p;
 }
 
@@ -68,10 +82,11 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
       cpu.last_stats().max_speed, cpu.ledger().water, cpu.ledger().rain, cpu.ledger().boundary_out);
   EXPECT_NEAR(ocl.time(), cpu.time(), 1e-5 * cpu.time());
   const double bound = 1e-5;
-  for (FieldId id : {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
-                     FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right,
-                     FieldId::flux_top, FieldId::flux_bottom, FieldId::wetness, FieldId::erosion,
-                     FieldId::soil_thickness, FieldId::infiltrated}) {
+  for (FieldId id :
+       {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
+        FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right, FieldId::flux_top,
+        FieldId::flux_bottom, FieldId::wetness, FieldId::erosion, FieldId::soil_thickness,
+        FieldId::infiltrated, FieldId::snow, FieldId::snow_liquid}) {
     const auto a = ocl.field(id), b = cpu.field(id);
     ASSERT_EQ(a.size(), b.size());
     // ||a - b|| / ||b|| (0 when both vanish) as `erodem compare` computes it; every cell
@@ -93,6 +108,19 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
       L.relative_closure_error(), M.relative_closure_error());
   EXPECT_NEAR(M.water, L.water, 1e-5 * L.water);
   EXPECT_NEAR(M.infiltrated, L.infiltrated, 1e-5 * L.infiltrated);
+  for (double Ledger::*v :
+       {&Ledger::snowfall, &Ledger::rain_on_snow, &Ledger::snow_melted, &Ledger::snow_runoff})
+    EXPECT_NEAR(M.*v, L.*v, 1e-5 * L.*v);
+  if (c.snow) {
+    std::printf(
+        "[agreement] %s snow: snowfall %.9g / %.9g, rain on snow %.9g / %.9g, melted %.9g / "
+        "%.9g, runoff %.9g / %.9g m^3\n",
+        c.name.c_str(), L.snowfall, M.snowfall, L.rain_on_snow, M.rain_on_snow, L.snow_melted,
+        M.snow_melted, L.snow_runoff, M.snow_runoff);
+    EXPECT_GT(L.snowfall, 0.0);
+    EXPECT_GT(L.rain_on_snow, 0.0);
+    EXPECT_GT(L.snow_melted, 0.0);
+  }
   EXPECT_NEAR(M.material, L.material, 1e-6 * std::abs(L.material));
   EXPECT_NEAR(M.boundary_out, L.boundary_out, 1e-5 * std::abs(L.boundary_out) + 1e-9);
 
@@ -271,7 +299,10 @@ INSTANTIATE_TEST_SUITE_P(
                       TransportScheme::conservative, true, 2.0, 1, ErosionLaw::physical},
         // Green-Ampt infiltration (the libraries' log1p on each side: equal here, not promised)
         AgreementCase{"local_inertial_infiltration", FlowScheme::local_inertial,
-                      TransportScheme::conservative, true, 2.0, 1, ErosionLaw::physical, true}),
+                      TransportScheme::conservative, true, 2.0, 1, ErosionLaw::physical, true},
+        // the snow pack: snowfall, rain on snow, melt, liquid water under a temperature series
+        AgreementCase{"local_inertial_snow", FlowScheme::local_inertial,
+                      TransportScheme::conservative, true, 2.0, 1, ErosionLaw::mei, false, true}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
 
 }  // namespace

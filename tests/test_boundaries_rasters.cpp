@@ -690,8 +690,7 @@ TEST_P(RasterParameters, GriddedRainVariesInSpaceAndTime) {
   EXPECT_LT(e_ledger, 1e-12);
 }
 
-// ==== the stage hydrograph and boundary.raster's codes =====================================
-
+// ==== the stage hydrograph and boundary.raster's codes ==============================
 class Stage : public TargetTest {};
 
 /// A flat basin of nx x ny cells of 10 m at bed 0, `depth` m of water, Manning 0.03, local
@@ -856,6 +855,50 @@ TEST(BoundaryRaster, BadCodesAreNamed) {
       EXPECT_EQ(e.code(), ExitCode::data);
     }
   }
+=======
+TEST_P(RasterParameters, SnowInitialRasterTakesTheSnowLineRule) {
+  // A 6 x 4 grid of 100 m cells whose bed rises 100 m per column (0 .. 500 m), with the initial
+  // snow water equivalent from a raster read through snow.initial's path, 0.01 (1 + row + col)
+  // m (every cell its own), under the snow-line rule: snow_line 250 m, transition 200 m, so
+  // the pack is S_0 times clamp((z - 150) / 200, 0, 1): none on columns 0 and 1, a quarter on
+  // 2, three quarters on 3, whole on 4 and 5. Every cell against
+  // the raster's (float32) value times the share; bound: float64 1e-15, float32 1e-7 of the
+  // largest S_0 (rounding). The uniform value (0) in place of the raster leaves no snow; a
+  // raster read upside down or mirrored puts another cell's S_0 on every cell.
+  TempDir dir;
+  const int nx = 6, ny = 4;
+  const Grid g = Grid::uniform(nx, ny, 100.0);
+  std::vector<double> bed(g.cells()), s0(g.cells());
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx + c;
+      bed[i] = 100.0 * c;
+      s0[i] = 0.01 * (1 + r + c);
+    }
+  write_raster(dir.file("dem.tif"), g, bed);
+  write_raster(dir.file("snow.tif"), g, s0);
+  Params p = quiet_params(FlowScheme::local_inertial, 60.0);
+  p.dem.path = dir.file("dem.tif");
+  p.snow.enabled = true;
+  p.snow.initial = ScalarOrRaster{0.0, dir.file("snow.tif")};
+  p.snow.snow_line = 250.0;
+  p.snow.transition = 200.0;
+  auto sim = make_simulation(io::load_terrain(p), p, target());
+  const auto snow = sim.field(FieldId::snow);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < snow.size(); ++i) {
+    const double share = std::clamp((bed[i] - 150.0) / 200.0, 0.0, 1.0);
+    worst = std::max(worst, std::abs(snow[i] - static_cast<float>(s0[i]) * share));
+  }
+  const double limit = bound(1e-15, 1e-7) * 0.09;
+  std::printf(
+      "[snow raster] %s: max |snow - S0_raster x share| over %zu cells %.1e m (bound %.1e "
+      "m)\n",
+      target().label().c_str(), snow.size(), worst, limit);
+  vr::expect_below(figure("raster_parameters", "degree_day",
+                          "snow.initial raster with the snow line: max |snow - rule| (m)", 100.0,
+                          "S = S0(raster) clamp((z - z_s + w/2) / w, 0, 1)"),
+                   worst, limit);
 }
 
 }  // namespace

@@ -165,26 +165,28 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
   // state_fields() and output.fields' choices as written by hand before the table
   // (simulation.cpp and schema.cpp of 2026-11-25) with the snow pack and the shallow-water
   // scheme's unit discharges added, the bed shear stress as an output, the soil of the
-  // physical erosion law and infiltration's store, as sets: the order is the table's now.
+  // physical erosion law, infiltration's store and the snow pack's liquid water, as sets: the
+  // order is the table's now.
   std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
   for (FieldId id : state_fields()) state.insert(field_info(id).name);
   EXPECT_EQ(state,
             (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment", "velocity_x",
                                    "velocity_y", "flux_left", "flux_right", "flux_top",
-                                   "flux_bottom", "wetness", "bed_residual", "snow", "momentum_x",
-                                   "momentum_y", "soil_thickness", "infiltrated"}));
+                                   "flux_bottom", "wetness", "bed_residual", "snow", "snow_liquid",
+                                   "momentum_x", "momentum_y", "soil_thickness", "infiltrated"}));
   EXPECT_EQ(output,
             (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x", "velocity_y",
                                    "erosion", "wetness", "hardness", "flux_left", "flux_right",
-                                   "flux_top", "flux_bottom", "snow", "momentum_x", "momentum_y",
-                                   "shear_stress", "soil_thickness", "infiltrated"}));
+                                   "flux_top", "flux_bottom", "snow", "snow_liquid", "momentum_x",
+                                   "momentum_y", "shear_stress", "soil_thickness", "infiltrated"}));
   // a field restored from files that lack it starts at 0: the bed residual and the snow pack,
   // added later
   for (const auto& f : field_table())
     EXPECT_EQ(f.restart_zero_if_absent,
               f.id == FieldId::bed_residual || f.id == FieldId::snow ||
-                  f.id == FieldId::momentum_x || f.id == FieldId::momentum_y ||
-                  f.id == FieldId::soil_thickness || f.id == FieldId::infiltrated)
+                  f.id == FieldId::snow_liquid || f.id == FieldId::momentum_x ||
+                  f.id == FieldId::momentum_y || f.id == FieldId::soil_thickness ||
+                  f.id == FieldId::infiltrated)
         << f.name;
 }
 
@@ -213,6 +215,8 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "thermal_apply",
                                    "evaporation",
                                    "snow",
+                                   "snow_slide_share",
+                                   "snow_slide",
                                    "infiltration",
                                    "boundary_level",
                                    "flow_shallow_water",
@@ -221,7 +225,7 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 25u) << "a kernel listed twice";
+  EXPECT_EQ(k.size(), 27u) << "a kernel listed twice";
   EXPECT_EQ(
       opencl_program_order(),
       (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl", "water.cl",

@@ -21,9 +21,10 @@ namespace {
 
 using erodem::test::run_cli;
 
-/// Local inertial flow, conservative transport, thermal collapse, a melting snow pack above
-/// 20 m, Green-Ampt infiltration into a finite store, an open and a fixed-level edge, a rain
-/// series and adaptive steps: every state field changes.
+/// Local inertial flow, conservative transport, thermal collapse, a snow pack above 20 m (a
+/// temperature series through the snowfall threshold, sliding), Green-Ampt infiltration into a
+/// finite store, an open and a fixed-level edge, a rain series and adaptive steps: every state
+/// field changes.
 const char* kInertial = R"([dem]
 synthetic = "valley"
 size = 48
@@ -58,7 +59,10 @@ rate = 1e-6
 enabled = true
 initial = "20 mm"
 snow_line = "20 m"
-air_temperature = 3.0
+transition = "10 m"
+slide_angle = 20.0
+slide_rate = 0.01
+air_temperature = [[0, -2.0], [480, 6.0]]
 melt_factor = "100 mm/d"
 [infiltration]
 enabled = true
@@ -72,7 +76,7 @@ sea_level = 1.0
 path = "full.h5"
 interval = "2 min"
 fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion", "wetness",
-          "snow", "infiltrated"]
+          "snow", "snow_liquid", "infiltrated"]
 )";
 
 /// The same with the shallow-water scheme: its unit discharges are state too.

@@ -30,6 +30,8 @@ const std::vector<ParameterRaster>& parameter_rasters() {
        &Terrain::soil_depth, 0.0, inf},
       {"boundary.raster", [](Params& p) { return &p.boundary.raster; }, &Terrain::boundary_code,
        0.0, 3.0, true},
+      {"snow.initial", [](Params& p) { return &p.snow.initial.path; }, &Terrain::snow_initial, 0.0,
+       inf},
   };
   return table;
 }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <set>
 
@@ -222,19 +223,89 @@ std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
       {"evaporated"})};
 }
 
-std::vector<SweepInfo> snow_sweeps(const Params&) {
-  // snow_sweep_cell (snow.h): the degree-day melt of the pack into the depth
-  return {generic_sweep("snow", {{"kind", R}, {"bed", R}, {"snow", U}, {"water_depth", U}},
-                        {"snow_melted"})};
+std::vector<SweepInfo> snow_sweeps(const Params& p) {
+  std::vector<SweepInfo> s;
+  if (p.snow.slide_angle) {
+    // snow_slide_share_sweep_cell then snow_slide_sweep_cell (snow.h): what each pack gives
+    // down slopes steeper than the slide angle, then what it keeps and takes (thermal's
+    // pattern), before the melt
+    s.push_back(generic_sweep(
+        "snow_slide_share",
+        {{"kind", N}, {"bed", N}, {"snow", R}, {"dx", R}, {"dy", R}, {"snow_slide_share", Wr}},
+        {}));
+    s.push_back(generic_sweep(
+        "snow_slide",
+        {{"kind", N}, {"bed", N}, {"snow", U}, {"dx", R}, {"dy", R}, {"snow_slide_share", N}}, {}));
+  }
+  // snow_sweep_cell (snow.h): snowfall and rain on snow from the step's rain on the depth,
+  // the degree-day melt and the rain's heat, the liquid water beyond retention into the depth
+  s.push_back(generic_sweep("snow",
+                            {{"kind", R},
+                             {"bed", R},
+                             {"rain_factor", R},
+                             {"snow", U},
+                             {"snow_liquid", U},
+                             {"water_depth", U}},
+                            {"snowfall", "rain_on_snow", "snow_melted", "snow_runoff"}));
+  return s;
 }
 
-/// The initial pack: snow.initial on the active cells at or above snow.snow_line.
+/// The slope of the bed at DEM cell (col c, row r) in degrees: the angle of the gradient by
+/// central differences over the active neighbours (one-sided where one of a pair is missing or
+/// not active; 0 along an axis with neither).
+double bed_slope_degrees(const Terrain& t, int c, int r) {
+  const Grid& g = t.grid;
+  const auto at = [&](int cc, int rr) { return static_cast<std::size_t>(rr) * g.nx + cc; };
+  const std::size_t i = at(c, r);
+  const auto usable = [&](int cc, int rr) {
+    return cc >= 0 && cc < g.nx && rr >= 0 && rr < g.ny && t.active(at(cc, rr));
+  };
+  // the gradient along one axis from the neighbours a (before) and b (after), `da` and `db`
+  // metres away
+  const auto derivative = [&](bool has_a, std::size_t a, double da, bool has_b, std::size_t b,
+                              double db) {
+    const double za = has_a ? t.bed[a] : t.bed[i], zb = has_b ? t.bed[b] : t.bed[i];
+    const double run = (has_a ? da : 0.0) + (has_b ? db : 0.0);
+    return run > 0 ? (zb - za) / run : 0.0;
+  };
+  const double dx = g.dx[static_cast<std::size_t>(r)];
+  const double gx = derivative(usable(c - 1, r), usable(c - 1, r) ? at(c - 1, r) : i, dx,
+                               usable(c + 1, r), usable(c + 1, r) ? at(c + 1, r) : i, dx);
+  const auto dy_between = [&](int r0, int r1) {
+    return 0.5 * (g.dy[static_cast<std::size_t>(r0)] + g.dy[static_cast<std::size_t>(r1)]);
+  };
+  const bool north = usable(c, r - 1), south = usable(c, r + 1);
+  const double gy = derivative(north, north ? at(c, r - 1) : i, north ? dy_between(r - 1, r) : 0.0,
+                               south, south ? at(c, r + 1) : i, south ? dy_between(r, r + 1) : 0.0);
+  const double pi = 3.14159265358979323846;
+  return std::atan(std::hypot(gx, gy)) * 180.0 / pi;
+}
+
+/// The share of snow.initial an initial pack at elevation z (m) gets: 1 where no snow line is
+/// given; with one at z_s and a transition band w, 0 below z_s - w/2, 1 from z_s + w/2, linear
+/// in between (w = 0: 1 at or above z_s, else 0).
+double snow_line_share(double z, const Params::Snow& sn) {
+  if (!sn.snow_line) return 1.0;
+  const double line = *sn.snow_line, band = sn.transition;
+  if (!(band > 0)) return z >= line ? 1.0 : 0.0;
+  return std::clamp((z - (line - 0.5 * band)) / band, 0.0, 1.0);
+}
+
+/// The initial pack: snow.initial (uniform or its raster) on the active cells, times
+/// snow_line_share of their bed, where the bed's slope is below snow.max_slope (when given).
 std::vector<std::pair<FieldId, std::vector<double>>> snow_initial(const Terrain& t,
                                                                   const Params& p) {
+  const auto& sn = p.snow;
   std::vector<double> snow(t.bed.size(), 0.0);
-  for (std::size_t i = 0; i < snow.size(); ++i)
-    if (t.active(i) && (!p.snow.snow_line || t.bed[i] >= *p.snow.snow_line))
-      snow[i] = p.snow.initial;
+  for (int r = 0; r < t.grid.ny; ++r)
+    for (int c = 0; c < t.grid.nx; ++c) {
+      const std::size_t i = static_cast<std::size_t>(r) * t.grid.nx + c;
+      if (!t.active(i)) continue;
+      if (sn.max_slope && !(bed_slope_degrees(t, c, r) < *sn.max_slope)) continue;
+      const double share = snow_line_share(t.bed[i], sn);
+      const double s0 = t.snow_initial.empty() ? sn.initial.value : t.snow_initial[i];
+      if (share > 0) snow[i] = share == 1.0 ? s0 : s0 * share;
+    }
   return {{FieldId::snow, std::move(snow)}};
 }
 
@@ -338,7 +409,7 @@ const std::vector<ProcessInfo>& process_table() {
        "snow",
        snow_on,
        snow_sweeps,
-       {"snow_melted"},
+       {"snowfall", "rain_on_snow", "snow_melted", "snow_runoff"},
        "snow.cl",
        snow_initial},
       {Process::infiltration,
@@ -486,6 +557,7 @@ std::vector<std::string> opencl_cell_kernels() {
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
   p.boundary.stage = {{0.0, 0.0}};
+  p.snow.slide_angle = 45.0;
   for (auto flow : {FlowScheme::pipes, FlowScheme::local_inertial, FlowScheme::shallow_water})
     for (auto transport : {TransportScheme::conservative, TransportScheme::semi_lagrangian})
       for (auto law : {ErosionLaw::mei, ErosionLaw::physical}) {

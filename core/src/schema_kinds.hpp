@@ -237,6 +237,42 @@ Descriptor series(const char* key, Access access, Dimension dim, Range range, co
   return d;
 }
 
+/// A number (`value`), or a time series [[t, value], ...] with increasing times (`series`; an
+/// empty series means the number): one key for a value constant or varying in time.
+template <class Value, class SeriesAccess>
+Descriptor number_or_series(const char* key, Value value, SeriesAccess series_of, Dimension dim,
+                            Range range, const char* doc) {
+  Descriptor d = base(key, value, "number or series", dim,
+                      (range.text().empty() ? std::string("number") : range.text()) +
+                          ", or [[time, value], ...] with times increasing",
+                      doc);
+  d.assign = [=](Params& p, const toml::node& n, const Where& w) {
+    if (n.is_array()) {
+      Series s = read_series(n, dim, range, w);
+      check_series(s, dim, range, w);
+      series_of(p) = std::move(s);
+    } else {
+      value(p) = read_double(n, dim, range, w);
+      series_of(p).clear();
+    }
+  };
+  d.check = [=](const Params& p, const Where& w) {
+    if (series_of(p).empty())
+      check_double(value(p), dim, range, w);
+    else
+      check_series(series_of(p), dim, range, w);
+  };
+  d.format = [=](const Params& p) {
+    return series_of(p).empty() ? format_number(value(p)) : format_series(series_of(p));
+  };
+  d.reset = [value, series_of](Params& p) {
+    const Params defaults;
+    value(p) = value(defaults);
+    series_of(p) = series_of(defaults);
+  };
+  return d;
+}
+
 /// A list of [x, y] points in the DEM's CRS.
 template <class Access>
 Descriptor points(const char* key, Access access, const char* doc) {

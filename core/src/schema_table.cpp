@@ -214,9 +214,11 @@ const std::vector<Descriptor>& descriptor_table() {
       number(ERODEM_FIELD(evaporation.rate), D::inverse_time, at_least(0),
              "evaporation rate K_e (1/s)"),
 
-      boolean(ERODEM_FIELD(snow.enabled), "a snow pack that melts by a degree-day rule"),
-      number(ERODEM_FIELD(snow.initial), D::length, at_least(0),
-             "initial snow water equivalent S_0 (m)"),
+      boolean(ERODEM_FIELD(snow.enabled),
+              "a snow pack: snowfall, degree-day melt, rain on snow, liquid water"),
+      scalar_or_raster(ERODEM_FIELD(snow.initial), D::length, at_least(0),
+                       "initial snow water equivalent S_0 (m), uniform or a raster path; times "
+                       "the snow line's share where snow.snow_line is given"),
       optional_number(ERODEM_FIELD(snow.snow_line), D::length, any_finite(),
                       "the initial pack lies only where the bed is at or above this (m)"),
       number(ERODEM_FIELD(snow.melt_factor), D::speed, at_least(0),
@@ -224,12 +226,36 @@ const std::vector<Descriptor>& descriptor_table() {
              "e.g. '4 mm/d')"),
       number(ERODEM_FIELD(snow.melt_temperature), D::dimensionless, any_finite(),
              "air temperature above which snow melts, T_melt (degrees C)"),
-      number(ERODEM_FIELD(snow.air_temperature), D::dimensionless, any_finite(),
-             "air temperature T_ref at snow.reference_elevation (degrees C)"),
+      number_or_series(
+          ERODEM_FIELD(snow.air_temperature),
+          [](auto& p) -> auto& { return p.snow.air_temperature_series; }, D::dimensionless,
+          any_finite(),
+          "air temperature T_ref at snow.reference_elevation (degrees C), constant or a series "
+          "[[time (s), T_ref (degrees C)], ...], linear in between, held at the end values "
+          "outside, taken at each step's midpoint"),
       number(ERODEM_FIELD(snow.reference_elevation), D::length, any_finite(),
              "elevation z_ref of snow.air_temperature (m)"),
       number(ERODEM_FIELD(snow.lapse_rate), D::dimensionless, any_finite(),
              "air temperature lapse rate dT/dz (K/m; -0.0065 is -6.5 K/km)"),
+      number(ERODEM_FIELD(snow.snowfall_temperature), D::dimensionless, any_finite(),
+             "the step's rain falls on the pack as snow where the air temperature is below this "
+             "(degrees C; 1.0: Jennings et al. 2018)"),
+      number(ERODEM_FIELD(snow.retention), D::dimensionless, at_least(0),
+             "liquid water the pack holds per unit of its snow water equivalent (1; 0.1: HBV's "
+             "CWH); melt and rain on the pack beyond it reach the depth"),
+      number(ERODEM_FIELD(snow.transition), D::length, at_least(0),
+             "width of the band centred on snow.snow_line over which the initial pack ramps "
+             "linearly from 0 to snow.initial (m); 0 = a sharp line"),
+      optional_number(ERODEM_FIELD(snow.slide_angle), D::angle, open(0, 90),
+                      "the pack slides towards the active neighbours whose bed lies lower than "
+                      "this angle below it (degrees; Bernhardt & Schulz 2010 use 25 - 60); not "
+                      "set = the pack does not move"),
+      number(ERODEM_FIELD(snow.slide_rate), D::inverse_time, at_least(0),
+             "fraction of a sliding cell's pack that moves per second (1/s; min(1, rate dt) "
+             "per step)"),
+      optional_number(ERODEM_FIELD(snow.max_slope), D::angle, closed(0, 90),
+                      "the initial pack lies only where the bed's slope (central differences) "
+                      "is below this (degrees); not set = on any slope"),
 
       boolean(ERODEM_FIELD(infiltration.enabled),
               "Green-Ampt infiltration of the water depth into the soil"),

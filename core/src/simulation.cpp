@@ -418,6 +418,7 @@ StepInputs Simulation::inputs_for(double dt) const {
       params_.rain.series.empty() ? params_.rain.rate : series_value(params_.rain.series, t_mid);
   in.boundary_level = boundary_level(params_, t_mid);
   if (!rain_bands_.empty()) in.rain_rate = 1.0;  // the rain_factor field holds the rate (m/s)
+  in.air_temperature = air_temperature_at(t_mid);
   for (const auto& ic : inflows_) {
     const double q = series_value(params_.inflow[ic.spec].hydrograph, t_mid);
     const double share = q * dt / static_cast<double>(ic.cells.size());
@@ -426,6 +427,12 @@ StepInputs Simulation::inputs_for(double dt) const {
     for (auto cell : ic.cells) in.points.push_back({cell, share, c * share});
   }
   return in;
+}
+
+double Simulation::air_temperature_at(double t) const {
+  const auto& sn = params_.snow;
+  return sn.air_temperature_series.empty() ? sn.air_temperature
+                                           : series_value(sn.air_temperature_series, t);
 }
 
 std::string Simulation::cell_name(std::int64_t cell) const {

@@ -140,6 +140,50 @@ CASES = {
         "A ramp 0-1575 m, 0.2 m of snow, 10 degrees C at 0 m, -6.5 K/km, DDF 4 mm/d/K.",
         "The pack melts out below z* = 769.2 m; every cell against the closed form.",
     ),
+    "snow_rain_on_snow": (
+        "Snow: rain on snow adds exactly its heat term",
+        "8 x 8 cells of 1 km, 0.1 m of snow at 5 degrees C, DDF 5 mm/d/K, rain 10 mm/h for 12 h, "
+        "retention 0.",
+        "Melt DDF T t + r t c_w T / L_f (c_w = 4186 J/kg/K, L_f = 334 kJ/kg): the heat term "
+        "7.52 mm against the closed form; all rain and melt reach the depth.",
+    ),
+    "snow_snowfall": (
+        "Snow: rain below the threshold falls on the pack; water and pack budgets close",
+        "Flat 8 x 8 cells of 1 km at -3 degrees C, 0.05 m of snow, 5 mm/h for 12 h; and a ramp "
+        "0-1575 m at 6 degrees C at 0 m, -6.5 K/km, 0.1 m of snow, retention 0.1, 6 h of "
+        "5 mm/h with flow.",
+        "S = S0 + r t and no water on the flat; the snowfall is r t times the cold area; the "
+        "water closure (pack outside) and the pack's own (snowfall + rain on snow - runoff; "
+        "snowfall - melt for the solid) close to rounding.",
+    ),
+    "snow_retention": (
+        "Snow: the pack holds liquid water up to its retention fraction",
+        "8 x 8 cells of 1 km, 0.1 m of snow at 4 degrees C, DDF 5 mm/d/K (20 mm/d), retention "
+        "0.1.",
+        "L = min(m t, theta S), depth m t - L: no water on the depth before t_w = 0.4545 d; "
+        "L <= theta S at every step.",
+    ),
+    "snow_series": (
+        "Snow: melt under a temperature series",
+        "8 x 8 cells of 10 km, 0.2 m of snow, T_ref linear from -5 to 15 degrees C over 5 d, "
+        "held after, DDF 4 mm/d/K, steps of 1 h.",
+        "S(t) = S0 - DDF times the integral of max(0, T_ref): 24.5 mm by 3 d, 172.5 mm by 6 d "
+        "(the step-midpoint values integrate the linear series exactly).",
+    ),
+    "snow_slide": (
+        "Snow: the pack slides down slopes steeper than the slide angle",
+        "8 columns of 10 m, a 60 degree slope then flat, 0.1 m of snow, slide angle 45 degrees "
+        "(and 65: nothing moves), slide_rate dt 1 (5 steps) and 1/4 (1 step).",
+        "The pack gathers on the first flat column (6 S0) or moves a quarter per step; its "
+        "volume is kept to rounding.",
+    ),
+    "snow_initial_rule": (
+        "Snow: the initial pack with a transition band and a slope limit",
+        "A ramp of 25 m then 60 m per 50 m column, snow line 400 m, band 200 m, max slope 35 "
+        "degrees.",
+        "Every cell against S0 clamp((z - 300) / 200, 0, 1) where the central-difference slope "
+        "is below 35 degrees, else 0.",
+    ),
     "green_ampt_ponded": (
         "Infiltration: ponded Green-Ampt against its implicit closed form",
         "4 x 4 flat cells of 2 km under 0.1 m of water, loam (K_sat 0.34 cm/h, psi 8.89 cm, "

@@ -205,6 +205,9 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
     p.ledger.*e.member =
         exists(file_, name) || !e.zero_if_absent ? read_doubles(file_, name, path_).at(index) : 0.0;
   }
+  // Before the pack held liquid water (snowfall, 2026-11-26) its melt went straight into the
+  // depth: what such a file calls snow_melted is the pack's runoff of the water closure now.
+  if (!exists(file_, "restart/ledger_snow_runoff")) p.ledger.snow_runoff = p.ledger.snow_melted;
   for (FieldId id : state_fields()) {
     const std::string name = std::string("restart/") + field_info(id).name;
     if (field_info(id).restart_zero_if_absent && !exists(file_, name)) {

@@ -29,6 +29,18 @@ ERODEM_FN real talus_excess(real from, real to, real dist, real tan_talus) {
   return excess > 0 ? excess : (real)0;
 }
 
+/* The sum of talus_excess from the bed `b` to each of its four neighbours (left, right, top,
+ * bottom: beds b_l .. b_b at dist_x, dist_x, dist_t, dist_b m) that `has_*` marks; the others
+ * add +0 (branch-free, the same sum as skipping them). */
+ERODEM_FN real talus_excess_out(real b, real b_l, real b_r, real b_t, real b_b, int has_l,
+                                int has_r, int has_t, int has_b, real dist_x, real dist_t,
+                                real dist_b, real tan_talus) {
+  return (has_l ? talus_excess(b, b_l, dist_x, tan_talus) : (real)0) +
+         (has_r ? talus_excess(b, b_r, dist_x, tan_talus) : (real)0) +
+         (has_t ? talus_excess(b, b_t, dist_t, tan_talus) : (real)0) +
+         (has_b ? talus_excess(b, b_b, dist_b, tan_talus) : (real)0);
+}
+
 /* Pass 1, active padded cell (x, y): the volume to move,
  *   V = min(1, K_t dt) * area * (dh_max - dist tan(theta)) / 2,
  * shared among the lower active neighbours in proportion to their excess. Returns V per
@@ -84,10 +96,8 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const int has_l = kind[i - 1] == ERODEM_CELL_ACTIVE, has_r = kind[i + 1] == ERODEM_CELL_ACTIVE;
   const int has_t = kind[i - W] == ERODEM_CELL_ACTIVE, has_b = kind[i + W] == ERODEM_CELL_ACTIVE;
   const real b_l = bed[i - 1], b_r = bed[i + 1], b_t = bed[i - W], b_b = bed[i + W];
-  const real given = (has_l ? talus_excess(b, b_l, dist_x, tan_talus) : (real)0) +
-                     (has_r ? talus_excess(b, b_r, dist_x, tan_talus) : (real)0) +
-                     (has_t ? talus_excess(b, b_t, dist_t, tan_talus) : (real)0) +
-                     (has_b ? talus_excess(b, b_b, dist_b, tan_talus) : (real)0);
+  const real given = talus_excess_out(b, b_l, b_r, b_t, b_b, has_l, has_r, has_t, has_b, dist_x,
+                                      dist_t, dist_b, tan_talus);
   const real s_l = share[i - 1], s_r = share[i + 1], s_t = share[i - W], s_b = share[i + W];
   /* each neighbour gives at its own talus slope, as its pass 1 shared */
   const real t_l = cell_tan_talus(wetness[i - 1], p), t_r = cell_tan_talus(wetness[i + 1], p);

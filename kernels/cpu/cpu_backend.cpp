@@ -86,6 +86,7 @@ double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) {
 template <class Real>
 void CpuBackend<Real>::begin_step(const StepInputs& in) {
   step_inputs_ = in;
+  step_cell_params(cell_, in);
   step_tally_ = StepTally{};
   face_water_.assign(face_codes_.size(), 0.0);
   face_sediment_.assign(face_codes_.size(), 0.0);

@@ -83,12 +83,20 @@ void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real 
                             sweep.name, sweep.uses.size(), sweep.tallies.size(), nf, nt));
   std::array<void*, nf> fields{};
   for (std::size_t k = 0; k < nf; ++k) {
+    // the grid inputs outside the field table (kind, the rain factor, the per-row cell
+    // sizes), then the fields
     const std::string name = sweep.uses[k].field;
-    Field* f = name == "kind" ? nullptr : field_storage(field_info(name).id);
-    if (name != "kind" && !f)
+    if (name == "kind" || name == "dx" || name == "dy") {
+      fields[k] = name == "kind" ? static_cast<void*>(kind_.data())
+                  : name == "dx" ? static_cast<void*>(dx_.data())
+                                 : static_cast<void*>(dy_.data());
+      continue;
+    }
+    Field* f = name == "rain_factor" ? &rain_factor_ : field_storage(field_info(name).id);
+    if (!f)
       throw Error(ExitCode::internal,
                   fmt::format("sweep '{}': field '{}' has no storage", sweep.name, name));
-    fields[k] = name == "kind" ? static_cast<void*>(kind_.data()) : static_cast<void*>(f->data());
+    fields[k] = static_cast<void*>(f->data());
   }
   const ParamBytes bytes = cell_params_bytes(cell_, process);
   if (bytes.size != sizeof(P))
@@ -130,6 +138,8 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
   static const std::pair<const char*, Run> sweeps[] = {
       {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
       {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
+      {"snow_slide_share", &CpuBackend::cell_sweep<&cell::snow_slide_share_sweep_cell<Real>>},
+      {"snow_slide", &CpuBackend::cell_sweep<&cell::snow_slide_sweep_cell<Real>>},
       {"infiltration", &CpuBackend::cell_sweep<&cell::infiltration_sweep_cell<Real>>},
       {"boundary_level", &CpuBackend::cell_sweep<&cell::boundary_level_sweep_cell<Real>>},
       {"shallow_water_velocity",

@@ -61,7 +61,13 @@ void OpenClBackend::run_generic(const SweepInfo& sweep, Process process, Real dt
   set_arg(k, i++, cl_int{H_});
   for (const FieldUse& u : sweep.uses) {
     const std::string name = u.field;
-    const Buffer* b = name == "kind" ? &kind_ : field_buffer(field_info(name).id);
+    // the grid inputs outside the field table (kind, the rain factor, the per-row cell
+    // sizes), then the fields
+    const Buffer* b = name == "kind"          ? &kind_
+                      : name == "rain_factor" ? &rain_factor_
+                      : name == "dx"          ? &dx_
+                      : name == "dy"          ? &dy_
+                                              : field_buffer(field_info(name).id);
     if (!b)
       throw Error(ExitCode::internal,
                   fmt::format("sweep '{}': field '{}' has no buffer", sweep.name, name));

@@ -184,6 +184,7 @@ void OpenClBackend::begin_step(const StepInputs& in) {
   pending_ = 0;
   pending_tally_ = nullptr;
   step_inputs_ = in;
+  step_cell_params(cell_, in);
   step_tally_ = StepTally{};
   face_water_done_ = face_sediment_done_ = false;
   in_step_ = true;

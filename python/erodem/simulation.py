@@ -320,7 +320,9 @@ class Simulation:
         ``water_moved``, ``relative_closure_error`` (1, of ``water_moved``),
         ``material_initial``, ``material``, ``sediment_out``, ``transport_change``,
         ``eroded``, ``deposited``, ``sediment_exchanged``, ``thermal_moved``,
-        ``snow_melted``, ``sediment_inflow``, ``eroded_bedrock``, ``bed_bulking``,
+        ``snow_melted`` (snow to the pack's liquid water), ``snowfall`` and ``rain_on_snow``
+        (taken from the depth into the pack), ``snow_runoff`` (the pack's liquid water beyond
+        its retention, into the depth), ``sediment_inflow``, ``eroded_bedrock``, ``bed_bulking``,
         ``infiltrated`` and ``soil_drained`` (Green-Ampt: into the soil, and drained from its
         store as it recovers), ``material_closure_error``, ``material_moved``, ``relative_material_closure_error``
         (1, of ``material_moved``). With the physical erosion law the sediment volumes are of

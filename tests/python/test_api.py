@@ -228,6 +228,36 @@ def test_infiltration_from_python(erodem, tujunga):
         erodem.Simulation(dem, backend="cpu", infiltration__moisture_deficit=1.5)
 
 
+def test_snow_from_python(erodem, tujunga):
+    """The snow pack from keywords: a temperature series (a list of [t, T]), the snowfall
+    threshold, the retention and the initial pack's band and slope limit; the cold storm falls
+    as snow (the ledger's snowfall, the snow field), the pack holds some liquid water, and both
+    the water and the pack's budgets close."""
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", rain__rate="100 mm/h", time__dt=1.0,
+                            snow__enabled=True, snow__initial="5 cm", snow__retention=0.2,
+                            snow__air_temperature=[[0, -20.0], [600, 30.0]],
+                            snow__reference_elevation=0.0, snow__lapse_rate=0.0,
+                            snow__snow_line=1000.0, snow__transition="200 m",
+                            snow__max_slope=40.0, snow__melt_factor="50 mm/d")
+    assert "air_temperature = [[0" in sim.config_toml and "retention = 0.2" in sim.config_toml
+    sim.step(600)
+    led = sim.ledger
+    snow, liquid = sim.field("snow"), sim.field("snow_liquid")
+    print("rain %.4g m^3, snowfall %.4g, rain on snow %.4g, melted %.4g, runoff %.4g; closure "
+          "%.2e of moved" % (led["rain"], led["snowfall"], led["rain_on_snow"],
+                             led["snow_melted"], led["snow_runoff"],
+                             led["relative_closure_error"]))
+    # below 1 degree C (the first 252 s) the rain is snow; after it, rain on the pack
+    assert 0.3 * led["rain"] < led["snowfall"] < 0.5 * led["rain"]
+    assert led["rain_on_snow"] > 0 and led["snow_melted"] > 0
+    assert np.nanmax(snow) > 0 and np.nanmax(liquid) > 0
+    assert np.all(liquid <= 0.2 * snow * (1 + 1e-6) + 1e-9)
+    assert abs(led["relative_closure_error"]) < 1e-5
+    with pytest.raises(ValueError, match="snow.retention"):
+        erodem.Simulation(dem, backend="cpu", snow__retention=-1)
+
+
 # ---- numpy views ------------------------------------------------------------------------
 
 

@@ -45,6 +45,11 @@ enum FieldFlag : unsigned {
     kStateField | kRestartZero)                                                                    \
   /* the snow pack (snow.h); files before 2026-11-26 restart without snow */                       \
   X(snow, "m", "snow water equivalent", kStateField | kOutputField | kRestartZero)                 \
+  /* the liquid water the pack holds (snow.h); files before 2026-11-26's snowfall restart dry */   \
+  X(snow_liquid, "m", "liquid water held in the snow pack",                                        \
+    kStateField | kOutputField | kRestartZero)                                                     \
+  /* the snow pack's sliding: what a cell gives per metre of its neighbours' excess drop */        \
+  X(snow_slide_share, "1", "snow sliding: pack given per metre of excess drop", 0u)                \
   /* the shallow-water scheme's state (shallow_water.h); 0 with the other schemes */               \
   X(momentum_x, "m2 s-1", "depth-integrated eastward discharge per unit width",                    \
     kStateField | kOutputField | kRestartZero | kTwinField)                                        \

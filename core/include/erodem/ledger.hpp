@@ -29,7 +29,10 @@ namespace erodem {
   X(deposited, true, "suspended sediment laid down on the bed")                            \
   X(sediment_exchanged, true, "sediment the cells gave through their faces")               \
   X(thermal_moved, true, "bed moved between cells by slope collapse")                      \
-  X(snow_melted, true, "snow melted into the water depth (water equivalent)")              \
+  X(snow_melted, true, "snow melted into the pack's liquid water (water equivalent)")      \
+  X(snowfall, true, "precipitation fallen on the snow pack as snow (water equivalent)")    \
+  X(rain_on_snow, true, "rain the snow pack's liquid water took from the depth")           \
+  X(snow_runoff, true, "liquid water of the snow pack released into the depth")            \
   X(eroded_bedrock, true, "solid taken into suspension from the bedrock (part of eroded)") \
   X(bed_bulking, true,                                                                     \
     "bed volume lowered minus solid moved into suspension: pores opened (closed by "       \
@@ -65,18 +68,22 @@ struct Ledger {
   /// against this fraction of the volume on the grid (the rounding of a double sum).
   static constexpr double kVolumeEpsilon = std::numeric_limits<double>::epsilon();
 
-  /// V(t) - V(0) - rain - inflow + out + evaporated - clipped - snow melted + infiltrated: 0
-  /// up to rounding (m^3).
+  /// V(t) - V(0) - rain - inflow + out + evaporated - clipped + snowfall + rain on snow - snow
+  /// runoff + infiltrated: 0 up to rounding (m^3). The snow pack is outside V: what it takes
+  /// from the depth (snowfall, rain on snow) and gives back (snow runoff) cross its boundary;
+  /// the melt moves water inside the pack (snow_storage_closure_error).
   double closure_error() const {
-    return water - water_initial - rain - inflow + boundary_out + evaporated - clipped -
-           snow_melted + infiltrated;
+    return water - water_initial - rain - inflow + boundary_out + evaporated - clipped + snowfall +
+           rain_on_snow - snow_runoff + infiltrated;
   }
   /// What moved of the water (m^3): max(rain + inflow + |boundary out| + evaporated + snow
-  /// melted + infiltrated, water exchanged between cells, kVolumeEpsilon * water on the grid).
+  /// runoff + snowfall + rain on snow + infiltrated, water exchanged between cells,
+  /// kVolumeEpsilon * water on the grid).
   double water_moved() const {
-    return std::max(
-        {rain + inflow + std::abs(boundary_out) + evaporated + snow_melted + infiltrated,
-         water_exchanged, kVolumeEpsilon * std::max(std::abs(water_initial), std::abs(water))});
+    return std::max({rain + inflow + std::abs(boundary_out) + evaporated + snow_runoff + snowfall +
+                         rain_on_snow + infiltrated,
+                     water_exchanged,
+                     kVolumeEpsilon * std::max(std::abs(water_initial), std::abs(water))});
   }
   /// Closure error relative to water_moved().
   double relative_closure_error() const {

@@ -193,13 +193,31 @@ struct Params {
 
   struct Snow {
     bool enabled = false;
-    double initial = 0.0;                   ///< initial snow water equivalent S_0 (m)
+    ScalarOrRaster initial{0.0, {}};        ///< initial snow water equivalent S_0 (m)
     std::optional<double> snow_line;        ///< the initial pack lies where bed >= this (m)
     double melt_factor = 4.0e-3 / 86400.0;  ///< degree-day factor DDF (m/s per K): 4 mm/d/K
     double melt_temperature = 0.0;          ///< T_melt (degrees C)
     double air_temperature = 0.0;           ///< T_ref, the air temperature at z_ref (degrees C)
-    double reference_elevation = 0.0;       ///< z_ref (m)
-    double lapse_rate = -0.0065;            ///< dT/dz (K/m)
+    /// T_ref(t): time (s), degrees C, linear in between, held at the end values outside;
+    /// when not empty it replaces air_temperature (the same key, snow.air_temperature)
+    Series air_temperature_series;
+    double reference_elevation = 0.0;  ///< z_ref (m)
+    double lapse_rate = -0.0065;       ///< dT/dz (K/m)
+    /// precipitation falls as snow where T < this (degrees C): Jennings et al. (2018)'s mean
+    /// rain-snow threshold over the Northern Hemisphere, 1.0 degrees C
+    double snowfall_temperature = 1.0;
+    /// liquid water the pack holds per unit of snow water equivalent (1): HBV's CWH, 0.1
+    double retention = 0.1;
+    /// width of the band over which the initial pack ramps from 0 to snow.initial, centred on
+    /// snow_line (m); 0 = a sharp line
+    double transition = 0.0;
+    /// the initial pack lies only where the slope is below this (degrees); none = anywhere
+    std::optional<double> max_slope;
+    /// the pack slides towards neighbours lower than this angle below it (degrees); none = no
+    /// sliding
+    std::optional<double> slide_angle;
+    /// the fraction of a sliding cell's pack that moves per second (1/s): 1/h
+    double slide_rate = 1.0 / 3600.0;
   } snow;
 
   /// Green-Ampt infiltration (infiltration.h, docs/model.md section 3.11). The soil's K_sat,

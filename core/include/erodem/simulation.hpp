@@ -140,6 +140,9 @@ class Simulation {
   double progress() const;
   /// Inputs of the next step (rain rate, inflow volumes) for a step of `dt` seconds.
   StepInputs inputs_for(double dt) const;
+  /// snow.air_temperature T_ref at time t (s): its series' value there, or the constant
+  /// (degrees C).
+  double air_temperature_at(double t) const;
   /// The (col, row) of a DEM cell index, formatted for messages.
   std::string cell_name(std::int64_t cell) const;
 
