@@ -690,7 +690,8 @@ TEST_P(RasterParameters, GriddedRainVariesInSpaceAndTime) {
   EXPECT_LT(e_ledger, 1e-12);
 }
 
-// ==== the stage hydrograph and boundary.raster's codes ==============================
+// ==== the stage hydrograph and boundary.raster's codes =====================================
+
 class Stage : public TargetTest {};
 
 /// A flat basin of nx x ny cells of 10 m at bed 0, `depth` m of water, Manning 0.03, local
@@ -855,7 +856,8 @@ TEST(BoundaryRaster, BadCodesAreNamed) {
       EXPECT_EQ(e.code(), ExitCode::data);
     }
   }
-=======
+}
+
 TEST_P(RasterParameters, SnowInitialRasterTakesTheSnowLineRule) {
   // A 6 x 4 grid of 100 m cells whose bed rises 100 m per column (0 .. 500 m), with the initial
   // snow water equivalent from a raster read through snow.initial's path, 0.01 (1 + row + col)
