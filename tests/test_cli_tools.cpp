@@ -182,13 +182,13 @@ TEST_F(CliTools, BenchReportsRatesAndBandwidth) {
   // the process table (tests/test_process_table.cpp has every process's figure).
   EXPECT_TRUE(contains(r.output, "\"process\": \"flow\", \"seconds_per_step\"")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 45,")) << r.output;
-  EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 237,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 245,")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"flow_scheme\": \"local_inertial\"")) << r.output;
 }
 
 TEST_F(CliTools, BenchRunsTheSchemesSetAndRejectsBadSettings) {
   // --set reaches the bench scenario through the config schema: pipes move 41 B/cell, the
-  // semi-Lagrangian transport 17, so the full step 237 - 45 + 41 - 29 + 17 = 221.
+  // semi-Lagrangian transport 17, so the full step 245 - 45 + 41 - 29 + 17 = 229.
   const auto r = run_cli(
       "bench --size 32 --steps 1 --threads 1 --stream-floats 1048576 --json --set "
       "flow.scheme=pipes --set transport.scheme=semi_lagrangian",
@@ -197,7 +197,7 @@ TEST_F(CliTools, BenchRunsTheSchemesSetAndRejectsBadSettings) {
   EXPECT_TRUE(contains(r.output, "\"flow_scheme\": \"pipes\"")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"transport_scheme\": \"semi_lagrangian\"")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 41,")) << r.output;
-  EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 221,")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 229,")) << r.output;
   const auto bad = run_cli("bench --size 32 --steps 1 --set flow.scheme=foo", dir_);
   std::printf("[bench --set flow.scheme=foo] exit %d: %s", bad.code, bad.output.c_str());
   EXPECT_EQ(bad.code, 78) << bad.output;

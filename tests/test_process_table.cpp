@@ -119,12 +119,13 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
   EXPECT_EQ(bytes(Process::water), 37);        // kind bed depth flux*4 | depth velocity_x, _y
   EXPECT_EQ(bytes(Process::erosion), 41);      // kind bed bed_residual sediment depth u v hardness
   EXPECT_EQ(bytes(Process::transport), 29);    // kind sediment depth_flow flux*4 | sediment
-  EXPECT_EQ(bytes(Process::thermal), 30);      // kind bed | share; kind bed residual share | ...
+  // kind bed wetness | share; kind bed residual wetness share | ... (the wet talus angle)
+  EXPECT_EQ(bytes(Process::thermal), 38);
   EXPECT_EQ(bytes(Process::evaporation), 17);  // kind depth wetness | depth wetness
   EXPECT_EQ(sweep_bytes(stats_sweep(), 4).total(), 25);
   int full = sweep_bytes(stats_sweep(), 4).total();
   for (Process pr : step_sequence(p)) full += bytes(pr);
-  EXPECT_EQ(full, 237);
+  EXPECT_EQ(full, 245);
   std::printf(
       "[process table] full local-inertial step %d B/cell (hand model of 2026-11-23: 213)\n", full);
   // kind bed bed_residual sediment soil depth u v manning hardness | bed residual sediment soil
