@@ -4,6 +4,15 @@
 
 namespace erodem::schema_detail {
 
+namespace {
+/// The default parameters, built once (temporaries of the whole Params in every reset lambda
+/// made GCC 12 warn of strings "maybe used uninitialized" in their destructors).
+const Params& defaults() {
+  static const Params d;
+  return d;
+}
+}  // namespace
+
 Descriptor resample_descriptor(const char* key, const char* doc) {
   auto access = [](auto& p) -> auto& {
     return p.dem;
@@ -13,8 +22,8 @@ Descriptor resample_descriptor(const char* key, const char* doc) {
                       "factor >= 0; 0 = none",
                       doc);
   d.reset = [](Params& p) {
-    p.dem.resample = Params{}.dem.resample;
-    p.dem.resample_factor = Params{}.dem.resample_factor;
+    p.dem.resample = defaults().dem.resample;
+    p.dem.resample_factor = defaults().dem.resample_factor;
   };
   d.assign = [](Params& p, const toml::node& n, const Where& w) {
     if (n.is_integer()) {
@@ -73,12 +82,12 @@ Descriptor hardness_descriptor(const char* key, const char* doc) {
   d.accepted = inner.accepted + ", or \"noise\"";
   d.reset = [reset = inner.reset](Params& p) {
     reset(p);
-    p.erosion.hardness_noise = Params{}.erosion.hardness_noise;
+    p.erosion.hardness_noise = defaults().erosion.hardness_noise;
   };
   d.assign = [assign = inner.assign](Params& p, const toml::node& n, const Where& w) {
     const auto s = n.value_exact<std::string>();
     if (s && *s == "noise") {
-      p.erosion.hardness = Params{}.erosion.hardness;
+      p.erosion.hardness = defaults().erosion.hardness;
       p.erosion.hardness_noise = true;
       return;
     }
