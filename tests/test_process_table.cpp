@@ -114,11 +114,11 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
   p.evaporation.rate = 1e-7;
   auto bytes = [&](Process pr) { return process_bytes(pr, p, 4).total(); };
   EXPECT_EQ(bytes(Process::boundary), 0);
-  EXPECT_EQ(bytes(Process::sources), 13);      // kind depth rain_factor | depth
-  EXPECT_EQ(bytes(Process::flow), 45);         // kind bed depth manning flux*4 | flux*4
-  EXPECT_EQ(bytes(Process::water), 37);        // kind bed depth flux*4 | depth velocity_x, _y
-  EXPECT_EQ(bytes(Process::erosion), 41);      // kind bed bed_residual sediment depth u v hardness
-  EXPECT_EQ(bytes(Process::transport), 29);    // kind sediment depth_flow flux*4 | sediment
+  EXPECT_EQ(bytes(Process::sources), 13);    // kind depth rain_factor | depth
+  EXPECT_EQ(bytes(Process::flow), 45);       // kind bed depth manning flux*4 | flux*4
+  EXPECT_EQ(bytes(Process::water), 37);      // kind bed depth flux*4 | depth velocity_x, _y
+  EXPECT_EQ(bytes(Process::erosion), 41);    // kind bed bed_residual sediment depth u v hardness
+  EXPECT_EQ(bytes(Process::transport), 29);  // kind sediment depth_flow flux*4 | sediment
   // kind bed wetness | share; kind bed residual wetness share | ... (the wet talus angle)
   EXPECT_EQ(bytes(Process::thermal), 38);
   EXPECT_EQ(bytes(Process::evaporation), 17);  // kind depth wetness | depth wetness

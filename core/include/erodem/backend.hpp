@@ -39,10 +39,10 @@ struct PointSource {
 
 /// What a process needs to know about the current step.
 struct StepInputs {
-  double t = 0.0;                   ///< time at the start of the step (s)
-  double dt = 0.0;                  ///< step (s)
-  double rain_rate = 0.0;           ///< uniform rain rate this step (m/s), times the rain factor
-  double air_temperature = 0.0;     ///< snow.air_temperature T_ref this step (degrees C)
+  double t = 0.0;                ///< time at the start of the step (s)
+  double dt = 0.0;               ///< step (s)
+  double rain_rate = 0.0;        ///< uniform rain rate this step (m/s), times the rain factor
+  double air_temperature = 0.0;  ///< snow.air_temperature T_ref this step (degrees C)
   /// Level of the fixed-level cells this step (m; boundary.stage at the midpoint); NaN:
   /// boundary.sea_level.
   double boundary_level = std::numeric_limits<double>::quiet_NaN();

@@ -62,9 +62,9 @@ struct Terrain {
   std::vector<double> boundary_code;     ///< boundary.raster's codes (boundary_codes.hpp)
   /// rain.grids' bands, each a rate in the bands' units (times rain.grid_scale: m/s)
   std::vector<std::vector<double>> rain_grids;
-  std::vector<double> snow_initial;      ///< the initial snow water equivalent S_0 (m)
-  std::string source;                    ///< DEM path or generator description
-  std::string source_sha256;             ///< checksum of the DEM file, when read from one
+  std::vector<double> snow_initial;  ///< the initial snow water equivalent S_0 (m)
+  std::string source;                ///< DEM path or generator description
+  std::string source_sha256;         ///< checksum of the DEM file, when read from one
 
   bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
 };
