@@ -106,7 +106,7 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
   // neighbours nor the lowest level (so the sea never runs dry), cells coded fixed_level on
   // their own bed; each holds the level at t = 0 and the sediment its water carries in.
   s.sediment.assign(n, 0.0);
-  const double sea = boundary_level(params, 0.0), lowest = lowest_boundary_level(params);
+  const double sea = boundary_level(params, 0.0), lowest = boundary_level_range(params).first;
   for (int y = 1; y <= ny; ++y)
     for (int x = 1; x <= nx; ++x) {
       const auto p = s.at(x, y);

@@ -230,7 +230,10 @@ struct SedimentAdaptation {
   double length = 100.0, depth = 1.0, speed = 1.0;   // m, m, m/s
   double capacity_k = 0.02, dissolving_rate = 0.05;  // K_c (s), K_s (1/s)
   double courant = 0.4;                              // u dt / dx
-  double capacity() const { return capacity_k * Params{}.erosion.min_tilt * speed; }
+  double capacity() const {
+    static const Params defaults;  // (a Params temporary made GCC 12 warn: schema_kinds.cpp)
+    return capacity_k * defaults.erosion.min_tilt * speed;
+  }
   /// K_s dx / u: the adaptation length u / K_s in cells, inverted.
   double resolution(double dx) const { return dissolving_rate * dx / speed; }
   Params params(TransportScheme scheme, double dx) const {

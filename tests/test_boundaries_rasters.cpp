@@ -16,6 +16,7 @@
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/io/setup.hpp"
+#include "reference_solutions.hpp"
 #include "scenarios.hpp"
 #include "target_test.hpp"
 #include "temp_dir.hpp"
@@ -602,14 +603,9 @@ TEST_P(RasterParameters, InfiltrationRastersGiveEachCellItsSoil) {
       rock_wet += f[i] != 0.0;
       continue;
     }
-    double lo = k * hour, hi = k * hour + std::sqrt(2 * s * k * hour);
-    for (int it = 0; it < 200; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (mid - s * std::log1p(mid / s) > k * hour ? hi : lo) = mid;
-    }
     const double store =
         static_cast<double>(static_cast<float>(soil[i])) * static_cast<float>(deficit[i]);
-    const double exact = std::min(0.5 * (lo + hi), store);
+    const double exact = std::min(green_ampt_increment_exact(0.0, hour, k, s), store);
     worst = std::max(worst, std::abs(f[i] - exact) / exact);
   }
   std::printf(

@@ -83,18 +83,12 @@ double boundary_level(const Params& p, double t) {
   return p.boundary.stage.empty() ? p.boundary.sea_level : series_value(p.boundary.stage, t);
 }
 
-double lowest_boundary_level(const Params& p) {
-  if (p.boundary.stage.empty()) return p.boundary.sea_level;
-  double m = p.boundary.stage.front().value;
-  for (const auto& s : p.boundary.stage) m = std::min(m, s.value);
-  return m;
-}
-
-double highest_boundary_level(const Params& p) {
-  if (p.boundary.stage.empty()) return p.boundary.sea_level;
-  double m = p.boundary.stage.front().value;
-  for (const auto& s : p.boundary.stage) m = std::max(m, s.value);
-  return m;
+std::pair<double, double> boundary_level_range(const Params& p) {
+  const auto& stage = p.boundary.stage;
+  if (stage.empty()) return {p.boundary.sea_level, p.boundary.sea_level};
+  const auto [lo, hi] = std::minmax_element(
+      stage.begin(), stage.end(), [](const auto& a, const auto& b) { return a.value < b.value; });
+  return {lo->value, hi->value};
 }
 
 }  // namespace erodem

@@ -255,7 +255,7 @@ double Simulation::coast_depth(const std::vector<double>& coast_bed) const {
   // h_f = max(eta_g, eta_a) - max(b_g, b_a) = max(level - b_a, d_a); the highest level the
   // stage hydrograph reaches bounds it over the run.
   double h = 0.0;
-  const double level = highest_boundary_level(params_);
+  const double level = boundary_level_range(params_).second;
   for (const double b : coast_bed) h = std::max(h, level - b);
   return h;
 }

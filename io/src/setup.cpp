@@ -13,18 +13,25 @@ namespace erodem::io {
 
 namespace {
 
-/// Reads a parameter raster and checks its active cells hold finite values in [lo, hi].
-std::vector<double> parameter_raster(const std::string& path, const Terrain& t, const Params& p,
-                                     const std::string& key, double lo, double hi) {
-  auto v = read_raster_on_grid(path, t.grid, p.dem.window, key);
+/// Checks that the active cells of `v`, read from `path` for `key` (`what`: "value", or
+/// "band k value"), hold finite values in [lo, hi]; Error(data) naming the first that does not.
+void check_raster_values(const std::vector<double>& v, const Terrain& t, const std::string& path,
+                         const std::string& key, const std::string& what, double lo, double hi) {
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!t.active(i)) continue;
     if (!(std::isfinite(v[i]) && v[i] >= lo && v[i] <= hi))
-      throw Error(ExitCode::data, path + ": '" + key + "' value " + std::to_string(v[i]) +
+      throw Error(ExitCode::data, path + ": '" + key + "' " + what + " " + std::to_string(v[i]) +
                                       " at cell " + std::to_string(i % t.grid.nx) + ", " +
                                       std::to_string(i / t.grid.nx) + " is outside [" +
                                       std::to_string(lo) + ", " + std::to_string(hi) + "]");
   }
+}
+
+/// Reads a parameter raster and checks its active cells hold finite values in [lo, hi].
+std::vector<double> parameter_raster(const std::string& path, const Terrain& t, const Params& p,
+                                     const std::string& key, double lo, double hi) {
+  auto v = read_raster_on_grid(path, t.grid, p.dem.window, key);
+  check_raster_values(v, t, path, key, "value", lo, hi);
   return v;
 }
 
@@ -47,13 +54,8 @@ Terrain load_terrain(const Params& p) {
   if (!p.rain.grids.empty()) {
     t.rain_grids = read_raster_bands_on_grid(p.rain.grids, t.grid, p.dem.window, "rain.grids");
     for (std::size_t b = 0; b < t.rain_grids.size(); ++b)
-      for (std::size_t i = 0; i < t.bed.size(); ++i)
-        if (t.active(i) && !(std::isfinite(t.rain_grids[b][i]) && t.rain_grids[b][i] >= 0))
-          throw Error(ExitCode::data, p.rain.grids + ": 'rain.grids' band " +
-                                          std::to_string(b + 1) + " value " +
-                                          std::to_string(t.rain_grids[b][i]) + " at cell " +
-                                          std::to_string(i % t.grid.nx) + ", " +
-                                          std::to_string(i / t.grid.nx) + " is not a rate >= 0");
+      check_raster_values(t.rain_grids[b], t, p.rain.grids, "rain.grids",
+                          "band " + std::to_string(b + 1) + " value", 0.0, HUGE_VAL);
   }
   const int factor = resample_factor(p.dem, t.grid);
   if (factor > 1) t = coarsen(t, factor);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 
 #include "erodem/grid.hpp"
 #include "erodem/params.hpp"
@@ -44,7 +45,6 @@ bool held_on_own_bed(const Terrain& t, std::size_t i);
 /// The level of the fixed-level cells at time t (s): the stage hydrograph, or sea_level (m).
 double boundary_level(const Params& p, double t);
 /// The lowest and highest level the fixed-level cells take over the run (m).
-double lowest_boundary_level(const Params& p);
-double highest_boundary_level(const Params& p);
+std::pair<double, double> boundary_level_range(const Params& p);
 
 }  // namespace erodem
