@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 
 #include "common/boundary.h"
 #include "common/erosion.h"
@@ -15,10 +16,12 @@
 #include "common/infiltration.h"
 #include "common/snow.h"
 #include "common/sources.h"
+#include "common/terrain_class.h"
 #include "common/thermal.h"
 #include "common/water.h"
 #include "erodem/backend.hpp"
 #include "erodem/params.hpp"
+#include "erodem/process.hpp"
 
 namespace erodem {
 
@@ -39,6 +42,7 @@ struct CellParams {
   cell_params::EvaporationParams<real> evaporation;
   cell_params::SnowParams<real> snow;
   cell_params::InfiltrationParams<real> infiltration;
+  cell_params::TerrainClassParams<real> terrain_class;
 };
 
 /// The physical erosion law's constants (erosion.h SedimentParams), derived in double from
@@ -89,6 +93,56 @@ cell_params::SedimentParams<real> sediment_params_of(const Params& params) {
   return s;
 }
 
+/// The terrain classes' rule and tables (terrain_class.h), in double and then rounded once:
+/// each class's value of a parameter is its terrain_classes.<class> value, else the uniform
+/// parameter (the same double the uniform field is filled from, so a class without a value
+/// gives its cells the uniform field's bits); set_* as class_tables (process.hpp) says.
+template <class real>
+cell_params::TerrainClassParams<real> terrain_class_params_of(const Params& params) {
+  const auto r = [](double v) { return static_cast<real>(v); };
+  const auto& tc = params.terrain_classes;
+  cell_params::TerrainClassParams<real> c{};
+  c.snow_depth = r(tc.snow_depth);
+  c.snow_line = tc.snow_line ? r(*tc.snow_line) : std::numeric_limits<real>::max();
+  c.water_wetness = r(tc.water_wetness);
+  c.rock_slope = r(tc.rock_slope);
+  c.rock_elevation =
+      tc.rock_elevation ? r(*tc.rock_elevation) : std::numeric_limits<real>::lowest();
+  c.mud_wetness = r(tc.mud_wetness);
+  const Params::ClassValues* by_code[ERODEM_CLASS_COUNT];
+  by_code[ERODEM_CLASS_GRASS] = &tc.grass;
+  by_code[ERODEM_CLASS_MUD] = &tc.mud;
+  by_code[ERODEM_CLASS_ROCK] = &tc.rock;
+  by_code[ERODEM_CLASS_SNOW] = &tc.snow;
+  by_code[ERODEM_CLASS_WATER] = &tc.water;
+  const auto& in = params.infiltration;
+  const double pi = 3.14159265358979323846;
+  for (int k = 0; k < ERODEM_CLASS_COUNT; ++k) {
+    const Params::ClassValues& v = *by_code[k];
+    c.manning_n[k] = r(v.manning_n.value_or(params.flow.manning_n.value));
+    c.hardness[k] = r(v.erodibility.value_or(params.erosion.hardness.value));
+    c.ksat[k] = r(v.ksat.value_or(in.ksat.value));
+    // as infiltration_initial (process_table.cpp): psi delta theta, and L delta theta or the
+    // largest float for an unlimited store
+    const double deficit = v.moisture_deficit.value_or(in.moisture_deficit.value);
+    c.suction_deficit[k] = r(v.suction.value_or(in.suction.value) * deficit);
+    const std::optional<double> depth =
+        v.soil_depth ? v.soil_depth
+                     : (in.soil_depth ? std::optional<double>(in.soil_depth->value) : std::nullopt);
+    c.store[k] =
+        r(depth ? *depth * deficit : static_cast<double>(std::numeric_limits<float>::max()));
+    c.talus_slope[k] = r(std::tan(v.talus_angle.value_or(params.thermal.talus_angle) * pi / 180.0));
+  }
+  const ClassTables set = class_tables(params);
+  c.set_manning = set.manning;
+  c.set_hardness = set.hardness;
+  c.set_ksat = set.ksat;
+  c.set_soil = set.soil;
+  c.set_talus = set.talus;
+  c.classify = 1;
+  return c;
+}
+
 /// The run constants from the parameters (units in the structs' headers): sea_level;
 /// gravity, theta, dry_depth, pipe_area, pipe_length; velocity_min_depth; the erosion rates,
 /// with -inf for no bedrock level; K_t and tan(talus angle); K_e, the wetness time and
@@ -129,7 +183,9 @@ CellParams<real> cell_params_of(const Params& params) {
   c.thermal.tan_wet = params.thermal.wet_talus_angle
                           ? r(std::tan(*params.thermal.wet_talus_angle * pi / 180.0))
                           : c.thermal.tan_talus;
-  c.thermal.wet_threshold = r(params.thermal.wet_threshold);
+  // no wet talus angle: no cell is wet enough for one (tan_wet = tan_talus all the same)
+  c.thermal.wet_threshold = params.thermal.wet_talus_angle ? r(params.thermal.wet_threshold)
+                                                           : std::numeric_limits<real>::infinity();
 
   c.evaporation.rate = r(params.evaporation.rate);
   c.evaporation.wetness_time = r(params.numerics.wetness_time);
@@ -154,6 +210,9 @@ CellParams<real> cell_params_of(const Params& params) {
   c.infiltration.recovery_swmm = in.recovery_rate ? 0 : 1;
   c.infiltration.recovery_rate = r(in.recovery_rate ? *in.recovery_rate : 0.0);
   c.infiltration.swmm_scale = r(3600.0 / 0.0254);
+
+  c.terrain_class = terrain_class_params_of<real>(params);
+  c.thermal.by_class = c.terrain_class.set_talus;
   return c;
 }
 
@@ -171,6 +230,7 @@ template <class real>
 void step_cell_params(CellParams<real>& c, const StepInputs& in) {
   c.snow.air_temperature = static_cast<real>(in.air_temperature);
   c.snow.rain_rate = static_cast<real>(in.rain_rate);
+  c.terrain_class.classify = in.classify ? 1 : 0;
 }
 
 /// The bytes of process `p`'s parameter struct in `c` (what the generic sweeps pass to their
@@ -200,6 +260,8 @@ ParamBytes cell_params_bytes(const CellParams<real>& c, Process p) {
       return of(c.snow);
     case Process::infiltration:
       return of(c.infiltration);
+    case Process::terrain_class:
+      return of(c.terrain_class);
     default:
       return {};
   }
@@ -219,9 +281,11 @@ static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
 static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));
-static_assert(sizeof(cell_params::ThermalParams<float>) == 4 * sizeof(float));
+static_assert(sizeof(cell_params::ThermalParams<float>) == 4 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::SnowParams<float>) == 11 * sizeof(float));
 static_assert(sizeof(cell_params::InfiltrationParams<float>) == 2 * sizeof(float) + sizeof(int));
+static_assert(sizeof(cell_params::TerrainClassParams<float>) ==
+              (6 + 6 * ERODEM_CLASS_COUNT) * sizeof(float) + 6 * sizeof(int));
 
 }  // namespace erodem

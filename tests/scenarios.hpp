@@ -90,6 +90,13 @@ inline Terrain bumpy_terrain(int n, double cell) {
   return t;
 }
 
+/// The default parameters, one object (a Params temporary per default value makes GCC 12
+/// warn of its strings, falsely).
+inline const Params& default_params() {
+  static const Params p;
+  return p;
+}
+
 /// Parameters with every process off and closed boundaries.
 inline Params quiet_params(FlowScheme scheme, double dt) {
   Params p;

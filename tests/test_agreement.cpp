@@ -35,6 +35,9 @@ struct AgreementCase {
   /// T_ref(t) at 1000 m: snowfall, rain on snow, melt, liquid water and sliding above 40
   /// degrees at once
   bool snow = false;
+  /// terrain classes every 20 steps (snow above 1400 m, rock above 0.7 m/m, mud and water where
+  /// the storm stays) whose tables give Manning n, erodibility, talus angles and K_sat
+  bool classes = false;
 };
 
 Params agreement_params(const AgreementCase& c) {
@@ -54,6 +57,21 @@ Params agreement_params(const AgreementCase& c) {
   p.snow.melt_factor = 50e-3 / 86400.0;
   p.snow.slide_angle = 40.0;
   p.snow.slide_rate = 1e-3;
+  auto& tc = p.terrain_classes;
+  tc.enabled = c.classes;
+  tc.interval = 20;
+  tc.snow_line = 1400.0;
+  tc.mud_wetness = 2e-3;
+  tc.water_wetness = 0.05;
+  tc.rock.manning_n = 0.03;
+  tc.rock.erodibility = 0.2;
+  tc.rock.talus_angle = 45.0;
+  tc.rock.ksat = 1e-7;
+  tc.mud.talus_angle = 25.0;
+  tc.mud.manning_n = 0.05;
+  tc.water.manning_n = 0.03;
+  tc.snow.erodibility = 0.0;
+  if (!c.classes) tc = Params::TerrainClasses{};
   return p;
 }
 
@@ -86,7 +104,8 @@ TEST_P(Agreement, OpenClMatchesCpuFloat32After1000Steps) {
        {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
         FieldId::velocity_y, FieldId::flux_left, FieldId::flux_right, FieldId::flux_top,
         FieldId::flux_bottom, FieldId::wetness, FieldId::erosion, FieldId::soil_thickness,
-        FieldId::infiltrated, FieldId::snow, FieldId::snow_liquid}) {
+        FieldId::infiltrated, FieldId::snow, FieldId::snow_liquid, FieldId::terrain_class,
+        FieldId::manning_n, FieldId::hardness}) {
     const auto a = ocl.field(id), b = cpu.field(id);
     ASSERT_EQ(a.size(), b.size());
     // ||a - b|| / ||b|| (0 when both vanish) as `erodem compare` computes it; every cell
@@ -302,7 +321,11 @@ INSTANTIATE_TEST_SUITE_P(
                       TransportScheme::conservative, true, 2.0, 1, ErosionLaw::physical, true},
         // the snow pack: snowfall, rain on snow, melt, liquid water under a temperature series
         AgreementCase{"local_inertial_snow", FlowScheme::local_inertial,
-                      TransportScheme::conservative, true, 2.0, 1, ErosionLaw::mei, false, true}),
+                      TransportScheme::conservative, true, 2.0, 1, ErosionLaw::mei, false, true},
+        // terrain classes and their tables, with infiltration, Mei's erosion and collapse
+        AgreementCase{"local_inertial_classes", FlowScheme::local_inertial,
+                      TransportScheme::conservative, true, 2.0, 1, ErosionLaw::mei, true, false,
+                      true}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
 
 }  // namespace

@@ -56,7 +56,7 @@ DamBreakErrors dam_break_errors(const DamBreak& db, const DamBreakResult& r, con
 /// no dissipation at all: behind a shock it leaves grid-scale oscillations (+-0.3 m at 2 m
 /// and at 0.5 m cells) that do not shrink when dx does (LocalInertialDamBreakConverges
 /// prints that ladder too).
-Params dam_break_params(FlowScheme scheme, double dt, double theta = Params{}.flow.theta) {
+Params dam_break_params(FlowScheme scheme, double dt, double theta = default_params().flow.theta) {
   Params p = quiet_params(scheme, dt);
   p.flow.theta = theta;
   return p;
@@ -140,7 +140,7 @@ TEST_P(Analytical, LocalInertialDamBreakConverges) {
   std::vector<double> sizes{4.0, 2.0, 1.0, 0.5};
   if (vr::full_ladder()) sizes.push_back(0.25);
   const char* self_ref = "self-convergence (finest grid); Stoker (1957) for the model error";
-  for (double theta : {Params{}.flow.theta, 1.0}) {
+  for (double theta : {default_params().flow.theta, 1.0}) {
     const bool asserted = theta < 1.0;
     if (!asserted && (target().backend != "cpu" || !target().f64())) continue;  // once is enough
     std::vector<DamBreak> grids;

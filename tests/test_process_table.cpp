@@ -166,20 +166,21 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
   // state_fields() and output.fields' choices as written by hand before the table
   // (simulation.cpp and schema.cpp of 2026-11-25) with the snow pack and the shallow-water
   // scheme's unit discharges added, the bed shear stress as an output, the soil of the
-  // physical erosion law, infiltration's store and the snow pack's liquid water, as sets: the
-  // order is the table's now.
+  // physical erosion law, infiltration's store, the snow pack's liquid water and the terrain
+  // classes, as sets: the order is the table's now.
   std::set<std::string> state, output(output_field_names().begin(), output_field_names().end());
   for (FieldId id : state_fields()) state.insert(field_info(id).name);
-  EXPECT_EQ(state,
-            (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment", "velocity_x",
-                                   "velocity_y", "flux_left", "flux_right", "flux_top",
-                                   "flux_bottom", "wetness", "bed_residual", "snow", "snow_liquid",
-                                   "momentum_x", "momentum_y", "soil_thickness", "infiltrated"}));
+  EXPECT_EQ(state, (std::set<std::string>{"bed", "initial_bed", "water_depth", "sediment",
+                                          "velocity_x", "velocity_y", "flux_left", "flux_right",
+                                          "flux_top", "flux_bottom", "wetness", "bed_residual",
+                                          "snow", "snow_liquid", "momentum_x", "momentum_y",
+                                          "soil_thickness", "infiltrated", "terrain_class"}));
   EXPECT_EQ(output,
-            (std::set<std::string>{"bed", "water_depth", "sediment", "velocity_x", "velocity_y",
-                                   "erosion", "wetness", "hardness", "flux_left", "flux_right",
-                                   "flux_top", "flux_bottom", "snow", "snow_liquid", "momentum_x",
-                                   "momentum_y", "shear_stress", "soil_thickness", "infiltrated"}));
+            (std::set<std::string>{
+                "bed",        "water_depth",  "sediment",       "velocity_x",  "velocity_y",
+                "erosion",    "wetness",      "hardness",       "flux_left",   "flux_right",
+                "flux_top",   "flux_bottom",  "snow",           "snow_liquid", "momentum_x",
+                "momentum_y", "shear_stress", "soil_thickness", "infiltrated", "terrain_class"}));
   // a field restored from files that lack it starts at 0: the bed residual and the snow pack,
   // added later
   for (const auto& f : field_table())
@@ -187,14 +188,15 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
               f.id == FieldId::bed_residual || f.id == FieldId::snow ||
                   f.id == FieldId::snow_liquid || f.id == FieldId::momentum_x ||
                   f.id == FieldId::momentum_y || f.id == FieldId::soil_thickness ||
-                  f.id == FieldId::infiltrated)
+                  f.id == FieldId::infiltrated || f.id == FieldId::terrain_class)
         << f.name;
 }
 
 TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // the cell kernels whose work-group the OpenCL backend queried from its own list (before
   // 2026-11-26), the snow pack's, the shallow-water second order's, infiltration's and the
-  // stage hydrograph's (added through the table), as a set; the program in step order
+  // stage hydrograph's and the terrain classes' (added through the table), as a set; the
+  // program in step order (the terrain classes first)
   // (flow before sources since they run after it; before, the files were listed in the enum's
   // order)
   const auto k = opencl_cell_kernels();
@@ -220,18 +222,19 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "snow_slide",
                                    "infiltration",
                                    "boundary_level",
+                                   "terrain_class",
                                    "flow_shallow_water",
                                    "flow_shallow_water_muscl",
                                    "flow_shallow_water_stage_depth",
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 27u) << "a kernel listed twice";
-  EXPECT_EQ(
-      opencl_program_order(),
-      (std::vector<std::string>{"reduce.cl", "boundary.cl", "flow.cl", "sources.cl", "water.cl",
-                                "erosion.cl", "transport.cl", "thermal.cl", "evaporation.cl",
-                                "snow.cl", "infiltration.cl", "edges.cl", "stats.cl"}));
+  EXPECT_EQ(k.size(), 28u) << "a kernel listed twice";
+  EXPECT_EQ(opencl_program_order(),
+            (std::vector<std::string>{"reduce.cl", "terrain_class.cl", "boundary.cl", "flow.cl",
+                                      "sources.cl", "water.cl", "erosion.cl", "transport.cl",
+                                      "thermal.cl", "evaporation.cl", "snow.cl", "infiltration.cl",
+                                      "edges.cl", "stats.cl"}));
 }
 
 }  // namespace

@@ -106,6 +106,24 @@ const std::string kPhysical = [] {
   return c;
 }();
 
+/// The same with terrain classes every 7 steps, whose tables give Manning n, talus angles and
+/// K_sat by class: a restart between two classifications writes the tables again from the
+/// classes it restores.
+const std::string kClasses = std::string(kInertial) + R"(
+[terrain_classes]
+enabled = true
+interval = 7
+rock_slope = 0.2
+mud_wetness = "2 mm"
+water_wetness = "2 cm"
+grass.manning_n = 0.045
+rock.manning_n = 0.03
+rock.talus_angle = 40.0
+mud.talus_angle = 20.0
+mud.ksat = "2 mm/h"
+snow.manning_n = 0.02
+)";
+
 /// Pipes, semi-Lagrangian transport, a point inflow hydrograph and fixed steps.
 const char* kPipes = R"([dem]
 synthetic = "hill"
@@ -260,6 +278,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"physical", kPhysical.c_str(), "cpu", "float32"},
                       Case{"physical", kPhysical.c_str(), "cpu", "float64"},
                       Case{"physical", kPhysical.c_str(), "opencl", "float32"},
+                      Case{"classes", kClasses.c_str(), "cpu", "float32"},
+                      Case{"classes", kClasses.c_str(), "cpu", "float64"},
+                      Case{"classes", kClasses.c_str(), "opencl", "float32"},
                       Case{"pipes", kPipes, "cpu", "float32"},
                       Case{"pipes", kPipes, "opencl", "float32"}),
     [](const ::testing::TestParamInfo<Case>& p) {

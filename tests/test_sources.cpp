@@ -22,7 +22,7 @@ class Sources : public TargetTest {};
 /// Every process but flow off, closed edges, Manning n `n`, the default adaptive step
 /// (time.cfl 0.7, time.dt_max 5 s) for `duration` s.
 Params adaptive_params(double n, double duration) {
-  Params p = quiet_params(FlowScheme::local_inertial, Params{}.time.dt);
+  Params p = quiet_params(FlowScheme::local_inertial, default_params().time.dt);
   p.flow.manning_n.value = n;
   p.time.adaptive = true;
   p.time.duration = duration;

@@ -9,6 +9,7 @@
 #include <limits>
 #include <set>
 
+#include "common/terrain_class.h"
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
 #include "erodem/process.hpp"
@@ -33,6 +34,9 @@ bool snow_on(const Params& p) {
 }
 bool infiltration_on(const Params& p) {
   return p.infiltration.enabled;
+}
+bool classes_on(const Params& p) {
+  return p.terrain_classes.enabled;
 }
 bool rains(const Params& p) {
   return p.rain.rate > 0 || !p.rain.series.empty() || !p.rain.grids.empty();
@@ -202,17 +206,45 @@ std::vector<SweepInfo> transport_sweeps(const Params& p) {
            {"transport_semi_lagrangian"}}};
 }
 
-std::vector<SweepInfo> thermal_sweeps(const Params&) {
+std::vector<SweepInfo> thermal_sweeps(const Params& p) {
   // thermal_share_cell then thermal_apply_cell (thermal.h): what each cell gives, then what
-  // it keeps and takes from its neighbours
-  return {{"thermal_share",
-           Domain::cells,
-           {{"kind", N}, {"bed", N}, {"wetness", R}, {"thermal_share", Wr}},
-           {"thermal_share"}},
-          {"thermal_apply",
-           Domain::cells,
-           {{"kind", N}, {"bed", U}, {"bed_residual", U}, {"wetness", N}, {"thermal_share", N}},
-           {"thermal_apply"}}};
+  // it keeps and takes from its neighbours; each cell's dry talus slope from its class's table
+  // where the terrain classes give talus angles
+  std::vector<SweepInfo> s{
+      {"thermal_share",
+       Domain::cells,
+       {{"kind", N}, {"bed", N}, {"wetness", R}, {"thermal_share", Wr}},
+       {"thermal_share"}},
+      {"thermal_apply",
+       Domain::cells,
+       {{"kind", N}, {"bed", U}, {"bed_residual", U}, {"wetness", N}, {"thermal_share", N}},
+       {"thermal_apply"}}};
+  if (class_tables(p).talus) {
+    s[0].uses.push_back({"talus_slope", R});
+    s[1].uses.push_back({"talus_slope", N});
+  }
+  return s;
+}
+
+std::vector<SweepInfo> terrain_class_sweeps(const Params&) {
+  // terrain_class_sweep_cell (terrain_class.h): each active cell's class from its bed, slope,
+  // wetness and pack (on the steps of terrain_classes.interval), then its class's values into
+  // the parameter fields the tables write (class_tables)
+  return {generic_sweep("terrain_class",
+                        {{"kind", N},
+                         {"dx", R},
+                         {"dy", R},
+                         {"bed", N},
+                         {"wetness", R},
+                         {"snow", R},
+                         {"terrain_class", U},
+                         {"manning_n", Wr},
+                         {"hardness", Wr},
+                         {"infiltration_ksat", Wr},
+                         {"infiltration_suction_deficit", Wr},
+                         {"infiltration_store", Wr},
+                         {"talus_slope", Wr}},
+                        {})};
 }
 
 std::vector<SweepInfo> evaporation_sweeps(const Params& p) {
@@ -250,35 +282,27 @@ std::vector<SweepInfo> snow_sweeps(const Params& p) {
   return s;
 }
 
-/// The slope of the bed at DEM cell (col c, row r) in degrees: the angle of the gradient by
-/// central differences over the active neighbours (one-sided where one of a pair is missing or
-/// not active; 0 along an axis with neither).
+/// The slope of the bed at DEM cell (col c, row r) in degrees: the angle of bed_slope_cell
+/// (terrain_class.h, the terrain classes' slope), the gradient by central differences over
+/// the active neighbours (one-sided where one of a pair is missing or not active; 0 along an
+/// axis with neither).
 double bed_slope_degrees(const Terrain& t, int c, int r) {
   const Grid& g = t.grid;
   const auto at = [&](int cc, int rr) { return static_cast<std::size_t>(rr) * g.nx + cc; };
-  const std::size_t i = at(c, r);
   const auto usable = [&](int cc, int rr) {
     return cc >= 0 && cc < g.nx && rr >= 0 && rr < g.ny && t.active(at(cc, rr));
   };
-  // the gradient along one axis from the neighbours a (before) and b (after), `da` and `db`
-  // metres away
-  const auto derivative = [&](bool has_a, std::size_t a, double da, bool has_b, std::size_t b,
-                              double db) {
-    const double za = has_a ? t.bed[a] : t.bed[i], zb = has_b ? t.bed[b] : t.bed[i];
-    const double run = (has_a ? da : 0.0) + (has_b ? db : 0.0);
-    return run > 0 ? (zb - za) / run : 0.0;
-  };
-  const double dx = g.dx[static_cast<std::size_t>(r)];
-  const double gx = derivative(usable(c - 1, r), usable(c - 1, r) ? at(c - 1, r) : i, dx,
-                               usable(c + 1, r), usable(c + 1, r) ? at(c + 1, r) : i, dx);
+  const auto bed = [&](int cc, int rr) { return usable(cc, rr) ? t.bed[at(cc, rr)] : 0.0; };
   const auto dy_between = [&](int r0, int r1) {
     return 0.5 * (g.dy[static_cast<std::size_t>(r0)] + g.dy[static_cast<std::size_t>(r1)]);
   };
-  const bool north = usable(c, r - 1), south = usable(c, r + 1);
-  const double gy = derivative(north, north ? at(c, r - 1) : i, north ? dy_between(r - 1, r) : 0.0,
-                               south, south ? at(c, r + 1) : i, south ? dy_between(r, r + 1) : 0.0);
+  const int north = usable(c, r - 1), south = usable(c, r + 1);
+  const double slope = cell::bed_slope_cell<double>(
+      t.bed[at(c, r)], bed(c - 1, r), bed(c + 1, r), bed(c, r - 1), bed(c, r + 1), usable(c - 1, r),
+      usable(c + 1, r), north, south, g.dx[static_cast<std::size_t>(r)],
+      north ? dy_between(r - 1, r) : 0.0, south ? dy_between(r, r + 1) : 0.0);
   const double pi = 3.14159265358979323846;
-  return std::atan(std::hypot(gx, gy)) * 180.0 / pi;
+  return std::atan(slope) * 180.0 / pi;
 }
 
 /// The share of snow.initial an initial pack at elevation z (m) gets: 1 where no snow line is
@@ -362,8 +386,38 @@ std::vector<std::pair<FieldId, std::vector<double>>> erosion_initial(const Terra
 
 }  // namespace
 
+ClassTables class_tables(const Params& p) {
+  ClassTables t;
+  const auto& tc = p.terrain_classes;
+  if (!tc.enabled) return t;
+  for (const Params::ClassValues* v : {&tc.grass, &tc.mud, &tc.rock, &tc.snow, &tc.water}) {
+    t.manning = t.manning || v->manning_n;
+    t.hardness = t.hardness || v->erodibility;
+    t.ksat = t.ksat || v->ksat;
+    t.soil = t.soil || v->suction || v->moisture_deficit || v->soil_depth;
+    t.talus = t.talus || v->talus_angle;
+  }
+  const auto& in = p.infiltration;
+  t.manning = t.manning && !p.flow.manning_n.is_raster();
+  t.hardness = t.hardness && p.erosion.enabled && !p.erosion.hardness.is_raster() &&
+               !p.erosion.hardness_noise;
+  t.ksat = t.ksat && in.enabled && !in.ksat.is_raster();
+  t.soil = t.soil && in.enabled;  // schema.cpp refuses class soils beside soil rasters
+  t.talus = t.talus && p.thermal.enabled;
+  return t;
+}
+
 const std::vector<ProcessInfo>& process_table() {
   static const std::vector<ProcessInfo> table{
+      // first: the classes of the state the step starts from, and their parameters, before
+      // any process reads them (Simulation::step runs it every terrain_classes.interval steps)
+      {Process::terrain_class,
+       "terrain_class",
+       "terrain_classes",
+       classes_on,
+       terrain_class_sweeps,
+       {},
+       "terrain_class.cl"},
       {Process::boundary, "boundary", "boundary", always, boundary_sweeps, {}, "boundary.cl"},
       {Process::flow, "flow", "flow", always, flow_sweeps, {}, "flow.cl"},
       {Process::sources, "sources", "rain", always, sources_sweeps, {}, "sources.cl"},

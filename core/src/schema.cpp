@@ -171,6 +171,25 @@ void check_cross_fields(const Params& p, const std::string& source) {
     throw fail("erosion.bedrock_level",
                "give erosion.bedrock_level or a raster erosion.soil_thickness, not both (the "
                "level sets the soil thickness to bed - bedrock_level)");
+  const auto& tc = p.terrain_classes;
+  const std::pair<const char*, const Params::ClassValues*> classes[] = {{"grass", &tc.grass},
+                                                                        {"mud", &tc.mud},
+                                                                        {"rock", &tc.rock},
+                                                                        {"snow", &tc.snow},
+                                                                        {"water", &tc.water}};
+  const auto& in = p.infiltration;
+  const bool soil_raster = in.suction.is_raster() || in.moisture_deficit.is_raster() ||
+                           (in.soil_depth && in.soil_depth->is_raster());
+  for (const auto& [name, values] : classes) {
+    if (values->any() && !tc.enabled)
+      throw fail(fmt::format("terrain_classes.{}", name),
+                 "class parameters act only with terrain_classes.enabled = true");
+    if (soil_raster && (values->suction || values->moisture_deficit || values->soil_depth))
+      throw fail(fmt::format("terrain_classes.{}", name),
+                 "its suction, moisture_deficit or soil_depth would combine with a raster of "
+                 "infiltration.suction, .moisture_deficit or .soil_depth cell by cell: give the "
+                 "soil as rasters or by class, not both");
+  }
   if (p.flow.order == 2 && p.flow.scheme != FlowScheme::shallow_water)
     throw fail("flow.order",
                "order 2 is the shallow_water scheme's (flow.scheme = \"shallow_water\")");

@@ -32,6 +32,28 @@ namespace erodem::schema_detail {
                       "physical, cohesive: Krone's critical shear stress for deposition "       \
                       "tau_c,d over " what " (Pa); not set = deposition w_s c at any stress")
 
+/// The keys of one terrain class's table, terrain_classes.<cls>.* (Params::ClassValues).
+#define ERODEM_CLASS_TABLE(cls)                                                                  \
+  optional_number(ERODEM_FIELD(terrain_classes.cls.manning_n), D::manning, closed(0, 1),         \
+                  "Manning n of " #cls " cells (s m^-1/3); not set = flow.manning_n"),           \
+      optional_number(ERODEM_FIELD(terrain_classes.cls.talus_angle), D::angle, open(0, 90),      \
+                      "talus angle of " #cls " cells (degrees); not set = thermal.talus_angle"), \
+      optional_number(ERODEM_FIELD(terrain_classes.cls.ksat), D::speed, at_least(0),             \
+                      "K_sat of " #cls " cells (m/s); not set = infiltration.ksat"),             \
+      optional_number(ERODEM_FIELD(terrain_classes.cls.suction), D::length, at_least(0),         \
+                      "suction head psi of " #cls " cells (m); not set = infiltration.suction"), \
+      optional_number(                                                                           \
+          ERODEM_FIELD(terrain_classes.cls.moisture_deficit), D::dimensionless, closed(0, 1),    \
+          "moisture deficit of " #cls " cells (1); not set = infiltration.moisture_deficit"),    \
+      optional_number(ERODEM_FIELD(terrain_classes.cls.soil_depth), D::length, at_least(0),      \
+                      "soil store depth L of " #cls                                              \
+                      " cells (m); not set = infiltration.soil_depth"),                          \
+      optional_number(ERODEM_FIELD(terrain_classes.cls.erodibility), D::dimensionless,           \
+                      closed(0, 1),                                                              \
+                      "erodibility R of " #cls                                                   \
+                      " cells (1, the hardness field); not set = "                               \
+                      "erosion.hardness")
+
 const std::vector<Descriptor>& descriptor_table() {
   using D = Dimension;
   static const Choices<BoundaryKind> boundary{{"closed", BoundaryKind::closed},
@@ -273,6 +295,29 @@ const std::vector<Descriptor>& descriptor_table() {
       optional_number(ERODEM_FIELD(infiltration.recovery_rate), D::inverse_time, at_least(0),
                       "recovery constant k_r (1/s): a dry cell's infiltrated depth decays as "
                       "e^(-k_r t); not set = SWMM's sqrt(K_sat in in/h) / 75 per hour"),
+
+      boolean(ERODEM_FIELD(terrain_classes.enabled),
+              "terrain classes: every active cell is snow, water, rock, mud or grass, and each "
+              "class may give its cells their own parameters (terrain_classes.<class>.*)"),
+      integer(ERODEM_FIELD(terrain_classes.interval), closed(1, 1e9),
+              "steps between two classifications (the first step classifies)"),
+      number(ERODEM_FIELD(terrain_classes.snow_depth), D::length, at_least(0),
+             "a cell whose snow pack (snow water equivalent) exceeds this is snow (m)"),
+      optional_number(ERODEM_FIELD(terrain_classes.snow_line), D::length, any_finite(),
+                      "a cell whose bed lies above this is snow (m); not set = by its pack only"),
+      number(ERODEM_FIELD(terrain_classes.water_wetness), D::length, at_least(0),
+             "a cell whose wetness (the running mean of its depth) exceeds this is water (m)"),
+      number(ERODEM_FIELD(terrain_classes.rock_slope), D::dimensionless, at_least(0),
+             "a cell whose bed slope exceeds this is rock (m/m; 0.7 is 35 degrees)"),
+      optional_number(ERODEM_FIELD(terrain_classes.rock_elevation), D::length, any_finite(),
+                      "rock only where the bed lies above this (m); not set = at any elevation"),
+      number(ERODEM_FIELD(terrain_classes.mud_wetness), D::length, at_least(0),
+             "a cell whose wetness exceeds this is mud (m)"),
+      ERODEM_CLASS_TABLE(grass),
+      ERODEM_CLASS_TABLE(mud),
+      ERODEM_CLASS_TABLE(rock),
+      ERODEM_CLASS_TABLE(snow),
+      ERODEM_CLASS_TABLE(water),
 
       choice(ERODEM_FIELD(boundary.north), boundary, "north edge: closed, open or fixed_level"),
       choice(ERODEM_FIELD(boundary.south), boundary, "south edge: closed, open or fixed_level"),

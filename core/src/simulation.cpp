@@ -86,6 +86,7 @@ void Simulation::restore(const RestartPoint& point) {
   time_ = point.time;
   steps_ = point.steps;
   ledger_ = point.ledger;
+  class_fields_stale_ = true;
   state_changed();
   diag_ = diagnostics_now(0.0);
 }
@@ -473,11 +474,18 @@ void Simulation::check_stability(double dt) const {
 void Simulation::step() {
   const double dt = next_dt();
   if (!(dt > 0)) throw Error(ExitCode::internal, "time step is not positive");
-  const StepInputs in = inputs_for(dt);
+  StepInputs in = inputs_for(dt);
+  // terrain classes: classified on every terrain_classes.interval-th step (the first one
+  // included), their tables written again after a restart; otherwise the pass is skipped
+  const bool classify = steps_ % params_.terrain_classes.interval == 0;
+  const bool class_pass = classify || class_fields_stale_;
+  in.classify = classify;
   // gridded rain: the rate of the step's midpoint in the rain_factor field, and its volume
   const double rain_volume_rate = rain_bands_.empty() ? 0.0 : set_rain_grid(time_ + 0.5 * dt);
   backend_->begin_step(in);
-  for (Process p : sequence()) backend_->run(p);
+  for (Process p : sequence())
+    if (p != Process::terrain_class || class_pass) backend_->run(p);
+  class_fields_stale_ = false;
   StepResult result = backend_->end_step();  // the step's one wait
   const StepTally& tally = result.tally;
   time_ += dt;

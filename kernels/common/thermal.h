@@ -10,16 +10,21 @@ ERODEM_PARAMS(ThermalParams, {
   real rate;          /* K_t (1/s) */
   real tan_talus;     /* tan of the talus angle (1) */
   real tan_wet;       /* tan of the wet talus angle (1); tan_talus where none is given */
-  real wet_threshold; /* wetness (m) above which a cell takes tan_wet */
+  real wet_threshold; /* wetness (m) above which a cell takes tan_wet (+inf: no wet angle) */
+  int by_class;       /* 1: the dry talus slope of each cell is its talus_slope field (the
+                         terrain classes' table, terrain_class.h); 0: tan_talus everywhere */
 })
 
 ERODEM_BEGIN_NAMESPACE
 
-/* The talus slope of a cell with wetness `w` (m, the running mean of its depth): the wet one
+/* The talus slope of cell j from its wetness (m, the running mean of its depth): the wet one
  * above the threshold (MODEL.md step 6: wet or soft ground stands less steep), else the dry
- * one. The giver's slope sets each transfer. */
-ERODEM_FN real cell_tan_talus(real w, ERODEM_P(ThermalParams) p) {
-  return w > p.wet_threshold ? p.tan_wet : p.tan_talus;
+ * one, its class's (talus_slope, read only with by_class) or tan_talus. The giver's slope sets
+ * each transfer. */
+ERODEM_FN real cell_tan_talus(GLOBAL const real* wetness, GLOBAL const real* talus, int j,
+                              ERODEM_P(ThermalParams) p) {
+  const real dry = p.by_class ? talus[j] : p.tan_talus;
+  return wetness[j] > p.wet_threshold ? p.tan_wet : dry;
 }
 
 /* Height (m) by which the bed drop from `from` to `to` over `dist` (m) exceeds the talus
@@ -47,10 +52,11 @@ ERODEM_FN real talus_excess_out(real b, real b_l, real b_r, real b_t, real b_b, 
  * metre of summed excess (m^2), which pass 2 multiplies by each neighbour's excess. */
 ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                   GLOBAL const real* bed, GLOBAL const real* wetness,
-                                  GLOBAL const real* dx, GLOBAL const real* dy,
-                                  GLOBAL const real* area, real dt, ERODEM_P(ThermalParams) p) {
+                                  GLOBAL const real* talus, GLOBAL const real* dx,
+                                  GLOBAL const real* dy, GLOBAL const real* area, real dt,
+                                  ERODEM_P(ThermalParams) p) {
   const int i = x + y * W;
-  const real rate = p.rate, tan_talus = cell_tan_talus(wetness[i], p);
+  const real rate = p.rate, tan_talus = cell_tan_talus(wetness, talus, i, p);
   const real b = bed[i];
   const real dist_t = centre_distance_y(dy, y - 1);
   const real dist_b = centre_distance_y(dy, y);
@@ -82,12 +88,13 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
  * conservative. */
 ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                   GLOBAL const real* bed, GLOBAL const real* bed_residual,
-                                  GLOBAL const real* wetness, GLOBAL const real* share,
-                                  GLOBAL const real* dx, GLOBAL const real* dy,
-                                  GLOBAL const real* area, ERODEM_P(ThermalParams) p,
-                                  real* bed_residual_out, real* given_out) {
+                                  GLOBAL const real* wetness, GLOBAL const real* talus,
+                                  GLOBAL const real* share, GLOBAL const real* dx,
+                                  GLOBAL const real* dy, GLOBAL const real* area,
+                                  ERODEM_P(ThermalParams) p, real* bed_residual_out,
+                                  real* given_out) {
   const int i = x + y * W;
-  const real tan_talus = cell_tan_talus(wetness[i], p);
+  const real tan_talus = cell_tan_talus(wetness, talus, i, p);
   const real b = bed[i];
   const real dist_t = centre_distance_y(dy, y - 1);
   const real dist_b = centre_distance_y(dy, y);
@@ -100,8 +107,10 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
                                       dist_t, dist_b, tan_talus);
   const real s_l = share[i - 1], s_r = share[i + 1], s_t = share[i - W], s_b = share[i + W];
   /* each neighbour gives at its own talus slope, as its pass 1 shared */
-  const real t_l = cell_tan_talus(wetness[i - 1], p), t_r = cell_tan_talus(wetness[i + 1], p);
-  const real t_t = cell_tan_talus(wetness[i - W], p), t_b = cell_tan_talus(wetness[i + W], p);
+  const real t_l = cell_tan_talus(wetness, talus, i - 1, p),
+             t_r = cell_tan_talus(wetness, talus, i + 1, p);
+  const real t_t = cell_tan_talus(wetness, talus, i - W, p),
+             t_b = cell_tan_talus(wetness, talus, i + W, p);
   const real taken = (has_l ? s_l * talus_excess(b_l, b, dist_x, t_l) : (real)0) +
                      (has_r ? s_r * talus_excess(b_r, b, dist_x, t_r) : (real)0) +
                      (has_t ? s_t * talus_excess(b_t, b, dist_t, t_t) : (real)0) +
@@ -121,26 +130,27 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
  * through *moved. */
 ERODEM_FN void thermal_share_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                         GLOBAL const real* bed, GLOBAL const real* wetness,
-                                        GLOBAL const real* dx, GLOBAL const real* dy,
-                                        GLOBAL const real* area, GLOBAL real* share, real dt,
-                                        ERODEM_P(ThermalParams) p) {
+                                        GLOBAL const real* talus, GLOBAL const real* dx,
+                                        GLOBAL const real* dy, GLOBAL const real* area,
+                                        GLOBAL real* share, real dt, ERODEM_P(ThermalParams) p) {
   const int i = x + y * W;
-  const real s = thermal_share_cell(x, y, W, kind, bed, wetness, dx, dy, area, dt, p);
+  const real s = thermal_share_cell(x, y, W, kind, bed, wetness, talus, dx, dy, area, dt, p);
   share[i] = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s : (real)0;
 }
 
 ERODEM_FN void thermal_apply_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                         GLOBAL const real* bed, GLOBAL real* bed_out,
                                         GLOBAL real* bed_residual, GLOBAL const real* wetness,
-                                        GLOBAL const real* share, GLOBAL const real* dx,
-                                        GLOBAL const real* dy, GLOBAL const real* area,
-                                        ERODEM_P(ThermalParams) p, real* moved) {
+                                        GLOBAL const real* talus, GLOBAL const real* share,
+                                        GLOBAL const real* dx, GLOBAL const real* dy,
+                                        GLOBAL const real* area, ERODEM_P(ThermalParams) p,
+                                        real* moved) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   const real b_old = bed[i], lo_old = bed_residual[i]; /* unconditional loads */
   real lo_new, gave;
-  const real b = thermal_apply_cell(x, y, W, kind, bed, bed_residual, wetness, share, dx, dy, area,
-                                    p, &lo_new, &gave);
+  const real b = thermal_apply_cell(x, y, W, kind, bed, bed_residual, wetness, talus, share, dx, dy,
+                                    area, p, &lo_new, &gave);
   bed_out[i] = active ? b : b_old;
   bed_residual[i] = active ? lo_new : lo_old;
   *moved = active ? gave : (real)0;

@@ -18,6 +18,7 @@
 #include "common/shallow_water.h"
 #include "common/snow.h"
 #include "common/sources.h"
+#include "common/terrain_class.h"
 #include "cpu/cpu_backend.hpp"
 #include "erodem/error.hpp"
 #include "erodem/process.hpp"
@@ -142,6 +143,7 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
       {"snow_slide", &CpuBackend::cell_sweep<&cell::snow_slide_sweep_cell<Real>>},
       {"infiltration", &CpuBackend::cell_sweep<&cell::infiltration_sweep_cell<Real>>},
       {"boundary_level", &CpuBackend::cell_sweep<&cell::boundary_level_sweep_cell<Real>>},
+      {"terrain_class", &CpuBackend::cell_sweep<&cell::terrain_class_sweep_cell<Real>>},
       {"shallow_water_velocity",
        &CpuBackend::cell_sweep<&cell::shallow_water_velocity_sweep_cell<Real>>},
   };

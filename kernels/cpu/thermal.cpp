@@ -15,6 +15,7 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
   const Kind* kind = kind_.data();
   const Real *bed = bed_.data(), *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const Real* wet = wetness_.data();
+  const Real* talus = field_storage(FieldId::talus_slope)->data();  // read with by_class only
   Real *share = thermal_share_.data(), *bed_out = bed_next_.data(), *bed_lo = bed_residual_.data();
   const cell_params::ThermalParams<Real> params = cell_.thermal;
   const int W = W_;
@@ -24,7 +25,7 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
     const cell_params::ThermalParams<Real> p = params;
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
-      cell::thermal_share_sweep_cell(x, y, W, kind, bed, wet, dx, dy, area, share, step, p);
+      cell::thermal_share_sweep_cell(x, y, W, kind, bed, wet, talus, dx, dy, area, share, step, p);
   });
   for_rows(1, H_ - 1, [=](int y) {
     const cell_params::ThermalParams<Real> p = params;
@@ -32,8 +33,8 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
     Real* given = given_row.get();
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
-      cell::thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_lo, wet, share, dx, dy, area,
-                                     p, given + x);
+      cell::thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_lo, wet, talus, share, dx, dy,
+                                     area, p, given + x);
     row_sums_a_[y] = sum_row(given, static_cast<std::size_t>(W));
   });
   tally.thermal_moved += sum_rows(row_sums_a_);

@@ -36,9 +36,6 @@ __kernel void boundary_level(int W, int H, __global const uchar* restrict kind,
                              __global real* restrict sediment, __global const real* restrict area,
                              real dt, BoundaryParams p, __global acc_t* restrict partials,
                              int stride) {
-  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  (void)partials;
-  (void)stride;
-  if (!ERODEM_PAST_ROW(x, W))
-    boundary_level_sweep_cell(x, y, W, kind, bed, depth, sediment, area, dt, p);
+  ERODEM_UNTALLIED_CELL(x, y);
+  boundary_level_sweep_cell(x, y, W, kind, bed, depth, sediment, area, dt, p);
 }

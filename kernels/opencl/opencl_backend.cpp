@@ -456,12 +456,13 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
 
 void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   cl_kernel share = kernel("thermal_share");
-  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, dx_, dy_, area_, thermal_share_,
-           dt, cell_.thermal);
+  const Buffer& talus = *field_buffer(FieldId::talus_slope);  // read with by_class only
+  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, talus, dx_, dy_, area_,
+           thermal_share_, dt, cell_.thermal);
   launch_interior(share);
   cl_kernel apply = kernel("thermal_apply");
-  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, wetness_, thermal_share_, dx_,
-           dy_, area_, bed_next_, cell_.thermal, tally_partials_,
+  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, wetness_, talus,
+           thermal_share_, dx_, dy_, area_, bed_next_, cell_.thermal, tally_partials_,
            static_cast<cl_int>(tally_stride_));
   defer(tally, tally_bit(&StepTally::thermal_moved));
   launch_interior(apply);

@@ -47,6 +47,16 @@ typedef int8 acc8_mask_t;
 #define ERODEM_PAST_ROW(x, W) ((x) >= (W))
 #endif
 
+/* The opening of a generic kernel without tallies (the arguments every generic kernel takes,
+ * process.hpp SweepInfo::generic): its work-item's padded cell (x, y), and a return for a
+ * work-item past the row. */
+#define ERODEM_UNTALLIED_CELL(x, y)                               \
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1); \
+  (void)H;                                                        \
+  (void)partials;                                                 \
+  (void)stride;                                                   \
+  if (ERODEM_PAST_ROW(x, W)) return
+
 /* The largest work-group of the cell kernels (the host's local size is at most this). */
 #define ERODEM_CELL_GROUP_MAX 1024
 

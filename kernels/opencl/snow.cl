@@ -33,11 +33,7 @@ __kernel void snow_slide_share(int W, int H, __global const uchar* restrict kind
                                __global const real* restrict dy, __global real* restrict share,
                                __global const real* restrict area, real dt, SnowParams p,
                                __global acc_t* restrict partials, int stride) {
-  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  (void)H;
-  (void)partials;
-  (void)stride;
-  if (ERODEM_PAST_ROW(x, W)) return;
+  ERODEM_UNTALLIED_CELL(x, y);
   snow_slide_share_sweep_cell(x, y, W, kind, bed, snow, dx, dy, share, area, dt, p);
 }
 
@@ -47,10 +43,6 @@ __kernel void snow_slide(int W, int H, __global const uchar* restrict kind,
                          __global const real* restrict dx, __global const real* restrict dy,
                          __global const real* restrict share, __global const real* restrict area,
                          real dt, SnowParams p, __global acc_t* restrict partials, int stride) {
-  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  (void)H;
-  (void)partials;
-  (void)stride;
-  if (ERODEM_PAST_ROW(x, W)) return;
+  ERODEM_UNTALLIED_CELL(x, y);
   snow_slide_sweep_cell(x, y, W, kind, bed, snow, dx, dy, share, area, dt, p);
 }

@@ -7,12 +7,13 @@
  * thermal_share_sweep_cell. */
 __kernel void thermal_share(int W, int H, __global const uchar* restrict kind,
                             __global const real* restrict bed,
-                            __global const real* restrict wetness, __global const real* restrict dx,
+                            __global const real* restrict wetness,
+                            __global const real* restrict talus, __global const real* restrict dx,
                             __global const real* restrict dy, __global const real* restrict area,
                             __global real* restrict share, real dt, ThermalParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
-  thermal_share_sweep_cell(x, y, W, kind, bed, wetness, dx, dy, area, share, dt, p);
+  thermal_share_sweep_cell(x, y, W, kind, bed, wetness, talus, dx, dy, area, share, dt, p);
 }
 
 /* Pass 2, one work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the
@@ -22,6 +23,7 @@ __kernel void thermal_share(int W, int H, __global const uchar* restrict kind,
 __kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
                             __global const real* restrict bed, __global real* restrict bed_residual,
                             __global const real* restrict wetness,
+                            __global const real* restrict talus,
                             __global const real* restrict share, __global const real* restrict dx,
                             __global const real* restrict dy, __global const real* restrict area,
                             __global real* restrict bed_out, ThermalParams p,
@@ -30,7 +32,7 @@ __kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real moved = 0;
   if (!ERODEM_PAST_ROW(x, W))
-    thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, wetness, share, dx, dy,
-                             area, p, &moved);
+    thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, wetness, talus, share, dx,
+                             dy, area, p, &moved);
   cell_group_sum(s_sum, moved, partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index());
 }

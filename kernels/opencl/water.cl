@@ -41,11 +41,7 @@ __kernel void shallow_water_velocity(int W, int H, __global const uchar* restric
                                      __global real* restrict velocity_y,
                                      __global const real* restrict area, real dt, WaterParams p,
                                      __global acc_t* restrict partials, int stride) {
-  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  (void)H;
-  (void)partials;
-  (void)stride;
-  if (ERODEM_PAST_ROW(x, W)) return;
+  ERODEM_UNTALLIED_CELL(x, y);
   shallow_water_velocity_sweep_cell(x, y, W, kind, depth, q_x, q_y, velocity_x, velocity_y, area,
                                     dt, p);
 }

@@ -228,6 +228,30 @@ def test_infiltration_from_python(erodem, tujunga):
         erodem.Simulation(dem, backend="cpu", infiltration__moisture_deficit=1.5)
 
 
+def test_terrain_classes_from_python(erodem, tujunga):
+    """Terrain classes from keywords (a class table three levels deep): the first step
+    classifies the crop of Big Tujunga, whose steep walls are rock; rock cells take the rock
+    table's Manning n and the others the uniform one; a class value without the classes is a
+    ValueError naming its key."""
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, backend="cpu", rain__rate="100 mm/h", time__dt=1.0,
+                            flow__manning_n=0.035, terrain_classes__enabled=True,
+                            terrain_classes__interval=5, terrain_classes__rock__manning_n=0.025)
+    assert "[terrain_classes.rock]" in sim.config_toml
+    sim.step(10)
+    cls = sim.field("terrain_class")
+    n = sim.field("manning_n")
+    valid = np.isfinite(cls)
+    codes = set(np.unique(cls[valid]).astype(int))
+    rock = valid & (cls == 2)
+    print("classes %s; rock cells %d of %d" % (sorted(codes), rock.sum(), valid.sum()))
+    assert codes <= {0, 1, 2, 3, 4} and rock.sum() > 0
+    assert np.allclose(n[rock], 0.025, rtol=1e-6)
+    assert np.allclose(n[valid & ~rock], 0.035, rtol=1e-6)
+    with pytest.raises(ValueError, match="terrain_classes.rock"):
+        erodem.Simulation(dem, backend="cpu", terrain_classes__rock__manning_n=0.025)
+
+
 def test_snow_from_python(erodem, tujunga):
     """The snow pack from keywords: a temperature series (a list of [t, T]), the snowfall
     threshold, the retention and the initial pack's band and slope limit; the cold storm falls

@@ -28,11 +28,12 @@ const std::vector<ColorStop>& color_stops(ColorMap map) {
                                                 {0.50, {0.97, 0.97, 0.97}},
                                                 {0.75, {0.92, 0.55, 0.45}},
                                                 {1.00, {0.65, 0.05, 0.12}}};
-  // grass, mud, rock, snow (codes 0..3 of TerrainClass).
+  // grass, mud, rock, snow, water (codes 0..4 of TerrainClass).
   static const std::vector<ColorStop> classes{{0.0, {0.40, 0.65, 0.25}},
-                                              {1.0 / 3.0, {0.45, 0.33, 0.20}},
-                                              {2.0 / 3.0, {0.55, 0.55, 0.55}},
-                                              {1.0, {0.98, 0.98, 1.00}}};
+                                              {0.25, {0.45, 0.33, 0.20}},
+                                              {0.5, {0.55, 0.55, 0.55}},
+                                              {0.75, {0.98, 0.98, 1.00}},
+                                              {1.0, {0.20, 0.45, 0.85}}};
   switch (map) {
     case ColorMap::water:
       return water;
@@ -79,7 +80,7 @@ double quantile(std::vector<double>& v, double q) {
 }  // namespace
 
 std::array<double, 2> color_range(ColorMap map, const std::vector<float>& values) {
-  if (map == ColorMap::classes) return {0.0, 3.0};
+  if (map == ColorMap::classes) return {0.0, 4.0};
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (float v : values)
     if (std::isfinite(v)) {

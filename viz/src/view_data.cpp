@@ -97,9 +97,10 @@ ViewData::ViewData(const std::string& path, const DemOptions& dem) : path_(path)
     fields_.push_back({"erosion", "m",
                        "bed lowering since the first snapshot (negative = deposition)",
                        ColorMap::diverging, false});
-  if (stored("bed"))
-    fields_.push_back(
-        {"terrain_class", "1", "terrain class (grass, mud, rock, snow)", ColorMap::classes, false});
+  // the model's classes where the run stored them (terrain_classes.enabled), else derived
+  if (stored("bed") && !stored("terrain_class"))
+    fields_.push_back({"terrain_class", "1", "terrain class (grass, mud, rock, snow, water)",
+                       ColorMap::classes, false});
 }
 
 ViewData::~ViewData() = default;
@@ -186,7 +187,9 @@ std::vector<float> ViewData::compute(const std::string& name, std::size_t index)
     wet = reader_->read_index("wetness", index);
   else if (stored("water_depth"))
     wet = reader_->read_index("water_depth", index);
-  return classify_terrain(grid_, b, wet, class_rule);
+  std::vector<float> snow;
+  if (stored("snow")) snow = reader_->read_index("snow", index);
+  return classify_terrain(grid_, b, wet, class_rule, snow);
 }
 
 CellValues ViewData::cell_values(int col, int row, std::size_t index) {

@@ -118,17 +118,17 @@ TEST(VizColor, RangesAndMaps) {
   EXPECT_LT(flat[0], flat[1]);
   const auto none = color_range(ColorMap::speed, {NAN});
   EXPECT_LT(none[0], none[1]);
-  EXPECT_EQ(color_range(ColorMap::classes, e), (std::array<double, 2>{0.0, 3.0}));
+  EXPECT_EQ(color_range(ColorMap::classes, e), (std::array<double, 2>{0.0, 4.0}));
   // The diverging map is white at zero (the middle) and distinct at the ends.
   const auto mid = color_at(ColorMap::diverging, 0.5);
   EXPECT_GT(mid[0] + mid[1] + mid[2], 2.8);
   EXPECT_NE(color_at(ColorMap::diverging, 0.0), color_at(ColorMap::diverging, 1.0));
-  EXPECT_EQ(color_at(ColorMap::classes, 2.0 / 3.0), color_stops(ColorMap::classes)[2].rgb);
+  EXPECT_EQ(color_at(ColorMap::classes, 2.0 / 4.0), color_stops(ColorMap::classes)[2].rgb);
 }
 
-TEST(VizTerrainClass, SnowRockMudGrass) {
-  // 8 x 8 cells of 10 m: a flat plain at 0 m with a wet strip (row 6), a 45-degree ramp in
-  // columns 3-5 and a 100 m plateau in columns 6-7.
+TEST(VizTerrainClass, SnowWaterRockMudGrass) {
+  // 8 x 8 cells of 10 m: a flat plain at 0 m with a wet strip (row 6) and a river (row 7,
+  // 0.5 m), a 45-degree ramp in columns 3-5 and a 100 m plateau in columns 6-7.
   Grid g = Grid::uniform(8, 8, 10.0);
   std::vector<float> bed(64, 0.f), wet(64, 0.f);
   for (int r = 0; r < 8; ++r)
@@ -136,6 +136,7 @@ TEST(VizTerrainClass, SnowRockMudGrass) {
       const std::size_t i = static_cast<std::size_t>(r) * 8 + c;
       bed[i] = c >= 6 ? 100.f : c >= 3 ? 10.f * (c - 2) : 0.f;
       if (r == 6) wet[i] = 0.05f;
+      if (r == 7) wet[i] = 0.5f;
     }
   const auto k = classify_terrain(g, bed, wet);
   const auto at = [&](int c, int r) {
@@ -146,6 +147,7 @@ TEST(VizTerrainClass, SnowRockMudGrass) {
   EXPECT_EQ(at(4, 2), static_cast<int>(TerrainClass::rock));
   EXPECT_EQ(at(0, 6), static_cast<int>(TerrainClass::mud));
   EXPECT_EQ(at(0, 2), static_cast<int>(TerrainClass::grass));
+  EXPECT_EQ(at(0, 7), static_cast<int>(TerrainClass::water));
   EXPECT_NEAR(cell_slope(g, bed, 4, 2), 1.0, 1e-12);
   // An absolute snow line: only the plateau's 100 m is above 50 m, the ramp's top (40 m) not.
   ClassRule absolute;

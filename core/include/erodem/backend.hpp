@@ -17,16 +17,17 @@ namespace erodem {
 /// The processes of one step (MODEL.md "One step"). Simulation::sequence() runs them in this
 /// order but for sources, which run after flow (model.md section 2).
 enum class Process {
-  boundary,      ///< ghost cells take the state the edge conditions give them
-  sources,       ///< rain and point/line inflows
-  flow,          ///< outflow fluxes (pipes or local_inertial)
-  water,         ///< depth and velocity update
-  erosion,       ///< erosion / deposition
-  transport,     ///< suspended sediment transport
-  thermal,       ///< slope collapse
-  evaporation,   ///< evaporation and the wetness running mean
-  snow,          ///< degree-day melt of the snow pack into the depth
-  infiltration,  ///< Green-Ampt infiltration of the depth into the soil store
+  boundary,       ///< ghost cells take the state the edge conditions give them
+  sources,        ///< rain and point/line inflows
+  flow,           ///< outflow fluxes (pipes or local_inertial)
+  water,          ///< depth and velocity update
+  erosion,        ///< erosion / deposition
+  transport,      ///< suspended sediment transport
+  thermal,        ///< slope collapse
+  evaporation,    ///< evaporation and the wetness running mean
+  snow,           ///< degree-day melt of the snow pack into the depth
+  infiltration,   ///< Green-Ampt infiltration of the depth into the soil store
+  terrain_class,  ///< the terrain classes and the parameter fields their tables give
 };
 const char* process_name(Process p);
 
@@ -47,6 +48,9 @@ struct StepInputs {
   /// boundary.sea_level.
   double boundary_level = std::numeric_limits<double>::quiet_NaN();
   std::vector<PointSource> points;  ///< inflows this step
+  /// Terrain classes: classify the cells this step (a step of terrain_classes.interval), or
+  /// only write the class tables from the classes held (the first step after a restart).
+  bool classify = true;
 };
 
 /// Reductions over the active cells, for the ledger and the stability check.

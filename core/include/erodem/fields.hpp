@@ -65,7 +65,12 @@ enum FieldFlag : unsigned {
     kStateField | kOutputField | kRestartZero)                                                     \
   X(infiltration_ksat, "m s-1", "saturated hydraulic conductivity", 0u)                            \
   X(infiltration_suction_deficit, "m", "wetting-front suction head times moisture deficit", 0u)    \
-  X(infiltration_store, "m", "largest depth the soil store holds", 0u)
+  X(infiltration_store, "m", "largest depth the soil store holds", 0u)                             \
+  /* terrain classes (terrain_class.h): the class codes 0 grass, 1 mud, 2 rock, 3 snow, */         \
+  /* 4 water; and the talus slope the class tables give slope collapse */                          \
+  X(terrain_class, "1", "terrain class (0 grass, 1 mud, 2 rock, 3 snow, 4 water)",                 \
+    kStateField | kOutputField | kRestartZero)                                                     \
+  X(talus_slope, "1", "tangent of the talus angle", 0u)
 
 enum class FieldId {
 #define ERODEM_FIELD_ID(id, units, long_name, flags) id,

@@ -233,6 +233,38 @@ struct Params {
     std::optional<double> recovery_rate;
   } infiltration;
 
+  /// The parameters one terrain class gives its cells (terrain_classes.<class>.*): each one
+  /// set replaces the uniform value on the class's cells; a raster of the parameter overrides
+  /// both (docs/model.md section 3.12).
+  struct ClassValues {
+    std::optional<double> manning_n;         ///< Manning n (s m^-1/3)
+    std::optional<double> talus_angle;       ///< talus angle (degrees)
+    std::optional<double> ksat;              ///< Green-Ampt K_sat (m/s)
+    std::optional<double> suction;           ///< Green-Ampt suction head psi (m)
+    std::optional<double> moisture_deficit;  ///< Green-Ampt moisture deficit delta theta (1)
+    std::optional<double> soil_depth;        ///< depth L of the soil store (m)
+    std::optional<double> erodibility;       ///< erodibility R (the hardness field, 1)
+    bool any() const {
+      return manning_n || talus_angle || ksat || suction || moisture_deficit || soil_depth ||
+             erodibility;
+    }
+  };
+
+  /// Terrain classes (terrain_class.h, docs/model.md section 3.12): every active cell is snow,
+  /// water, rock, mud or grass by a rule on its bed, slope, wetness and snow pack, recomputed
+  /// every `interval` steps, and each class may give its cells its own parameters.
+  struct TerrainClasses {
+    bool enabled = false;
+    int interval = 10;                ///< steps between classifications (the first step classifies)
+    double snow_depth = 0.01;         ///< a pack (snow water equivalent, m) above this makes snow
+    std::optional<double> snow_line;  ///< a bed above this (m) is snow; none = by the pack only
+    double water_wetness = 0.3;       ///< wetness (m) above which a cell is water
+    double rock_slope = 0.7;          ///< slope (m/m; 0.7 is 35 degrees) above which ... rock
+    std::optional<double> rock_elevation;  ///< ... where the bed is above this (m); none = any
+    double mud_wetness = 0.01;             ///< wetness (m) above which a cell is mud
+    ClassValues grass, mud, rock, snow, water;
+  } terrain_classes;
+
   struct Boundary {
     BoundaryKind north = BoundaryKind::closed;
     BoundaryKind south = BoundaryKind::closed;

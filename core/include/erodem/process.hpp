@@ -96,6 +96,18 @@ struct ProcessInfo {
                                                                   const Params&) = nullptr;
 };
 
+/// Which parameter fields the terrain classes' tables write (terrain_class.h): those of a
+/// parameter some class gives a value of, where no raster of it overrides the tables and the
+/// process that reads it runs (docs/model.md section 3.12).
+struct ClassTables {
+  bool manning = false;   ///< manning_n (flow)
+  bool hardness = false;  ///< hardness (erosion; not over a raster or "noise")
+  bool ksat = false;      ///< infiltration_ksat
+  bool soil = false;      ///< infiltration_suction_deficit and infiltration_store
+  bool talus = false;     ///< talus_slope (thermal then reads it)
+};
+ClassTables class_tables(const Params& params);
+
 /// Every process, in step order (the sources run after the flow: model.md section 2).
 const std::vector<ProcessInfo>& process_table();
 /// The entry of `p`.

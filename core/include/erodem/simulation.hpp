@@ -215,7 +215,10 @@ class Simulation {
   bool probes_current_ = false;
   SectionLayout sections_;
   std::vector<SectionState> section_state_;
-  bool sections_measured_ = false;  // a step has set the peaks
+  bool sections_measured_ = false;
+  /// Terrain classes: the parameter fields their tables write must be written again from the
+  /// classes held before the next step (after restore(), which sets terrain_class only).
+  bool class_fields_stale_ = false;  // a step has set the peaks
   /// Sums a step's face values into section_state_.
   void measure_sections(const StepResult& result, double dt);
 };

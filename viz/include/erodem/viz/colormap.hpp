@@ -13,7 +13,7 @@ enum class ColorMap {
   sediment,   ///< suspended sediment: pale grey to dark brown
   speed,      ///< flow speed: black-body (dark purple, red, yellow)
   diverging,  ///< erosion / deposition: blue (negative) - white (0) - red (positive)
-  classes,    ///< terrain classes: grass, mud, rock, snow (categorical)
+  classes,    ///< terrain classes: grass, mud, rock, snow, water (categorical)
 };
 
 /// A control point: position t in [0, 1] along the map, and an RGB colour in [0, 1].
