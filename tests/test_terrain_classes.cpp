@@ -118,6 +118,14 @@ TEST_P(TerrainClasses, RuleMatchesAnIndependentEvaluationAndTheTablesFillTheFiel
   const RuleTile tile;
   const Params p = rule_params();
   auto sim = make_simulation(tile.terrain, p, target());
+  // the initial state is classified when the simulation is built (the first snapshot shows
+  // its classes): dry, no pack, so grass, rock and the snow line's cells
+  const std::vector<double> none(tile.terrain.grid.cells(), 0.0);
+  const auto initial = codes(sim.field(FieldId::terrain_class));
+  const auto initial_want = expected_classes(tile.terrain, none, none, p);
+  std::size_t initial_wrong = 0;
+  for (std::size_t i = 0; i < initial.size(); ++i) initial_wrong += initial[i] != initial_want[i];
+  EXPECT_EQ(initial_wrong, 0u) << "the classes of the initial state";
   sim.backend().set_field(FieldId::wetness, tile.wetness);
   sim.backend().set_field(FieldId::snow, tile.snow);
   sim.step();
@@ -143,11 +151,12 @@ TEST_P(TerrainClasses, RuleMatchesAnIndependentEvaluationAndTheTablesFillTheFiel
   }
   const double bound = this->bound(1e-15, 1e-7);  // one rounding of the table's value
   std::printf(
-      "[terrain classes rule] %s: %zu of %zu cells off the rule (bound 0); cells by class "
+      "[terrain classes rule] %s: initially %zu, after the first step %zu of %zu cells off the "
+      "rule (bound 0); cells by class "
       "grass %d mud %d rock %d snow %d water %d; max relative |n - table| %.1e, |K_sat - table| "
       "%.1e (bound %.0e)\n",
-      target().label().c_str(), wrong, got.size(), count[0], count[1], count[2], count[3], count[4],
-      e_n, e_k, bound);
+      target().label().c_str(), initial_wrong, wrong, got.size(), count[0], count[1], count[2],
+      count[3], count[4], e_n, e_k, bound);
   EXPECT_EQ(wrong, 0u);
   for (int c = 0; c < 5; ++c) EXPECT_GT(count[static_cast<std::size_t>(c)], 0) << "class " << c;
   auto fig = [&](const char* q) {

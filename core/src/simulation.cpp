@@ -166,6 +166,13 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   for (const Process p : step_sequence(params_))
     if (const auto initial = process_info(p).initial)
       for (const auto& [id, values] : initial(terrain_, params_)) backend_->set_field(id, values);
+  // the terrain classes of the initial state, so that the first snapshot shows them (the
+  // first step classifies the same state again: the same classes)
+  if (params_.terrain_classes.enabled) {
+    backend_->begin_step(StepInputs{});
+    backend_->run(Process::terrain_class);
+    backend_->end_step();
+  }
   stats_ = backend_->stats();
   std::vector<double> coast_bed;
   for (const auto cell : coast_cells_)
