@@ -238,10 +238,13 @@ std::vector<SweepInfo> snow_sweeps(const Params& p) {
         {{"kind", N}, {"bed", N}, {"snow", U}, {"dx", R}, {"dy", R}, {"snow_slide_share", N}}, {}));
   }
   // snow_sweep_cell (snow.h): snowfall and rain on snow from the step's rain on the depth,
-  // the degree-day melt and the rain's heat, the liquid water beyond retention into the depth
-  s.push_back(generic_sweep("snow",
+  // the degree-day melt and the rain's heat, the liquid water beyond retention into the depth;
+  // at T_ref + lapse (bed - z_ref), or with snow.temperature_grids (snow_gridded_sweep_cell)
+  // at the air_temperature field the host interpolates from the bands
+  const bool gridded = !p.snow.temperature_grids.empty();
+  s.push_back(generic_sweep(gridded ? "snow_gridded" : "snow",
                             {{"kind", R},
-                             {"bed", R},
+                             {gridded ? "air_temperature" : "bed", R},
                              {"rain_factor", R},
                              {"snow", U},
                              {"snow_liquid", U},
@@ -452,6 +455,7 @@ const std::vector<std::string>& grid_inputs() {
                                                "hardness",
                                                "manning_n",
                                                "rain_factor",
+                                               "air_temperature",
                                                "infiltration_ksat",
                                                "infiltration_suction_deficit",
                                                "infiltration_store"};

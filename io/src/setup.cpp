@@ -35,6 +35,28 @@ std::vector<double> parameter_raster(const std::string& path, const Terrain& t, 
   return v;
 }
 
+/// The bands of a gridded forcing (`key`: rain.grids, snow.temperature_grids) read from
+/// `path` on the terrain's grid, each band's active cells checked to hold finite values in
+/// [lo, hi], and their times (s): `times` (its key `times_key`) when given, one per band, else
+/// `start` plus the file's time coordinate (relative to band 1), else none (start + k interval).
+void load_band_series(const std::string& path, const std::string& key,
+                      const std::vector<double>& times, const std::string& times_key, double start,
+                      double lo, double hi, const Terrain& t, const Params& p,
+                      std::vector<std::vector<double>>& bands, std::vector<double>& band_times) {
+  bands = read_raster_bands_on_grid(path, t.grid, p.dem.window, key);
+  for (std::size_t b = 0; b < bands.size(); ++b)
+    check_raster_values(bands[b], t, path, key, "band " + std::to_string(b + 1) + " value", lo, hi);
+  if (!times.empty()) {
+    if (times.size() != bands.size())
+      throw config_error(times_key, "lists " + std::to_string(times.size()) + " times, but " +
+                                        path + " has " + std::to_string(bands.size()) + " bands");
+    band_times = times;
+    return;
+  }
+  band_times = read_band_times(path, key);
+  for (double& time : band_times) time += start;
+}
+
 }  // namespace
 
 Terrain load_terrain(const Params& p) {
@@ -51,12 +73,15 @@ Terrain load_terrain(const Params& p) {
     const std::string path = parameter_raster_path(r, p);
     if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);
   }
-  if (!p.rain.grids.empty()) {
-    t.rain_grids = read_raster_bands_on_grid(p.rain.grids, t.grid, p.dem.window, "rain.grids");
-    for (std::size_t b = 0; b < t.rain_grids.size(); ++b)
-      check_raster_values(t.rain_grids[b], t, p.rain.grids, "rain.grids",
-                          "band " + std::to_string(b + 1) + " value", 0.0, HUGE_VAL);
-  }
+  if (!p.rain.grids.empty())
+    load_band_series(p.rain.grids, "rain.grids", p.rain.grid_times, "rain.grid_times",
+                     p.rain.grid_start, 0.0, HUGE_VAL, t, p, t.rain_grids, t.rain_grid_times);
+  // degrees C: [-100, 100] holds every air temperature measured, not kelvin
+  if (p.snow.enabled && !p.snow.temperature_grids.empty())
+    load_band_series(p.snow.temperature_grids, "snow.temperature_grids",
+                     p.snow.temperature_grid_times, "snow.temperature_grid_times",
+                     p.snow.temperature_grid_start, -100.0, 100.0, t, p, t.temperature_grids,
+                     t.temperature_grid_times);
   const int factor = resample_factor(p.dem, t.grid);
   if (factor > 1) t = coarsen(t, factor);
   apply_boundary_codes(t, p.boundary.raster);
