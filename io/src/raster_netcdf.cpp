@@ -84,7 +84,14 @@ std::vector<std::string> subdataset_variables(GDALDatasetH ds) {
 std::vector<std::string> netcdf_variables(const std::string& file) {
   Dataset ds(
       GDALOpenEx(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-  return ds ? subdataset_variables(ds.get()) : std::vector<std::string>{};
+  if (!ds) return {};
+  auto vars = subdataset_variables(ds.get());
+  // a file of one variable opens as that variable
+  if (vars.empty() && GDALGetRasterCount(ds.get()) > 0)
+    if (const char* name =
+            GDALGetMetadataItem(GDALGetRasterBand(ds.get(), 1), "NETCDF_VARNAME", nullptr))
+      vars.emplace_back(name);
+  return vars;
 }
 
 std::vector<double> read_band_times(const std::string& path, const std::string& what) {
