@@ -556,7 +556,7 @@ std::vector<std::string> opencl_cell_kernels() {
       if (std::find(out.begin(), out.end(), k) == out.end()) out.emplace_back(k);
   };
   // every process of the table (enabled or not), with each flow and transport scheme and
-  // erosion law, and a stage hydrograph
+  // erosion law, a stage hydrograph, and the snow pack without and with temperature grids
   Params p;
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
@@ -568,8 +568,11 @@ std::vector<std::string> opencl_cell_kernels() {
         p.flow.scheme = flow;
         p.transport.scheme = transport;
         p.erosion.law = law;
-        for (const auto& e : process_table())
-          for (const auto& sweep : e.sweeps(p)) add(sweep);
+        for (const char* grids : {"", "grids"}) {
+          p.snow.temperature_grids = grids;
+          for (const auto& e : process_table())
+            for (const auto& sweep : e.sweeps(p)) add(sweep);
+        }
       }
   add(stats_sweep());
   return out;
