@@ -168,12 +168,17 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     if (terrain_.temperature_grids.empty())
       throw Error(ExitCode::data, "snow.temperature_grids: " + sn.temperature_grids +
                                       ": the terrain holds none of its bands");
-    for (const auto& band : terrain_.temperature_grids)
+    std::vector<std::vector<double>> bands;  // 0 off the active cells (nodata there)
+    for (const auto& band : terrain_.temperature_grids) {
       if (band.size() != terrain_.bed.size())
         throw Error(ExitCode::data,
                     "snow.temperature_grids: a band's size differs from the grid's");
+      bands.emplace_back(band.size(), 0.0);
+      for (std::size_t i = 0; i < band.size(); ++i)
+        if (terrain_.active(i)) bands.back()[i] = band[i];
+    }
     temperature_grid_ =
-        BandSeries(terrain_.temperature_grids,
+        BandSeries(std::move(bands),
                    {sn.temperature_grid_start, sn.temperature_grid_interval,
                     terrain_.temperature_grid_times.empty() ? sn.temperature_grid_times
                                                             : terrain_.temperature_grid_times},
