@@ -269,5 +269,40 @@ TEST(GriddedForcingErrors, BadRasterAndNetcdfGridsAreNamed) {
   expect_error([&] { validate(both); }, ExitCode::config, {"snow.temperature_grids", "not both"});
 }
 
+TEST(GriddedForcingErrors, TemperatureGridUnitsAreReadFromTheBand) {
+  // A netCDF t2m in kelvin (ERA5's units: its `units` attribute "K") is converted to degrees C
+  // (-273.15; to float rounding of the file's 271.15 and 274.65, 1e-4 K: the float's spacing
+  // at 272 K is 3e-5 K); a variable in other units ("m") is refused with exit 65 naming them.
+  // Without the conversion the bands would be refused as outside [-100, 100] degrees C.
+  TempDir dir;
+  const Grid g = Grid::uniform(6, 4, 100.0);
+  write_dem(dir.file("dem.tif"), g, std::vector<double>(g.cells(), 0.0));
+  Params p = quiet_params(FlowScheme::local_inertial, 1.0);
+  p.dem.path = dir.file("dem.tif");
+  p.snow.enabled = true;
+  const std::vector<std::vector<float>> kelvin{std::vector<float>(g.cells(), 271.15f),
+                                               std::vector<float>(g.cells(), 274.65f)};
+  io::write_netcdf_bands(dir.file("t2m.nc"), g, "t2m", kelvin, "hours since 2000-01-01", {0, 6},
+                         "K");
+  p.snow.temperature_grids = dir.file("t2m.nc");
+  const Terrain t = io::load_terrain(p);
+  ASSERT_EQ(t.temperature_grids.size(), 2u);
+  double worst = 0;
+  for (std::size_t b = 0; b < 2; ++b)
+    for (double v : t.temperature_grids[b])
+      worst = std::max(worst, std::abs(v - (b == 0 ? -2.0 : 1.5)));
+  std::printf(
+      "[temperature units] kelvin to degrees C: max |T - exact| %.1e K (bound 1e-4); "
+      "band times %g, %g s\n",
+      worst, t.temperature_grid_times[0], t.temperature_grid_times[1]);
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_EQ(t.temperature_grid_times, (std::vector<double>{0.0, 6 * 3600.0}));
+  io::write_netcdf_bands(dir.file("metres.nc"), g, "t2m", kelvin, "hours since 2000-01-01", {0, 6},
+                         "m");
+  p.snow.temperature_grids = dir.file("metres.nc");
+  expect_error([&] { io::load_terrain(p); }, ExitCode::data,
+               {"snow.temperature_grids", "metres.nc", "units 'm'"});
+}
+
 }  // namespace
 }  // namespace erodem::test

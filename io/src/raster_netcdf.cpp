@@ -94,6 +94,14 @@ std::vector<std::string> netcdf_variables(const std::string& file) {
   return vars;
 }
 
+std::string read_band_units(const std::string& path, const std::string& what) {
+  ensure_gdal();
+  QuietGdal quiet;
+  Dataset ds = open_raster(path, what + ": ");
+  const char* units = GDALGetRasterUnitType(GDALGetRasterBand(ds.get(), 1));
+  return units != nullptr ? units : "";
+}
+
 std::vector<double> read_band_times(const std::string& path, const std::string& what) {
   ensure_gdal();
   QuietGdal quiet;
@@ -146,7 +154,7 @@ std::vector<double> read_band_times(const std::string& path, const std::string& 
 
 void write_netcdf_bands(const std::string& path, const Grid& grid, const std::string& variable,
                         const std::vector<std::vector<float>>& bands, const std::string& time_units,
-                        const std::vector<double>& times) {
+                        const std::vector<double>& times, const std::string& units) {
   ensure_gdal();
   QuietGdal quiet;
   const auto nx = static_cast<std::size_t>(grid.nx), ny = static_cast<std::size_t>(grid.ny);
@@ -187,11 +195,15 @@ void write_netcdf_bands(const std::string& path, const Grid& grid, const std::st
        coordinate(dx, xs,
                   {{"units", "m"}, {"axis", "X"}, {"standard_name", "projection_x_coordinate"}});
   auto v = ok ? root->CreateMDArray(variable, {dt, dy, dx}, f32) : nullptr;
+  if (v && !units.empty()) {
+    auto attr = v->CreateAttribute("units", {}, text);
+    ok = attr && attr->Write(units.c_str());
+  }
   std::vector<float> all;
   for (const auto& b : bands) all.insert(all.end(), b.begin(), b.end());
   const GUInt64 start[3] = {0, 0, 0};
   const std::size_t count[3] = {bands.size(), ny, nx};
-  ok = v && all.size() == bands.size() * nx * ny &&
+  ok = ok && v && all.size() == bands.size() * nx * ny &&
        v->Write(start, count, nullptr, nullptr, f32, all.data());
   if (!ok) throw Error(ExitCode::cant_create, path + ": cannot write" + gdal_reason());
 }

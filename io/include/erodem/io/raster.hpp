@@ -135,6 +135,10 @@ std::string netcdf_name(const NetcdfName& n);
 /// not of that form (months and years are not of fixed length), times not increasing.
 std::vector<double> read_band_times(const std::string& path, const std::string& what);
 
+/// The units of a raster's band 1 (GDAL's unit type: a netCDF variable's `units` attribute, a
+/// GeoTIFF band's unit); "" when it has none.
+std::string read_band_units(const std::string& path, const std::string& what);
+
 /// Writes `values` (grid.nx * grid.ny, row-major, row 0 north) as a float32 GeoTIFF with
 /// the grid's geotransform and CRS (WKT), DEFLATE-compressed (floating-point predictor,
 /// tiled, BigTIFF when needed). `description` becomes the band description and the
@@ -161,11 +165,11 @@ void write_geotiff_bands(const std::string& path, const Grid& grid,
 /// variable `variable`(time, y, x) of a new file `path`, with the cell centres of the grid's
 /// transform as the x and y coordinates (projection_x/y_coordinate, m) and a time coordinate
 /// "time" of `times` in `time_units` (CF, e.g. "hours since 2000-01-01"; `times` and `bands`
-/// of one size). For tests and examples of gridded forcing. Error(cant_create) when it cannot
-/// be written.
+/// of one size), the variable's `units` attribute `units` (none when empty). For tests and
+/// examples of gridded forcing. Error(cant_create) when it cannot be written.
 void write_netcdf_bands(const std::string& path, const Grid& grid, const std::string& variable,
                         const std::vector<std::vector<float>>& bands, const std::string& time_units,
-                        const std::vector<double>& times);
+                        const std::vector<double>& times, const std::string& units = "");
 
 /// SHA-256 of a file's bytes as 64 lower-case hex digits (GDAL /vsi paths work too).
 /// Throws Error(ExitCode::no_input) when the file cannot be opened, Error(ExitCode::io)
