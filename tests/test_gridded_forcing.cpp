@@ -273,7 +273,8 @@ TEST(GriddedForcingErrors, TemperatureGridUnitsAreReadFromTheBand) {
   // A netCDF t2m in kelvin (ERA5's units: its `units` attribute "K") is converted to degrees C
   // (-273.15; to float rounding of the file's 271.15 and 274.65, 1e-4 K: the float's spacing
   // at 272 K is 3e-5 K); a variable in other units ("m") is refused with exit 65 naming them.
-  // Without the conversion the bands would be refused as outside [-100, 100] degrees C.
+  // Without the conversion the bands would be refused as outside [-100, 100] degrees C. With
+  // dem.resample the bands are averaged onto the coarse grid and keep their times.
   TempDir dir;
   const Grid g = Grid::uniform(6, 4, 100.0);
   write_dem(dir.file("dem.tif"), g, std::vector<double>(g.cells(), 0.0));
@@ -297,6 +298,15 @@ TEST(GriddedForcingErrors, TemperatureGridUnitsAreReadFromTheBand) {
       worst, t.temperature_grid_times[0], t.temperature_grid_times[1]);
   EXPECT_LT(worst, 1e-4);
   EXPECT_EQ(t.temperature_grid_times, (std::vector<double>{0.0, 6 * 3600.0}));
+  // dem.resample: the bands averaged onto the coarse grid with the DEM, their times kept
+  Params coarse = p;
+  coarse.dem.resample_factor = 2;
+  const Terrain c = io::load_terrain(coarse);
+  ASSERT_EQ(c.grid.cells(), 6u);
+  ASSERT_EQ(c.temperature_grids.size(), 2u);
+  EXPECT_EQ(c.temperature_grids[1].size(), 6u);
+  EXPECT_NEAR(c.temperature_grids[1][5], t.temperature_grids[1][0], 1e-12);
+  EXPECT_EQ(c.temperature_grid_times, t.temperature_grid_times);
   io::write_netcdf_bands(dir.file("metres.nc"), g, "t2m", kelvin, "hours since 2000-01-01", {0, 6},
                          "m");
   p.snow.temperature_grids = dir.file("metres.nc");
