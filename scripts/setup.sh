@@ -10,6 +10,7 @@ DEBIAN_PACKAGES=(
   build-essential cmake ninja-build pkg-config git clang-format
   libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
   libgtest-dev googletest
+  # Debian's GDAL reads and writes netCDF (gridded forcing, test_gridded_forcing.cpp)
   libgdal-dev gdal-bin libgeographiclib-dev
   libhdf5-dev hdf5-tools
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
@@ -30,6 +31,8 @@ if ((${#missing[@]})); then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
+gdalinfo --formats | grep -q '^ *netCDF ' ||
+  echo "setup: warning: this GDAL has no netCDF driver; netCDF gridded forcing and its tests fail"
 
 # Python readers the tests open result files with (h5py, xarray with h5netcdf).
 if ! python3 -c 'import numpy, h5py, xarray, h5netcdf' 2>/dev/null; then

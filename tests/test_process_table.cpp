@@ -150,6 +150,16 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
   const SweepBytes f = process_bytes(Process::flow, p, 4);
   EXPECT_EQ(f.reads, "kind bed water_depth manning_n flux_left flux_right flux_top flux_bottom");
   EXPECT_EQ(f.writes, "flux_left flux_right flux_top flux_bottom");
+  // the snow pack: kind bed rain_factor snow liquid depth | snow liquid depth; with temperature
+  // grids the air_temperature field in place of the bed, the same bytes
+  p.snow.enabled = true;
+  EXPECT_EQ(bytes(Process::snow), 1 + 5 * 4 + 3 * 4);
+  EXPECT_EQ(process_bytes(Process::snow, p, 4).reads,
+            "kind bed rain_factor snow snow_liquid water_depth");
+  p.snow.temperature_grids = "t2m.nc";
+  EXPECT_EQ(bytes(Process::snow), 1 + 5 * 4 + 3 * 4);
+  EXPECT_EQ(process_bytes(Process::snow, p, 4).reads,
+            "kind air_temperature rain_factor snow snow_liquid water_depth");
 }
 
 TEST(ProcessTable, BedChangesWithErosionOrThermal) {
@@ -194,9 +204,9 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
 
 TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // the cell kernels whose work-group the OpenCL backend queried from its own list (before
-  // 2026-11-26), the snow pack's, the shallow-water second order's, infiltration's and the
-  // stage hydrograph's and the terrain classes' (added through the table), as a set; the
-  // program in step order (the terrain classes first)
+  // 2026-11-26), the snow pack's (with snow.temperature_grids: snow_gridded), the shallow-water
+  // second order's, infiltration's, the stage hydrograph's and the terrain classes' (added
+  // through the table), as a set; the program in step order (the terrain classes first)
   // (flow before sources since they run after it; before, the files were listed in the enum's
   // order)
   const auto k = opencl_cell_kernels();
@@ -218,6 +228,7 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "thermal_apply",
                                    "evaporation",
                                    "snow",
+                                   "snow_gridded",
                                    "snow_slide_share",
                                    "snow_slide",
                                    "infiltration",
@@ -229,7 +240,7 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 28u) << "a kernel listed twice";
+  EXPECT_EQ(k.size(), 29u) << "a kernel listed twice";
   EXPECT_EQ(opencl_program_order(),
             (std::vector<std::string>{"reduce.cl", "terrain_class.cl", "boundary.cl", "flow.cl",
                                       "sources.cl", "water.cl", "erosion.cl", "transport.cl",

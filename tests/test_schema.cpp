@@ -544,6 +544,8 @@ TEST(Dump, ModifiedRoundTrip) {
   p.output.gauges = {{1.0, 2.0}};
   p.numerics.precision = erodem::Precision::float64;
   p.numerics.threads = 4;
+  p.snow.temperature_grids = "NETCDF:\"t2m.nc\":t2m";
+  p.snow.temperature_grid_times = {0.0, 600.0, 7200.0 / 7.0};
   const std::string text = erodem::dump_toml(p);
   Params back;
   ASSERT_NO_THROW(back = erodem::params_from_toml(toml::parse(text), "dump")) << text;
@@ -553,6 +555,8 @@ TEST(Dump, ModifiedRoundTrip) {
   ASSERT_EQ(back.inflow.size(), 2u);
   EXPECT_EQ(back.inflow[1].vertices.size(), 1u);
   EXPECT_EQ(back.rain.series[1].value, p.rain.series[1].value);
+  EXPECT_EQ(back.snow.temperature_grids, p.snow.temperature_grids);
+  EXPECT_EQ(back.snow.temperature_grid_times, p.snow.temperature_grid_times);
   EXPECT_EQ(back.dem.window, p.dem.window);
   EXPECT_EQ(back.erosion.bedrock_level, p.erosion.bedrock_level);
   EXPECT_NO_THROW(erodem::validate(back));

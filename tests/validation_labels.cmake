@@ -4,7 +4,7 @@
 # (erodem_tests_TESTS).
 foreach(t IN LISTS erodem_tests_TESTS)
   if(t MATCHES
-     "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves|TerrainClasses|BoundarySediment|RasterParameters|RealDemLake|Snow|Infiltration|Stage|ShallowWater|Sediment|Sections)\\."
+     "^(Cpu|OpenCl)/(Analytical|Validation|Runoff|Waves|TerrainClasses|BoundarySediment|RasterParameters|RealDemLake|Snow|Infiltration|Stage|ShallowWater|Sediment|Sections|GriddedForcing)\\."
      OR t MATCHES
      "Physics\\.(SemiLagrangianLossIsMeasured|BedrockLevelIsNeverCut|LakeAtRestStaysAtRest|ClosedBoxConservesWaterAndMaterial)/"
      OR t MATCHES

@@ -270,10 +270,13 @@ std::vector<SweepInfo> snow_sweeps(const Params& p) {
         {{"kind", N}, {"bed", N}, {"snow", U}, {"dx", R}, {"dy", R}, {"snow_slide_share", N}}, {}));
   }
   // snow_sweep_cell (snow.h): snowfall and rain on snow from the step's rain on the depth,
-  // the degree-day melt and the rain's heat, the liquid water beyond retention into the depth
-  s.push_back(generic_sweep("snow",
+  // the degree-day melt and the rain's heat, the liquid water beyond retention into the depth;
+  // at T_ref + lapse (bed - z_ref), or with snow.temperature_grids (snow_gridded_sweep_cell)
+  // at the air_temperature field the host interpolates from the bands
+  const bool gridded = !p.snow.temperature_grids.empty();
+  s.push_back(generic_sweep(gridded ? "snow_gridded" : "snow",
                             {{"kind", R},
-                             {"bed", R},
+                             {gridded ? "air_temperature" : "bed", R},
                              {"rain_factor", R},
                              {"snow", U},
                              {"snow_liquid", U},
@@ -506,6 +509,7 @@ const std::vector<std::string>& grid_inputs() {
                                                "hardness",
                                                "manning_n",
                                                "rain_factor",
+                                               "air_temperature",
                                                "infiltration_ksat",
                                                "infiltration_suction_deficit",
                                                "infiltration_store"};
@@ -606,7 +610,7 @@ std::vector<std::string> opencl_cell_kernels() {
       if (std::find(out.begin(), out.end(), k) == out.end()) out.emplace_back(k);
   };
   // every process of the table (enabled or not), with each flow and transport scheme and
-  // erosion law, and a stage hydrograph
+  // erosion law, a stage hydrograph, and the snow pack without and with temperature grids
   Params p;
   p.rain.rate = 1.0;
   p.evaporation.rate = 1.0;
@@ -618,8 +622,11 @@ std::vector<std::string> opencl_cell_kernels() {
         p.flow.scheme = flow;
         p.transport.scheme = transport;
         p.erosion.law = law;
-        for (const auto& e : process_table())
-          for (const auto& sweep : e.sweeps(p)) add(sweep);
+        for (const char* grids : {"", "grids"}) {
+          p.snow.temperature_grids = grids;
+          for (const auto& e : process_table())
+            for (const auto& sweep : e.sweeps(p)) add(sweep);
+        }
       }
   add(stats_sweep());
   return out;

@@ -154,6 +154,15 @@ void check_cross_fields(const Params& p, const std::string& source) {
   }
   if (!p.rain.grids.empty() && (p.rain.rate != 0.0 || !p.rain.series.empty()))
     throw fail("rain.grids", "give rain.grids or rain.rate / rain.series, not both");
+  if (!p.rain.grid_times.empty() && p.rain.grids.empty())
+    throw fail("rain.grid_times", "the times of rain.grids' bands: give rain.grids too");
+  if (!p.snow.temperature_grids.empty() &&
+      (p.snow.air_temperature != 0.0 || !p.snow.air_temperature_series.empty()))
+    throw fail("snow.temperature_grids",
+               "give snow.temperature_grids or snow.air_temperature, not both");
+  if (!p.snow.temperature_grid_times.empty() && p.snow.temperature_grids.empty())
+    throw fail("snow.temperature_grid_times",
+               "the times of snow.temperature_grids' bands: give snow.temperature_grids too");
   if (p.rain.rate != 0.0 && !p.rain.series.empty()) {
     throw fail("rain.rate", "give rain.rate or rain.series, not both");
   }

@@ -237,6 +237,37 @@ Descriptor series(const char* key, Access access, Dimension dim, Range range, co
   return d;
 }
 
+/// A list of times [t1, t2, ...] (s, or quantities such as "10 min"), increasing; [] = none.
+template <class Access>
+Descriptor times(const char* key, Access access, const char* doc) {
+  Descriptor d = base(key, access, "times", Dimension::time, "[time, ...], increasing", doc);
+  auto check_times = [](const std::vector<double>& v, const Where& w) {
+    for (size_t i = 0; i < v.size(); ++i) {
+      check_double(v[i], Dimension::time, any_finite(), w.sub("[" + std::to_string(i) + "]"));
+      if (i > 0 && !(v[i] > v[i - 1]))
+        throw w.fail("times must increase: [" + std::to_string(i) + "] = " + format_number(v[i]) +
+                     " s is not after " + format_number(v[i - 1]) + " s");
+    }
+  };
+  d.assign = [=](Params& p, const toml::node& n, const Where& w) {
+    const toml::array& a = read_array(n, "an array of times [t1, t2, ...]", w);
+    std::vector<double> v;
+    for (size_t i = 0; i < a.size(); ++i)
+      v.push_back(read_double(*a.get(i), Dimension::time, any_finite(),
+                              w.sub("[" + std::to_string(i) + "]")));
+    check_times(v, w);
+    access(p) = std::move(v);
+  };
+  d.check = [=](const Params& p, const Where& w) { check_times(access(p), w); };
+  d.format = [=](const Params& p) {
+    std::string out = "[";
+    for (size_t i = 0; i < access(p).size(); ++i)
+      out += (i ? ", " : "") + format_number(access(p)[i]);
+    return out + "]";
+  };
+  return d;
+}
+
 /// A number (`value`), or a time series [[t, value], ...] with increasing times (`series`; an
 /// empty series means the number): one key for a value constant or varying in time.
 template <class Value, class SeriesAccess>

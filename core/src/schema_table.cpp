@@ -137,11 +137,18 @@ const std::vector<Descriptor>& descriptor_table() {
              "values outside"),
       text(ERODEM_FIELD(rain.raster), "raster path of a spatial rain multiplier (1); \"\" = none"),
       text(ERODEM_FIELD(rain.grids),
-           "multi-band raster path of gridded rain on the DEM grid (radar): band k is the rate "
-           "at rain.grid_start + k rain.grid_interval, linear in between, held at the ends; "
-           "\"\" = none"),
+           "multi-band raster path of gridded rain on the DEM grid (radar), or a netCDF "
+           "variable NETCDF:\"file.nc\":var (a file.nc of one variable needs no name): band k "
+           "is the rate at rain.grid_times[k], else at rain.grid_start + the netCDF time "
+           "coordinate's time since band 1, else at rain.grid_start + k rain.grid_interval; "
+           "linear in between, held at the ends; \"\" = none"),
       number(ERODEM_FIELD(rain.grid_start), D::time, any_finite(), "time of the first band (s)"),
-      number(ERODEM_FIELD(rain.grid_interval), D::time, above(0), "time between bands (s)"),
+      number(ERODEM_FIELD(rain.grid_interval), D::time, above(0),
+             "time between bands (s), where neither rain.grid_times nor a netCDF time "
+             "coordinate gives the bands' times"),
+      times(ERODEM_FIELD(rain.grid_times),
+            "the bands' times [t1, t2, ...] (s, increasing, one per band): irregular bands; "
+            "replaces rain.grid_start, rain.grid_interval and a netCDF time coordinate"),
       number(ERODEM_FIELD(rain.grid_scale), D::speed, above(0),
              "the rain rate one unit of the bands' values stands for (m/s; default '1 mm/h')"),
 
@@ -278,6 +285,19 @@ const std::vector<Descriptor>& descriptor_table() {
       optional_number(ERODEM_FIELD(snow.max_slope), D::angle, closed(0, 90),
                       "the initial pack lies only where the bed's slope (central differences) "
                       "is below this (degrees); not set = on any slope"),
+      text(ERODEM_FIELD(snow.temperature_grids),
+           "multi-band raster path or netCDF variable (as rain.grids) of the air temperature "
+           "at each cell (degrees C, in [-100, 100]; no lapse correction), replacing "
+           "snow.air_temperature, snow.lapse_rate and snow.reference_elevation; its band times "
+           "as rain.grids' (snow.temperature_grid_*); \"\" = none"),
+      number(ERODEM_FIELD(snow.temperature_grid_start), D::time, any_finite(),
+             "time of the first band of snow.temperature_grids (s)"),
+      number(ERODEM_FIELD(snow.temperature_grid_interval), D::time, above(0),
+             "time between bands of snow.temperature_grids (s), where neither "
+             "snow.temperature_grid_times nor a netCDF time coordinate gives them"),
+      times(ERODEM_FIELD(snow.temperature_grid_times),
+            "the times [t1, t2, ...] of snow.temperature_grids' bands (s, increasing, one per "
+            "band); replaces the start, interval and a netCDF time coordinate"),
 
       boolean(ERODEM_FIELD(infiltration.enabled),
               "Green-Ampt infiltration of the water depth into the soil"),

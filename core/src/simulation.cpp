@@ -138,6 +138,7 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     }
   if (!terrain_.rain_grids.empty()) {
     const double scale = params_.rain.grid_scale;
+    std::vector<std::vector<double>> rates;
     for (const auto& band : terrain_.rain_grids) {
       if (band.size() != terrain_.bed.size())
         throw Error(ExitCode::data, "rain.grids: a band's size differs from the grid's");
@@ -152,10 +153,37 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
           volume += rate[i] * g.area[r];
           top = std::max(top, rate[i]);
         }
-      rain_bands_.push_back(std::move(rate));
+      rates.push_back(std::move(rate));
       rain_band_volume_.push_back(volume);
       rain_band_max_.push_back(top);
     }
+    const auto& rain = params_.rain;
+    rain_grid_ =
+        BandSeries(std::move(rates),
+                   {rain.grid_start, rain.grid_interval,
+                    terrain_.rain_grid_times.empty() ? rain.grid_times : terrain_.rain_grid_times},
+                   "rain.grid_times");
+  }
+  if (params_.snow.enabled && !params_.snow.temperature_grids.empty()) {
+    const auto& sn = params_.snow;
+    if (terrain_.temperature_grids.empty())
+      throw Error(ExitCode::data, "snow.temperature_grids: " + sn.temperature_grids +
+                                      ": the terrain holds none of its bands");
+    std::vector<std::vector<double>> bands;  // 0 off the active cells (nodata there)
+    for (const auto& band : terrain_.temperature_grids) {
+      if (band.size() != terrain_.bed.size())
+        throw Error(ExitCode::data,
+                    "snow.temperature_grids: a band's size differs from the grid's");
+      bands.emplace_back(band.size(), 0.0);
+      for (std::size_t i = 0; i < band.size(); ++i)
+        if (terrain_.active(i)) bands.back()[i] = band[i];
+    }
+    temperature_grid_ =
+        BandSeries(std::move(bands),
+                   {sn.temperature_grid_start, sn.temperature_grid_interval,
+                    terrain_.temperature_grid_times.empty() ? sn.temperature_grid_times
+                                                            : terrain_.temperature_grid_times},
+                   "snow.temperature_grid_times");
   }
   resolve_inflows();
   sections_ = layout_sections(terrain_, params_);
@@ -277,27 +305,11 @@ void Simulation::set_probes(const std::vector<std::int64_t>& cells,
   probes_current_ = false;
 }
 
-std::pair<std::size_t, double> Simulation::rain_band_at(double t) const {
-  const std::size_t last = rain_bands_.size() - 1;
-  const double s = (t - params_.rain.grid_start) / params_.rain.grid_interval;
-  if (!(s > 0)) return {0, 0.0};
-  if (s >= static_cast<double>(last)) return {last, 0.0};
-  const auto k = static_cast<std::size_t>(s);
-  return {k, s - static_cast<double>(k)};
-}
-
 double Simulation::set_rain_grid(double t) {
-  const auto [k, w] = rain_band_at(t);
+  const auto [k, w] = rain_grid_.at(t);
   const double volume =
       w > 0 ? (1 - w) * rain_band_volume_[k] + w * rain_band_volume_[k + 1] : rain_band_volume_[k];
-  if (k == rain_band_now_ && w == rain_weight_now_) return volume;
-  std::vector<double> rate = rain_bands_[k];
-  if (w > 0)
-    for (std::size_t i = 0; i < rate.size(); ++i)
-      rate[i] = (1 - w) * rate[i] + w * rain_bands_[k + 1][i];
-  backend_->set_field(FieldId::rain_factor, rate);
-  rain_band_now_ = k;
-  rain_weight_now_ = w;
+  if (auto rate = rain_grid_.values_if_changed(t)) backend_->set_field(FieldId::rain_factor, *rate);
   return volume;
 }
 
@@ -305,9 +317,9 @@ double Simulation::source_rise_rate() const {
   // Inputs are taken at the step's midpoint t + dt / 2 (inputs_for), within [t, t + dt_max / 2].
   const double t0 = time_, t1 = time_ + 0.5 * params_.time.dt_max;
   const auto& rain = params_.rain;
-  if (!rain_bands_.empty()) {  // the largest rate of the bands the window touches
-    const std::size_t k0 = rain_band_at(t0).first;
-    const std::size_t k1 = std::min(rain_band_at(t1).first + 1, rain_bands_.size() - 1);
+  if (!rain_grid_.empty()) {  // the largest rate of the bands the window touches
+    const std::size_t k0 = rain_grid_.at(t0).first;
+    const std::size_t k1 = std::min(rain_grid_.at(t1).first + 1, rain_grid_.size() - 1);
     double top = 0.0;
     for (std::size_t k = k0; k <= k1; ++k) top = std::max(top, rain_band_max_[k]);
     return top + source_rise_rate_of_inflows(t0, t1);
@@ -425,7 +437,7 @@ StepInputs Simulation::inputs_for(double dt) const {
   in.rain_rate =
       params_.rain.series.empty() ? params_.rain.rate : series_value(params_.rain.series, t_mid);
   in.boundary_level = boundary_level(params_, t_mid);
-  if (!rain_bands_.empty()) in.rain_rate = 1.0;  // the rain_factor field holds the rate (m/s)
+  if (!rain_grid_.empty()) in.rain_rate = 1.0;  // the rain_factor field holds the rate (m/s)
   in.air_temperature = air_temperature_at(t_mid);
   for (const auto& ic : inflows_) {
     const double q = series_value(params_.inflow[ic.spec].hydrograph, t_mid);
@@ -488,7 +500,11 @@ void Simulation::step() {
   const bool class_pass = classify || class_fields_stale_;
   in.classify = classify;
   // gridded rain: the rate of the step's midpoint in the rain_factor field, and its volume
-  const double rain_volume_rate = rain_bands_.empty() ? 0.0 : set_rain_grid(time_ + 0.5 * dt);
+  const double rain_volume_rate = rain_grid_.empty() ? 0.0 : set_rain_grid(time_ + 0.5 * dt);
+  // gridded air temperature: the bands at the step's midpoint in the air_temperature field
+  if (!temperature_grid_.empty())
+    if (auto T = temperature_grid_.values_if_changed(time_ + 0.5 * dt))
+      backend_->set_field(FieldId::air_temperature, *T);
   backend_->begin_step(in);
   for (Process p : sequence())
     if (p != Process::terrain_class || class_pass) backend_->run(p);
@@ -505,7 +521,7 @@ void Simulation::step() {
 
   double added = 0.0, sediment_added = 0.0;
   for (const auto& p : in.points) added += p.volume, sediment_added += p.sediment;
-  ledger_.rain += rain_bands_.empty() ? in.rain_rate * dt * rain_area_ : rain_volume_rate * dt;
+  ledger_.rain += rain_grid_.empty() ? in.rain_rate * dt * rain_area_ : rain_volume_rate * dt;
   ledger_.inflow += added;
   ledger_.sediment_inflow += sediment_added;
   for (const auto& t : tally_table()) ledger_.*t.ledger += tally.*t.step;

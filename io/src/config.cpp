@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "erodem/error.hpp"
+#include "erodem/io/raster.hpp"
 #include "erodem/parameter_rasters.hpp"
 #include "erodem/schema.hpp"
 
@@ -45,7 +46,15 @@ void resolve_relative_paths(Params& p, const std::string& base_dir) {
   p.dem.path = resolve_against(p.dem.path, base);
   for (const auto& r : parameter_rasters())
     if (std::string* path = r.path(p)) *path = resolve_against(*path, base);
-  p.rain.grids = resolve_against(p.rain.grids, base);
+  // the gridded forcing, a raster or a netCDF variable NETCDF:"file.nc":var (its file)
+  for (std::string* path : {&p.rain.grids, &p.snow.temperature_grids}) {
+    if (auto nc = io::parse_netcdf_name(*path)) {
+      nc->file = resolve_against(nc->file, base);
+      *path = io::netcdf_name(*nc);
+    } else {
+      *path = resolve_against(*path, base);
+    }
+  }
 }
 
 Params load_config(const std::string& path) {

@@ -52,21 +52,41 @@ bool is_vsi(const std::string& path) {
   return path.rfind("/vsi", 0) == 0;
 }
 
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& v : items) out += (out.empty() ? "" : ", ") + v;
+  return out;
+}
+
 }  // namespace
 
 Dataset open_raster(const std::string& path, const std::string& prefix) {
   if (path.empty()) throw Error(ExitCode::config, prefix + "no file given");
-  if (!is_vsi(path)) {
+  // a netCDF variable, NETCDF:"file.nc":var: its file must exist, its variable be one of it
+  const auto nc = parse_netcdf_name(path);
+  const std::string file = nc ? nc->file : path;
+  if (!is_vsi(file)) {
     std::error_code ec;
-    if (!fs::exists(path, ec)) throw Error(ExitCode::no_input, prefix + path + ": no such file");
+    if (!fs::exists(file, ec)) throw Error(ExitCode::no_input, prefix + file + ": no such file");
   }
   CPLErrorReset();
   Dataset ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR,
                         nullptr, nullptr, nullptr));
+  if (!ds && nc) {
+    const auto vars = netcdf_variables(nc->file);
+    if (!vars.empty())
+      throw Error(ExitCode::data, prefix + path + ": " + nc->file + " has no variable '" +
+                                      nc->variable + "'; its variables: " + join(vars));
+  }
   if (!ds)
     throw Error(ExitCode::data, prefix + path + ": not a raster GDAL can read" + gdal_reason());
-  if (GDALGetRasterCount(ds.get()) < 1)
+  if (GDALGetRasterCount(ds.get()) < 1) {
+    const auto vars = subdataset_variables(ds.get());
+    if (!vars.empty())
+      throw Error(ExitCode::data, prefix + path + ": holds several variables (" + join(vars) +
+                                      "): name one as NETCDF:\"" + path + "\":" + vars.front());
     throw Error(ExitCode::data, prefix + path + ": has no raster band");
+  }
   return ds;
 }
 

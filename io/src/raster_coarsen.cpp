@@ -133,6 +133,9 @@ Terrain coarsen(const Terrain& fine, int factor) {
   for (const auto& r : parameter_rasters())
     t.*r.values = r.categorical ? mode(fine.*r.values) : average(fine.*r.values);
   for (const auto& band : fine.rain_grids) t.rain_grids.push_back(average(band));
+  for (const auto& band : fine.temperature_grids) t.temperature_grids.push_back(average(band));
+  t.rain_grid_times = fine.rain_grid_times;
+  t.temperature_grid_times = fine.temperature_grid_times;
   return t;
 }
 

@@ -67,6 +67,11 @@ std::string size_text(int nx, int ny);
 /// Opens a raster read-only; `prefix` starts every error message.
 Dataset open_raster(const std::string& path, const std::string& prefix);
 
+/// The variables of a netCDF file that GDAL lists as its subdatasets (none for a file of one
+/// variable, which GDAL opens as that variable): of an open dataset, or of a file.
+std::vector<std::string> subdataset_variables(GDALDatasetH ds);
+std::vector<std::string> netcdf_variables(const std::string& file);
+
 /// The pixel window to read: the whole raster, or `window` checked against it.
 std::array<int, 4> checked_window(GDALDatasetH ds, const std::optional<std::array<int, 4>>& window,
                                   const std::string& prefix, const std::string& path);

@@ -29,7 +29,7 @@ namespace {
 bool has_parameter_rasters(const Params& p) {
   for (const auto& r : parameter_rasters())
     if (!parameter_raster_path(r, p).empty()) return true;
-  return !p.rain.grids.empty();
+  return !p.rain.grids.empty() || !p.snow.temperature_grids.empty();
 }
 
 /// The snapshot of `reader` at `time` (the last one when no time is given). Times match to

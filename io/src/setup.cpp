@@ -35,6 +35,45 @@ std::vector<double> parameter_raster(const std::string& path, const Terrain& t, 
   return v;
 }
 
+/// The bands of a gridded forcing (`key`: rain.grids, snow.temperature_grids) read from
+/// `path` on the terrain's grid, plus `offset`, each band's active cells checked to hold finite
+/// values in [lo, hi], and their times (s): `times` (its key `times_key`) when given, one per
+/// band, else `start` plus the file's time coordinate (relative to band 1), else none (start +
+/// k interval).
+void load_band_series(const std::string& path, const std::string& key,
+                      const std::vector<double>& times, const std::string& times_key, double start,
+                      double offset, double lo, double hi, const Terrain& t, const Params& p,
+                      std::vector<std::vector<double>>& bands, std::vector<double>& band_times) {
+  bands = read_raster_bands_on_grid(path, t.grid, p.dem.window, key);
+  if (offset != 0.0)
+    for (auto& band : bands)
+      for (double& v : band) v += offset;
+  for (std::size_t b = 0; b < bands.size(); ++b)
+    check_raster_values(bands[b], t, path, key, "band " + std::to_string(b + 1) + " value", lo, hi);
+  if (!times.empty()) {
+    if (times.size() != bands.size())
+      throw config_error(times_key, "lists " + std::to_string(times.size()) + " times, but " +
+                                        path + " has " + std::to_string(bands.size()) + " bands");
+    band_times = times;
+    return;
+  }
+  band_times = read_band_times(path, key);
+  for (double& time : band_times) time += start;
+}
+
+/// What to add to the values of temperature grids for degrees C, from their band's units:
+/// 0 for none or degrees C, -273.15 for kelvin (ERA5's t2m); other units are an error.
+double celsius_offset(const std::string& path, const std::string& key) {
+  const std::string units = read_band_units(path, key);
+  for (const char* c :
+       {"", "degC", "C", "deg_C", "degrees_C", "degree_Celsius", "celsius", "Celsius", "°C"})
+    if (units == c) return 0.0;
+  for (const char* k : {"K", "kelvin", "Kelvin", "degK", "deg_K", "degrees_K"})
+    if (units == k) return -273.15;
+  throw Error(ExitCode::data,
+              key + ": " + path + ": its units '" + units + "' are neither degrees C nor kelvin");
+}
+
 }  // namespace
 
 Terrain load_terrain(const Params& p) {
@@ -51,11 +90,17 @@ Terrain load_terrain(const Params& p) {
     const std::string path = parameter_raster_path(r, p);
     if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);
   }
-  if (!p.rain.grids.empty()) {
-    t.rain_grids = read_raster_bands_on_grid(p.rain.grids, t.grid, p.dem.window, "rain.grids");
-    for (std::size_t b = 0; b < t.rain_grids.size(); ++b)
-      check_raster_values(t.rain_grids[b], t, p.rain.grids, "rain.grids",
-                          "band " + std::to_string(b + 1) + " value", 0.0, HUGE_VAL);
+  if (!p.rain.grids.empty())
+    load_band_series(p.rain.grids, "rain.grids", p.rain.grid_times, "rain.grid_times",
+                     p.rain.grid_start, 0.0, 0.0, HUGE_VAL, t, p, t.rain_grids, t.rain_grid_times);
+  // degrees C (from kelvin where the band's units say so): [-100, 100] holds every air
+  // temperature measured, and no temperature in kelvin
+  if (p.snow.enabled && !p.snow.temperature_grids.empty()) {
+    const std::string& path = p.snow.temperature_grids;
+    load_band_series(path, "snow.temperature_grids", p.snow.temperature_grid_times,
+                     "snow.temperature_grid_times", p.snow.temperature_grid_start,
+                     celsius_offset(path, "snow.temperature_grids"), -100.0, 100.0, t, p,
+                     t.temperature_grids, t.temperature_grid_times);
   }
   const int factor = resample_factor(p.dem, t.grid);
   if (factor > 1) t = coarsen(t, factor);

@@ -43,26 +43,22 @@ ERODEM_FN real snow_melt_cell(real snow, real T, real rain, real dt, ERODEM_P(Sn
   return potential < snow ? potential : snow;
 }
 
-/* The snow sweep for padded cell (x, y) of a row 1 <= y <= H - 2, the body of both backends'
- * loops (the generic sweep "snow": kernels/cpu/sweeps.cpp, kernels/opencl/snow.cl). On an
- * active cell (1 <= x <= W - 2, kind active) at T = snow_air_temperature(bed):
+/* The snow pack of padded cell i (`active`: inside the grid and of kind active) at air
+ * temperature T (degrees C), the body of the snow sweeps (snow_sweep_cell,
+ * snow_gridded_sweep_cell):
  *   P = min(rain_rate rain_factor dt, d): the step's rain, which the sources put on the depth;
  *   below snowfall_temperature it falls as snow: the pack takes P back from the depth
  *   (*snowfall); above, on a pack (snow > 0) it is rain on snow: the pack's liquid water takes
  *   it back (*rain_on_snow) and it melts rain c_w max(0, T) / L_f more;
  *   the melt M (snow_melt_cell) turns pack into liquid water (*melted);
  *   the liquid water above retention times the pack that is left reaches the depth (*runoff).
- * Others keep everything. Volumes in m^3 (0 for others). Branch-free. */
-ERODEM_FN void snow_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                               GLOBAL const real* bed, GLOBAL const real* rain_factor,
-                               GLOBAL real* snow, GLOBAL real* liquid, GLOBAL real* depth,
-                               GLOBAL const real* area, real dt, ERODEM_P(SnowParams) p,
-                               real* snowfall, real* rain_on_snow, real* melted, real* runoff) {
-  const int i = x + y * W;
-  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+ * Others keep everything. Volumes in m^3 (0 for others); `a` is the cell's area. Branch-free. */
+ERODEM_FN void snow_pack_cell(int i, int active, real T, GLOBAL const real* rain_factor,
+                              GLOBAL real* snow, GLOBAL real* liquid, GLOBAL real* depth, real a,
+                              real dt, ERODEM_P(SnowParams) p, real* snowfall, real* rain_on_snow,
+                              real* melted, real* runoff) {
   /* unconditional loads: if-convertible */
   const real s = snow[i], l = liquid[i], d = depth[i], f = rain_factor[i];
-  const real T = snow_air_temperature(bed[i], p);
   const real rained = dt * p.rain_rate * f; /* as rain_cell (sources.h) computed it */
   const real P = active ? (rained < d ? rained : d) : (real)0;
   const int snows = T < p.snowfall_temperature;
@@ -77,11 +73,41 @@ ERODEM_FN void snow_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* 
   snow[i] = s_new;
   liquid[i] = held - out;
   depth[i] = d - fall - on_pack + out;
-  const real a = area[y];
   *snowfall = fall * a;
   *rain_on_snow = on_pack * a;
   *melted = m * a;
   *runoff = out * a;
+}
+
+/* The snow sweep for padded cell (x, y) of a row 1 <= y <= H - 2, the body of both backends'
+ * loops (the generic sweep "snow": kernels/cpu/sweeps.cpp, kernels/opencl/snow.cl): the pack
+ * (snow_pack_cell) of an active cell (1 <= x <= W - 2, kind active) at
+ * T = snow_air_temperature(bed). */
+ERODEM_FN void snow_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                               GLOBAL const real* bed, GLOBAL const real* rain_factor,
+                               GLOBAL real* snow, GLOBAL real* liquid, GLOBAL real* depth,
+                               GLOBAL const real* area, real dt, ERODEM_P(SnowParams) p,
+                               real* snowfall, real* rain_on_snow, real* melted, real* runoff) {
+  const int i = x + y * W;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  snow_pack_cell(i, active, snow_air_temperature(bed[i], p), rain_factor, snow, liquid, depth,
+                 area[y], dt, p, snowfall, rain_on_snow, melted, runoff);
+}
+
+/* The snow sweep with snow.temperature_grids (the generic sweep "snow_gridded"): as
+ * snow_sweep_cell at the cell's own air temperature T = air_temperature[i] (degrees C; the
+ * bands interpolated to the step's midpoint by the host), with no lapse correction. */
+ERODEM_FN void snow_gridded_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                       GLOBAL const real* air_temperature,
+                                       GLOBAL const real* rain_factor, GLOBAL real* snow,
+                                       GLOBAL real* liquid, GLOBAL real* depth,
+                                       GLOBAL const real* area, real dt, ERODEM_P(SnowParams) p,
+                                       real* snowfall, real* rain_on_snow, real* melted,
+                                       real* runoff) {
+  const int i = x + y * W;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  snow_pack_cell(i, active, air_temperature[i], rain_factor, snow, liquid, depth, area[y], dt, p,
+                 snowfall, rain_on_snow, melted, runoff);
 }
 
 /* Sliding, pass 1 (the generic sweep "snow_slide_share"), padded cell (x, y) of a row

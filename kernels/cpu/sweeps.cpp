@@ -139,6 +139,7 @@ void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real
   static const std::pair<const char*, Run> sweeps[] = {
       {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
       {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
+      {"snow_gridded", &CpuBackend::cell_sweep<&cell::snow_gridded_sweep_cell<Real>>},
       {"snow_slide_share", &CpuBackend::cell_sweep<&cell::snow_slide_share_sweep_cell<Real>>},
       {"snow_slide", &CpuBackend::cell_sweep<&cell::snow_slide_sweep_cell<Real>>},
       {"infiltration", &CpuBackend::cell_sweep<&cell::infiltration_sweep_cell<Real>>},

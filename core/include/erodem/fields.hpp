@@ -50,6 +50,8 @@ enum FieldFlag : unsigned {
     kStateField | kOutputField | kRestartZero)                                                     \
   /* the snow pack's sliding: what a cell gives per metre of its neighbours' excess drop */        \
   X(snow_slide_share, "1", "snow sliding: pack given per metre of excess drop", 0u)                \
+  /* snow.temperature_grids: the air temperature of the step's midpoint at each cell */            \
+  X(air_temperature, "degC", "air temperature (snow.temperature_grids)", 0u)                       \
   /* the shallow-water scheme's state (shallow_water.h); 0 with the other schemes */               \
   X(momentum_x, "m2 s-1", "depth-integrated eastward discharge per unit width",                    \
     kStateField | kOutputField | kRestartZero | kTwinField)                                        \

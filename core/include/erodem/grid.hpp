@@ -62,6 +62,12 @@ struct Terrain {
   std::vector<double> boundary_code;     ///< boundary.raster's codes (boundary_codes.hpp)
   /// rain.grids' bands, each a rate in the bands' units (times rain.grid_scale: m/s)
   std::vector<std::vector<double>> rain_grids;
+  /// rain.grids' band times (s) from rain.grid_times or the file's time coordinate; empty =
+  /// rain.grid_start + k rain.grid_interval
+  std::vector<double> rain_grid_times;
+  /// snow.temperature_grids' bands (degrees C) and their times (s), as rain.grids'
+  std::vector<std::vector<double>> temperature_grids;
+  std::vector<double> temperature_grid_times;
   std::vector<double> snow_initial;  ///< the initial snow water equivalent S_0 (m)
   std::string source;                ///< DEM path or generator description
   std::string source_sha256;         ///< checksum of the DEM file, when read from one

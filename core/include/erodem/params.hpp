@@ -128,11 +128,13 @@ struct Params {
     Series series;      ///< time (s), rate (m/s), linear in between, held at the end values outside
     std::string raster;  ///< optional spatial multiplier raster (1)
     /// Gridded rain that varies in time (radar, reanalysis): a multi-band raster on the DEM
-    /// grid, band k the rate at grid_start + k grid_interval, linear in between, held at the
-    /// ends; "" = none (rate or series instead).
+    /// grid (or a netCDF variable, NETCDF:"file.nc":var), band k the rate at grid_times[k], or
+    /// the netCDF time coordinate's grid_start + (time k - time 1), or grid_start + k
+    /// grid_interval, linear in between, held at the ends; "" = none (rate or series instead).
     std::string grids;
     double grid_start = 0.0;              ///< time of band 1 (s)
     double grid_interval = 3600.0;        ///< time between bands (s)
+    std::vector<double> grid_times;       ///< the bands' times (s), increasing; empty = above
     double grid_scale = 1.0e-3 / 3600.0;  ///< the rate one unit of the bands stands for (m/s)
   } rain;
 
@@ -218,6 +220,13 @@ struct Params {
     std::optional<double> slide_angle;
     /// the fraction of a sliding cell's pack that moves per second (1/s): 1/h
     double slide_rate = 1.0 / 3600.0;
+    /// The air temperature at each cell in time (degrees C, no lapse correction): a multi-band
+    /// raster on the DEM grid or a netCDF variable, its band times as rain.grids'; "" = none
+    /// (air_temperature and the lapse rate instead).
+    std::string temperature_grids;
+    double temperature_grid_start = 0.0;         ///< time of band 1 (s)
+    double temperature_grid_interval = 3600.0;   ///< time between bands (s)
+    std::vector<double> temperature_grid_times;  ///< the bands' times (s); empty = above
   } snow;
 
   /// Green-Ampt infiltration (infiltration.h, docs/model.md section 3.11). The soil's K_sat,

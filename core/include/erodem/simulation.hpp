@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "erodem/backend.hpp"
+#include "erodem/band_series.hpp"
 #include "erodem/grid.hpp"
 #include "erodem/ledger.hpp"
 #include "erodem/params.hpp"
@@ -183,19 +184,15 @@ class Simulation {
   std::vector<SourceCell> source_cells_;
   double rain_area_ = 0.0;        ///< sum(rain_factor * area) over active cells (m^2)
   double rain_factor_max_ = 0.0;  ///< largest rain_factor over active cells (1)
-  /// rain.grids: each band's rate (m/s) times the rain factor on the DEM cells, its volume rate
-  /// sum(rate area) over the active cells (m^3/s) and its largest rate (m/s); the band and
-  /// weight the backend's rain_factor field holds now.
-  std::vector<std::vector<double>> rain_bands_;
+  /// rain.grids: each band's rate (m/s) times the rain factor on the DEM cells in time, its
+  /// volume rate sum(rate area) over the active cells (m^3/s) and its largest rate (m/s).
+  BandSeries rain_grid_;
   std::vector<double> rain_band_volume_, rain_band_max_;
-  std::size_t rain_band_now_ = static_cast<std::size_t>(-1);
-  double rain_weight_now_ = -1.0;
-  /// The band k and weight w of rain.grids at time t (s): the rate is (1 - w) band k + w band
-  /// k + 1, held at the ends.
-  std::pair<std::size_t, double> rain_band_at(double t) const;
   /// Gives the backend the gridded rain of time t (s) when it changed; returns its volume rate
   /// (m^3/s).
   double set_rain_grid(double t);
+  /// snow.temperature_grids: the air temperature at each cell (degrees C) in time.
+  BandSeries temperature_grid_;
   /// Active DEM cells beside a fixed-level cell (an edge ghost or a sea nodata cell).
   std::vector<std::int64_t> coast_cells_;
   double time_ = 0.0;

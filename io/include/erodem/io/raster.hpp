@@ -119,6 +119,26 @@ std::vector<std::vector<double>> read_raster_bands_on_grid(
     const std::string& path, const Grid& grid, const std::optional<std::array<int, 4>>& window,
     const std::string& what, bool all_bands = true);
 
+/// A netCDF variable named in GDAL's syntax: NETCDF:"file.nc":var (or NETCDF:file.nc:var).
+struct NetcdfName {
+  std::string file, variable;
+};
+/// The file and variable of a path in GDAL's netCDF syntax; nullopt for any other path.
+std::optional<NetcdfName> parse_netcdf_name(const std::string& path);
+/// NETCDF:"file":variable.
+std::string netcdf_name(const NetcdfName& n);
+
+/// The times of a raster's bands (s) from a netCDF time coordinate: the time of band k less
+/// that of band 1, from its CF units "<seconds|minutes|hours|days> since <date>"; empty for a
+/// file without one (a GeoTIFF, a netCDF variable of one time or no time dimension). Errors
+/// (ExitCode::data, starting with `what` and the path): a second dimension besides time, units
+/// not of that form (months and years are not of fixed length), times not increasing.
+std::vector<double> read_band_times(const std::string& path, const std::string& what);
+
+/// The units of a raster's band 1 (GDAL's unit type: a netCDF variable's `units` attribute, a
+/// GeoTIFF band's unit); "" when it has none.
+std::string read_band_units(const std::string& path, const std::string& what);
+
 /// Writes `values` (grid.nx * grid.ny, row-major, row 0 north) as a float32 GeoTIFF with
 /// the grid's geotransform and CRS (WKT), DEFLATE-compressed (floating-point predictor,
 /// tiled, BigTIFF when needed). `description` becomes the band description and the
@@ -140,6 +160,16 @@ void write_geotiff_bands(const std::string& path, const Grid& grid,
                          const std::vector<std::vector<float>>& bands,
                          const std::string& description,
                          double nodata = std::numeric_limits<double>::quiet_NaN());
+
+/// Writes `bands` (grid.nx * grid.ny values each, row-major, row 0 north) as the netCDF
+/// variable `variable`(time, y, x) of a new file `path`, with the cell centres of the grid's
+/// transform as the x and y coordinates (projection_x/y_coordinate, m) and a time coordinate
+/// "time" of `times` in `time_units` (CF, e.g. "hours since 2000-01-01"; `times` and `bands`
+/// of one size), the variable's `units` attribute `units` (none when empty). For tests and
+/// examples of gridded forcing. Error(cant_create) when it cannot be written.
+void write_netcdf_bands(const std::string& path, const Grid& grid, const std::string& variable,
+                        const std::vector<std::vector<float>>& bands, const std::string& time_units,
+                        const std::vector<double>& times, const std::string& units = "");
 
 /// SHA-256 of a file's bytes as 64 lower-case hex digits (GDAL /vsi paths work too).
 /// Throws Error(ExitCode::no_input) when the file cannot be opened, Error(ExitCode::io)
