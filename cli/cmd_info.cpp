@@ -1,7 +1,7 @@
-// `erodem info DEM`: what a DEM holds and how erodem reads it — size, cell size in metres,
-// CRS (geographic or projected, with its ellipsoid), extent, elevations, nodata, area,
-// checksum. A file without georeferencing is described as far as it goes, with the config
-// keys it needs; that is not an error (exit 0).
+// `erodem info DEM` (a result file: info_result.cpp): what a DEM holds and how erodem reads it —
+// size, cell size in metres, CRS (geographic or projected, with its ellipsoid), extent, elevations,
+// nodata, area, checksum. A file without georeferencing is described as far as it goes, with the
+// config keys it needs; that is not an error (exit 0).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -267,6 +267,7 @@ void print_json(const InfoOptions& o, const DemInfo& d) {
 }
 
 int info(const InfoOptions& o) {
+  if (is_hdf5_file(o.path)) return info_result(o.path, o.json);
   const DemInfo d = gather(o);
   if (o.json)
     print_json(o, d);
@@ -279,8 +280,12 @@ int info(const InfoOptions& o) {
 
 Action add_info(CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
-  auto* sub = app.add_subcommand("info", "Describe a DEM: size, cell size, CRS, elevations");
-  sub->add_option("dem", o->path, "DEM file (any raster GDAL reads)")->required();
+  auto* sub = app.add_subcommand(
+      "info",
+      "Describe a DEM (size, cell size, CRS, elevations) or a result file (fields, times, "
+      "restart state, the run's books)");
+  sub->add_option("file", o->path, "DEM file (any raster GDAL reads) or result file (.h5)")
+      ->required();
   sub->add_flag("--json", o->json, "Print JSON instead of text");
   sub->add_option("--cell-size", o->cell_size,
                   "Cell size for a file without georeferencing (m, or \"160 m\")");

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -30,6 +31,7 @@ struct RunOptions {
   std::vector<std::string> sets;
   std::string backend = "auto";
   std::string output;
+  bool output_given = false;  ///< --output on the command line (an empty one is refused)
   bool dump_config = false;
   bool overwrite = false;
   std::string restart;  ///< FILE.h5[:TIME]
@@ -108,7 +110,13 @@ class Progress {
 int run(const RunOptions& o) {
   Params p = load_config(o.config);
   for (const auto& s : o.sets) apply_setting(p, s);
-  if (!o.output.empty()) p.output.path = o.output;
+  if (o.output_given) {
+    if (o.output.empty())
+      throw Error(ExitCode::usage,
+                  "--output: an empty path; give a file name, or leave --output out to write "
+                  "to output.path");
+    p.output.path = o.output;
+  }
   validate(p, o.config);
   if (o.dump_config) {
     std::fputs(dump_toml(p).c_str(), stdout);
@@ -132,6 +140,7 @@ int run(const RunOptions& o) {
     spdlog::info("erodem {}: {} ({} x {} cells, dx {:.4g} m), backend {} [{}]", ERODEM_VERSION,
                  sim.terrain().source, g.nx, g.ny, g.dx_min(), sim.backend().name(),
                  sim.backend().device());
+    spdlog::info("backend chosen by {}", sim.backend().choice_reason());
     spdlog::info("flow {}, erosion {}, transport {}, thermal {}, {}", scheme_name(p.flow.scheme),
                  p.erosion.enabled ? "on" : "off", scheme_name(p.transport.scheme),
                  p.thermal.enabled ? "on" : "off",
@@ -195,11 +204,22 @@ int run(const RunOptions& o) {
         sim.section_layout().names[k].c_str(), st.peak_discharge, st.peak_time, st.volume,
         st.sediment_volume);
   }
-  std::printf("ran %ld steps to t = %.6g s in %.3f s wall (%.3g cell-steps/s)\n", sim.steps_done(),
-              sim.time(), wall, cells * sim.steps_done() / wall);
-  std::printf("wrote %s (%zu snapshots of %zu fields, diagnostics of %ld steps) and %s\n",
-              writer.path().c_str(), writer.snapshots(), p.output.fields.size(),
-              sim.steps_done() - session.first_step(), io::xdmf_path(writer.path()).c_str());
+  // the steps this process ran (a restart's restored steps are not this run's work)
+  const long ran = sim.steps_done() - session.first_step();
+  std::printf("ran %ld steps to t = %.6g s in %.3f s wall (%.3g cell-steps/s)\n", ran, sim.time(),
+              wall, cells * static_cast<double>(ran) / wall);
+  // the file's size, and per snapshot (the restart state is most of it: output.restart_state)
+  std::error_code size_error;
+  const double megabytes =
+      static_cast<double>(std::filesystem::file_size(writer.path(), size_error)) / 1e6;
+  std::printf(
+      "wrote %s (%zu snapshots of %zu fields, diagnostics of %ld steps; %.4g MB, %.3g MB "
+      "per snapshot%s) and %s\n",
+      writer.path().c_str(), writer.snapshots(), p.output.fields.size(), ran,
+      size_error ? 0.0 : megabytes,
+      size_error || writer.snapshots() == 0 ? 0.0 : megabytes / writer.snapshots(),
+      p.output.restart_state ? " with the restart state" : "",
+      io::xdmf_path(writer.path()).c_str());
   // The closures last, relative to what moved (ledger.hpp), for scripts that read the tail.
   const Ledger& L = sim.ledger();
   std::printf(
@@ -219,7 +239,8 @@ Action add_run(CLI::App& app) {
   sub->add_option("--set", o->sets, "Override a config key: key=value (repeatable)");
   sub->add_option("--backend", o->backend, "Compute backend")
       ->check(CLI::IsMember({"auto", "cpu", "opencl"}));
-  sub->add_option("--output", o->output, "Output path (overrides output.path)");
+  sub->add_option("--output", o->output, "Output path (overrides output.path)")
+      ->each([o](const std::string&) { o->output_given = true; });
   sub->add_flag("--dump-config", o->dump_config, "Print the fully resolved config and exit");
   sub->add_flag("--overwrite", o->overwrite, "Replace existing output files");
   sub->add_option("--restart", o->restart,

@@ -21,6 +21,11 @@ Action add_info(CLI::App& app);
 Action add_export(CLI::App& app);
 Action add_view(CLI::App& app);
 
+/// Whether `path` starts with the HDF5 signature (a result file, not a DEM).
+bool is_hdf5_file(const std::string& path);
+/// `erodem info` of a result file (info_result.cpp): text, or JSON with `json`.
+int info_result(const std::string& path, bool json);
+
 /// Whether stderr is a terminal (progress bar) or a log (periodic lines).
 bool stderr_is_terminal();
 

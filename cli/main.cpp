@@ -9,9 +9,11 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <string>
 
 #include "commands.hpp"
 #include "erodem/error.hpp"
+#include "erodem/io/results.hpp"
 
 namespace erodem::cli {
 
@@ -23,6 +25,7 @@ bool stderr_is_terminal() {
 
 int main(int argc, char** argv) {
   using namespace erodem;
+  io::skip_hdf5_exit_cleanup();  // one error line, not HDF5's page (corrupt result files)
   CLI::App app{"erodem — hydrology and hydraulic erosion on real terrain"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("erodem ") + ERODEM_VERSION);
@@ -45,8 +48,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::usage);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // one line, as every other error: what the parser refused and where the help is
+    std::string help = "erodem --help";
+    for (const CLI::App* sub : app.get_subcommands())
+      help = "erodem " + sub->get_name() + " --help";
+    std::fprintf(stderr, "erodem: %s (see '%s')\n", e.what(), help.c_str());
+    return static_cast<int>(ExitCode::usage);
   }
   try {
     for (auto& [sub, action] : actions)

@@ -155,6 +155,11 @@ TEST_F(Cli, BadConfigValuesExit78WithoutOutput) {
       {"negative capacity", kConfig, "--set erosion.sediment_capacity=-1",
        "erosion.sediment_capacity"},
       {"bad unit", kConfig, "--set 'rain.rate=20 kg'", "rain.rate"},
+      // finite but absurd: no rain reaches 1 m/s (it made the depth infinite at step 1)
+      {"absurd rain", kConfig, "--set rain.rate=1e300", "rain.rate"},
+      // a wrong unit on a key that also takes a raster path is a unit error, not a file
+      {"unit on a raster key", kConfig, "--set 'flow.manning_n=0.03 s m-1/3'", "flow.manning_n"},
+      {"decimal comma on a raster key", kConfig, "--set 'flow.manning_n=0,03'", "flow.manning_n"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
@@ -166,6 +171,96 @@ TEST_F(Cli, BadConfigValuesExit78WithoutOutput) {
     EXPECT_EQ(files_matching("out"), 0u);
     EXPECT_EQ(files_matching(".out"), 0u);
   }
+}
+
+/// The lines of `text` (the last one without a newline counts too).
+std::size_t lines(const std::string& text) {
+  std::size_t n = 0;
+  for (char ch : text) n += ch == '\n';
+  return n + (!text.empty() && text.back() != '\n');
+}
+
+TEST_F(Cli, UsageAndInputErrorsAreOneLineWithTheirCodes) {
+  // Each of these was seen to print two lines without the "erodem:" prefix, HDF5's error
+  // page, the wrong code, or nothing at all (issue 19).
+  ASSERT_EQ(run_cli("generate --kind hill --size 16 hill.tif", dir_).code, 0);
+  write("c.toml", kConfig);
+  struct Case {
+    const char* what;
+    std::string args;
+    int code;
+    const char* must_name;
+  };
+  // a result file whose metadata is corrupt (bytes 2000-4000 flipped)
+  ASSERT_EQ(run_cli("run c.toml --set time.steps=4 --output good.h5", dir_).code, 0);
+  {
+    std::ifstream in(dir_ / "good.h5", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (std::size_t k = 2000; k < 4000 && k < bytes.size(); ++k) bytes[k] ^= 0x5A;
+    std::ofstream(dir_ / "bad.h5", std::ios::binary) << bytes;
+  }
+  // an ASCII grid with a cell of -1e39 (a float stores -inf or -3.4e38)
+  write("broken.asc",
+        "ncols 4\nnrows 4\nxllcorner 0\nyllcorner 0\ncellsize 10\n"
+        "1 2 3 4\n5 -1e39 7 8\n9 10 11 12\n13 14 15 16\n");
+  std::string broken = kConfig;
+  broken.replace(broken.find("hill.tif"), 8, "broken.asc");
+  write("broken.toml", broken);
+  fs::create_directories(dir_ / "folder.toml");
+  const Case cases[] = {
+      {"bad backend", "run c.toml --backend nope", 2, "--backend"},
+      {"unknown option", "run c.toml --frobnicate", 2, "--frobnicate"},
+      {"empty --output", "run c.toml --output ''", 2, "--output"},
+      {"config is a folder", "run folder.toml", 74, "folder.toml"},
+      {"corrupt result file", "compare bad.h5 good.h5", 65, "bad.h5"},
+      {"corrupt restart file", "run c.toml --restart bad.h5 --output x.h5", 65, "bad.h5"},
+      {"broken elevation", "run broken.toml --set dem.crs=EPSG:32610", 65, "cell (col 1, row 1)"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const auto r = run_cli(c.args, dir_);
+    std::printf("[one line] %s -> exit %d, %zu line(s): %s", c.what, r.code, lines(r.output),
+                r.output.c_str());
+    EXPECT_EQ(r.code, c.code);
+    EXPECT_EQ(lines(r.output), 1u);
+    EXPECT_EQ(r.output.rfind("erodem: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.must_name), std::string::npos) << r.output;
+    EXPECT_EQ(files_matching("out"), 0u);
+    EXPECT_EQ(files_matching("x.h5"), 0u);
+  }
+}
+
+TEST_F(Cli, RestartedRunCountsOnlyItsOwnSteps) {
+  // 200 steps with snapshots every 50; a restart from the snapshot at step 100 runs 100 steps
+  // and says so (it said 200, and a cell-steps/s twice the true one).
+  ASSERT_EQ(run_cli("generate --kind hill --size 16 hill.tif", dir_).code, 0);
+  write("c.toml", std::string(kConfig) + "every = 50\n");
+  ASSERT_EQ(run_cli("run c.toml", dir_).code, 0);
+  const auto r = run_cli("run c.toml --restart out.h5:50 --output again.h5", dir_);
+  std::printf("[restart steps] exit %d: %s", r.code, r.output.c_str());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("ran 100 steps to t = 100 s"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, InfoDescribesAResultFile) {
+  // `info` of a result file says what it holds (it read it as a DEM and failed before).
+  ASSERT_EQ(run_cli("generate --kind hill --size 16 hill.tif", dir_).code, 0);
+  write("c.toml", std::string(kConfig) + "every = 100\n");
+  ASSERT_EQ(run_cli("run c.toml", dir_).code, 0);
+  const auto r = run_cli("info out.h5", dir_);
+  std::printf("[info result]\n%s", r.output.c_str());
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* want :
+       {"result file  out.h5", "grid         16 x 16 cells",
+        "fields       bed, water_depth, erosion", "snapshots    3: t = 0 .. 100 s",
+        "--restart out.h5:TIME with TIME one of 0, 50, 100 s", "steps        200, to t = 100 s",
+        "backend      "})
+    EXPECT_NE(r.output.find(want), std::string::npos) << want;
+  const auto j = run_cli("info out.h5 --json", dir_);
+  ASSERT_EQ(j.code, 0) << j.output;
+  EXPECT_NE(j.output.find("\"times_s\": [0, 50, 100]"), std::string::npos) << j.output;
+  EXPECT_NE(j.output.find("\"restart_state\": true"), std::string::npos) << j.output;
+  EXPECT_NE(j.output.find("\"steps\": 200"), std::string::npos) << j.output;
 }
 
 TEST_F(Cli, MissingFilesExit66) {

@@ -249,7 +249,7 @@ TEST(Schema, UnknownTableAndMisplacedKey) {
 TEST(Schema, NegativeRateError) {
   const std::string msg = config_error_message([] { from_text("[rain]\nrate = -5\n"); });
   EXPECT_EQ(msg,
-            "config.toml: 'rain.rate': expected a rate >= 0 (m/s, or a string like \"20 "
+            "config.toml: 'rain.rate': expected a rate in [0, 1] (m/s, or a string like \"20 "
             "mm/h\"), got -5");
 }
 

@@ -88,6 +88,9 @@ const std::vector<Descriptor>& descriptor_table() {
              "cell size (m) for files without georeferencing and synthetic terrain; 0 = from "
              "the file"),
       text(ERODEM_FIELD(dem.crs), "CRS (e.g. \"EPSG:32610\") for files without georeferencing"),
+      number(ERODEM_FIELD(dem.elevation_limit), D::length, above(0),
+             "every valid cell's elevation must lie within +- this (m; 12 km holds every summit "
+             "and sea floor on Earth): beyond it a value is broken (exit 65), not terrain"),
       optional_number(ERODEM_FIELD(dem.nodata_value), D::dimensionless, any_finite(),
                       "stored value to treat as nodata, in the file's units before z_scale "
                       "(e.g. 0 for a heightmap whose sea is 0; with boundary.nodata = \"sea\" "
@@ -130,9 +133,10 @@ const std::vector<Descriptor>& descriptor_table() {
           "shallow_water: order of accuracy, 1 (first-order Godunov) or 2 (MUSCL reconstruction "
           "with the minmod limiter and Heun's method)"),
 
-      number(ERODEM_FIELD(rain.rate), D::speed, at_least(0),
-             "uniform rain rate (m/s), used when rain.series is empty"),
-      series(ERODEM_FIELD(rain.series), D::speed, at_least(0),
+      number(ERODEM_FIELD(rain.rate), D::speed, closed(0, 1),
+             "uniform rain rate (m/s, at most 1 m/s: 3.6e6 mm/h), used when rain.series is "
+             "empty"),
+      series(ERODEM_FIELD(rain.series), D::speed, closed(0, 1),
              "rain rate series [[time (s), rate (m/s)], ...], linear in between, held at the end "
              "values outside"),
       text(ERODEM_FIELD(rain.raster), "raster path of a spatial rain multiplier (1); \"\" = none"),

@@ -250,7 +250,12 @@ bool looks_like_quantity(const std::string& text) {
   double number = 0.0;
   std::string unit;
   if (!split_number_unit(text, &number, &unit)) return false;
-  return unit.empty() || find_unit(unit) != nullptr;
+  if (unit.empty() || find_unit(unit) != nullptr) return true;
+  // a number, then a space or a decimal comma: a quantity whose unit is wrong ("0.03 s m-1/3",
+  // "0,03"), not a file name ("30m.tif", "0.5.tif"); its parse says what is wrong (exit 78)
+  const std::string t = trim(text);
+  const std::size_t at = t.size() - unit.size();
+  return at > 0 && (std::isspace(static_cast<unsigned char>(t[at - 1])) || unit[0] == ',');
 }
 
 std::string format_number(double value) {

@@ -25,9 +25,12 @@ std::string resolve_against(const std::string& path, const fs::path& base_dir) {
   return (base_dir / p).lexically_normal().string();
 }
 
-/// The whole file as text; Error(no_input) when it does not exist or is not a file.
+/// The whole file as text; Error(no_input) when it does not exist, Error(io) when it is a
+/// folder or cannot be read.
 std::string read_config_text(const std::string& path) {
   std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw Error(ExitCode::io, path + ": a folder, not a config file (give the .toml file in it)");
   if (!fs::is_regular_file(path, ec)) {
     throw Error(ExitCode::no_input, path + ": no such config file");
   }

@@ -6,8 +6,13 @@
 #include <cstring>
 
 #include "erodem/error.hpp"
+#include "erodem/io/results.hpp"
 
 namespace erodem::io {
+
+void skip_hdf5_exit_cleanup() {
+  H5dont_atexit();
+}
 
 std::string h5_reason() {
   std::string msg;

@@ -96,6 +96,7 @@ Provenance Provenance::of(const Simulation& sim, const std::string& command_line
   p.config_toml = dump_toml(sim.params());
   p.backend = sim.backend().name();
   p.device = sim.backend().device();
+  p.backend_reason = sim.backend().choice_reason();
   p.dem_path = sim.terrain().source;
   p.dem_sha256 = sim.terrain().source_sha256;
   return p;
@@ -297,6 +298,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
       {"command_line", prov.command_line},
       {"config_toml", prov.config_toml},
       {"backend", prov.backend},
+      {"backend_reason", prov.backend_reason},
       {"device", prov.device},
       {"dem_path", prov.dem_path},
       {"dem_sha256", prov.dem_sha256},

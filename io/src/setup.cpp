@@ -1,5 +1,7 @@
 #include "erodem/io/setup.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "erodem/backends.hpp"
@@ -86,6 +88,18 @@ Terrain load_terrain(const Params& p) {
   for (std::size_t i = 0; i < t.grid.cells() && !any_active; ++i) any_active = t.active(i);
   if (!any_active)
     throw Error(ExitCode::data, t.source + ": every cell is nodata; nothing to simulate");
+  // a broken value (a float fill of -3.4e38, a wrong z_scale) stops here, naming the cell,
+  // not as a NaN after the first step
+  for (int r = 0; r < t.grid.ny; ++r)
+    for (int c = 0; c < t.grid.nx; ++c) {
+      const std::size_t i = static_cast<std::size_t>(r) * t.grid.nx + c;
+      if (t.active(i) && !(std::abs(t.bed[i]) <= p.dem.elevation_limit))
+        throw Error(ExitCode::data,
+                    fmt::format("{}: cell (col {}, row {}) has elevation {:.6g} m, beyond "
+                                "dem.elevation_limit = {:.6g} m (check dem.z_scale, its nodata "
+                                "value, or raise the limit)",
+                                t.source, c, r, t.bed[i], p.dem.elevation_limit));
+    }
   for (const auto& r : parameter_rasters()) {
     const std::string path = parameter_raster_path(r, p);
     if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);

@@ -34,7 +34,7 @@ class Simulation:
         ``dem.*`` settings replace those of ``config``. Without it, the config's ``dem.*``
         keys (or ``dem__path=...``) give the DEM.
     backend : {"auto", "cpu", "opencl"}, default "auto"
-        ``auto``: an OpenCL GPU, else OpenCL on PoCL, else the CPU reference.
+        ``auto``: an OpenCL GPU, else the CPU reference (faster than OpenCL on the CPU).
     config : dict or str or path-like, optional
         A TOML config file (relative raster paths in it resolve against its folder), or a
         dict of parameters (nested or dotted keys). Applied before ``params``.

@@ -117,6 +117,10 @@ class Backend {
   virtual std::string name() const = 0;
   /// What runs the kernels, e.g. "CPU reference, float32, 2 threads".
   virtual std::string device() const = 0;
+  /// Why this backend runs the simulation, in words (make_backend: "--backend cpu", or the
+  /// rule of --backend auto and what it found), for the log and the result file.
+  const std::string& choice_reason() const { return choice_reason_; }
+  void set_choice_reason(std::string reason) { choice_reason_ = std::move(reason); }
   /// Starts a step with its inputs (time, dt, rain rate, point inflows); the step's tallies
   /// start at zero. A step begun and not ended is discarded, tallies and all.
   virtual void begin_step(const StepInputs& in) = 0;
@@ -151,6 +155,9 @@ class Backend {
   virtual void set_field(FieldId id, const std::vector<double>& values) = 0;
   /// The field in host memory, to read or write in place; empty where it is not there.
   virtual HostView host_view(FieldId) { return {}; }
+
+ private:
+  std::string choice_reason_;
 };
 
 }  // namespace erodem

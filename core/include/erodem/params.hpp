@@ -96,6 +96,9 @@ struct Params {
     double cell_size = 0.0;              ///< m; for files without georeferencing (and synthetic)
     std::string crs;                     ///< CRS for files without georeferencing
     std::optional<double> nodata_value;  ///< stored value to treat as nodata (before z_scale)
+    /// every valid cell's elevation (after z_scale) must lie within +-this (m): a cell beyond
+    /// it is a broken value (a float's -3.4e38 fill), not terrain
+    double elevation_limit = 12000.0;
   } dem;
 
   struct Initial {

@@ -58,8 +58,9 @@ std::optional<double> try_parse_quantity(const std::string& text, Dimension dim,
 double parse_quantity(const std::string& text, Dimension dim, const std::string& key,
                       const std::string& source);
 
-/// True when `text` is a number, optionally followed by a unit of any dimension (so it
-/// is meant as a quantity, not as a file path).
+/// True when `text` is a number, optionally followed by a unit of any dimension, or by a
+/// space or a decimal comma and anything (a quantity with a wrong unit): meant as a quantity,
+/// not as a file path ("30m.tif" and "0.5.tif" stay paths).
 bool looks_like_quantity(const std::string& text);
 
 /// Formats a number so that it parses back to the same double, in TOML float syntax

@@ -66,7 +66,10 @@ struct BackendChoice {
   std::string reason;   ///< why, in words
 };
 /// The rule of make_backend("auto"): the device `selector` (ERODEM_OPENCL_DEVICE) names, else
-/// the first OpenCL GPU, else OpenCL on PoCL, else the CPU reference.
+/// the first OpenCL GPU, else the CPU reference. OpenCL on the CPU (PoCL) is not chosen: the
+/// CPU reference ran the full step as fast or faster at every grid size measured, 64^2 to
+/// 2048^2 cells (docs/performance.md, "auto and PoCL"; a 200 x 5 channel ran 28 times slower
+/// on PoCL); ERODEM_OPENCL_DEVICE or --backend opencl still select it.
 BackendChoice auto_backend_choice(const std::vector<ClDeviceInfo>& devices,
                                   const std::string& selector);
 

@@ -11,7 +11,8 @@ namespace erodem {
 /// Relative raster paths inside it (dem.path, initial.water_depth, flow.manning_n,
 /// erosion.hardness, rain.raster) are resolved against the config file's directory;
 /// output.path stays relative to the working directory.
-/// Errors: a missing file -> Error(ExitCode::no_input, "<path>: no such config file");
+/// Errors: a missing file -> Error(ExitCode::no_input, "<path>: no such config file"); a
+/// folder -> Error(ExitCode::io, "<path>: a folder, not a config file ...");
 /// a TOML syntax error -> Error(ExitCode::config, "<path>:<line>:<col>: <message>");
 /// unknown keys and bad values -> Error(ExitCode::config, "<path>: '<key>': ...").
 /// Cross-field checks are not done here: call erodem::validate() after any --set.

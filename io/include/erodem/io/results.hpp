@@ -17,6 +17,12 @@
 namespace erodem::io {
 
 /// The version and `git describe` of this build.
+/// Skips HDF5's own clean-up at process exit. A result file that fails to open (a corrupt
+/// one) can leave objects HDF5 cannot close, and that clean-up then prints "HDF5: infinite
+/// loop closing library" and a page-long line after erodem's one-line error. Every file erodem
+/// writes is closed explicitly before. Call it first in main, before any other HDF5 call.
+void skip_hdf5_exit_cleanup();
+
 std::string build_version();
 std::string build_git_describe();
 
@@ -28,9 +34,10 @@ struct Provenance {
   std::string config_toml;  ///< the fully resolved config (dump_toml)
   std::string backend;
   std::string device;
-  std::string dem_path;      ///< DEM file, or the generator description
-  std::string dem_sha256;    ///< SHA-256 of the DEM file ("" for synthetic terrain)
-  std::string restart_from;  ///< "FILE:TIME" a restarted run continued from ("" otherwise)
+  std::string backend_reason;  ///< why that backend (Backend::choice_reason)
+  std::string dem_path;        ///< DEM file, or the generator description
+  std::string dem_sha256;      ///< SHA-256 of the DEM file ("" for synthetic terrain)
+  std::string restart_from;    ///< "FILE:TIME" a restarted run continued from ("" otherwise)
 
   /// Everything but `command_line` from a simulation (config from its params).
   static Provenance of(const Simulation& sim, const std::string& command_line);
