@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 
 #include "erodem/error.hpp"
@@ -276,16 +277,28 @@ std::array<double, 2> ViewData::held_color_range(const std::string& name, ColorM
   const std::size_t cells = static_cast<std::size_t>(grid_.nx) * static_cast<std::size_t>(grid_.ny);
   const std::size_t n = map == ColorMap::classes ? 1 : times_.size();
   const std::size_t stride = std::max<std::size_t>(1, (n * cells + kPoolValues - 1) / kPoolValues);
+  // The minimum and maximum are exact (a sampled pool could miss the extreme cell and then
+  // mark the bar as clipped where nothing is).
   std::vector<float> pool;
   pool.reserve(n * ((cells + stride - 1) / stride));
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (std::size_t k = 0; k < n; ++k) {
     const auto it = cache_.find(std::make_pair(name, k));
     const std::vector<float> computed =
         it != cache_.end() ? std::vector<float>{} : compute(name, k);
     const std::vector<float>& v = it != cache_.end() ? it->second : computed;
     for (std::size_t i = 0; i < v.size(); i += stride) pool.push_back(v[i]);
+    for (float x : v)
+      if (std::isfinite(x)) {
+        lo = std::min(lo, static_cast<double>(x));
+        hi = std::max(hi, static_cast<double>(x));
+      }
   }
   std::optional<std::array<double, 2>> r = data_color_range(map, pool);
+  if (r && map != ColorMap::diverging && map != ColorMap::classes) {
+    (*r)[0] = lo;
+    if (map == ColorMap::terrain) (*r)[1] = hi;
+  }
   if (!r) r = color_range(map, values(name, times_.size() - 1));
   return held_ranges_[key] = *r;
 }

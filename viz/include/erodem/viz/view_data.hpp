@@ -94,8 +94,9 @@ class ViewData {
   /// `names` (in that order; empty: every field). Reads each snapshot once, around the cache.
   std::vector<CellValues> cell_series(int col, int row, const std::vector<std::string>& names = {});
   /// The colour range of field `name` under `map` held over all snapshots: color_range of
-  /// the values of all snapshots pooled (every k-th cell beyond 4 M values in all), so the
-  /// percentiles are the whole run's. Computed once per field and map, around the cache.
+  /// the values of all snapshots pooled, so the percentiles are the whole run's. Beyond 4 M
+  /// values in all the percentiles are taken of every k-th cell; the minimum and maximum
+  /// stay exact. Computed once per field and map, around the cache.
   std::array<double, 2> held_color_range(const std::string& name, ColorMap map);
   /// A one-line description: file, grid size, CRS kind, number of snapshots.
   std::string describe() const;
