@@ -3,11 +3,14 @@
 // renderer and prints the cell's values as JSON.
 #include <fmt/format.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +18,7 @@
 #include "erodem/error.hpp"
 
 #ifdef ERODEM_HAVE_VIEWER
+#include "erodem/viz/colormap.hpp"
 #include "erodem/viz/scene.hpp"
 #include "erodem/viz/view_data.hpp"
 #endif
@@ -25,7 +29,10 @@ namespace {
 
 struct ViewOptions {
   std::string input, field = "bed", screenshot, size = "1200x800", pick, keys;
+  std::string cmap, clim, series;
   double time = NAN;  // NaN: the last snapshot
+  long snapshot = 0;
+  bool has_snapshot = false, rescale = false, no_water = false;
   double exaggeration = 0.0;
   double water_threshold = 0.05;
   double max_cells = 4e6;
@@ -58,11 +65,65 @@ std::pair<double, double> parse_point(const std::string& s) {
   return {x, y};
 }
 
+/// "LO,HI" with LO < HI.
+std::array<double, 2> parse_clim(const std::string& s) {
+  double lo = NAN, hi = NAN;
+  char extra = 0;
+  if (std::sscanf(s.c_str(), "%lf,%lf%c", &lo, &hi, &extra) != 2 || !std::isfinite(lo) ||
+      !std::isfinite(hi) || !(lo < hi))
+    throw Error(
+        ExitCode::usage,
+        "--clim: expected LO,HI with LO < HI in the field's units, e.g. -0.5,0.5; got '" + s + "'");
+  return {lo, hi};
+}
+
+/// The picked cell's time series as CSV: time_s, then every field (NaN: empty).
+void write_series_csv(const std::string& path, const std::vector<viz::CellValues>& series) {
+  const std::filesystem::path target(path);
+  const std::filesystem::path tmp =
+      target.parent_path() / (std::string(".") + target.filename().string() + ".partial");
+  {
+    std::FILE* f = std::fopen(tmp.string().c_str(), "w");
+    if (!f) throw Error(ExitCode::cant_create, path + ": could not create the file");
+    std::string head = "time_s";
+    if (!series.empty())
+      for (const auto& [name, v] : series.front().values) head += "," + name;
+    std::fprintf(f, "%s\n", head.c_str());
+    for (const auto& c : series) {
+      std::string line = fmt::format("{:.17g}", c.time);
+      for (const auto& [name, v] : c.values)
+        line += std::isfinite(v) ? fmt::format(",{:.9g}", v) : std::string(",");
+      std::fprintf(f, "%s\n", line.c_str());
+    }
+    if (std::fclose(f) != 0) throw Error(ExitCode::io, path + ": could not write the file");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, target, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw Error(ExitCode::cant_create, path + ": could not create the file: " + ec.message());
+  }
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 #ifdef ERODEM_HAVE_VIEWER
+/// What was drawn, on stderr: the colour map and range, the clipped ends, the scale bar and
+/// the north arrow (the figures the tests check against the pixels).
+void describe_drawing(const viz::Scene& scene) {
+  const auto lim = scene.color_limits();
+  const auto clip = scene.clipped();
+  const auto bar = scene.scale_bar();
+  std::fprintf(stderr,
+               "erodem view: colour map %s, range %.6g .. %.6g, clipped below: %s, above: %s; "
+               "scale bar %g m = %.2f px; north %.1f deg from up\n",
+               viz::color_map_name(scene.color_map()).c_str(), lim[0], lim[1],
+               clip[0] ? "yes" : "no", clip[1] ? "yes" : "no", bar.metres, bar.pixels,
+               bar.north_degrees);
+}
+
 int view(const ViewOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto [width, height] = parse_size(o.size);
@@ -81,6 +142,16 @@ int view(const ViewOptions& o) {
   if (!o.keys.empty() && !o.pick.empty())
     throw Error(ExitCode::usage, "--keys: cannot be combined with --pick");
   if (!o.screenshot.empty()) check_output_path(o.screenshot, o.overwrite);
+  if (!o.series.empty()) {
+    if (o.pick.empty()) throw Error(ExitCode::usage, "--series: needs --pick X,Y (the cell)");
+    check_output_path(o.series, o.overwrite);
+  }
+  if (o.has_snapshot && !std::isnan(o.time))
+    throw Error(ExitCode::usage, "--snapshot: give either --time or --snapshot, not both");
+  std::optional<std::array<double, 2>> clim;
+  if (!o.clim.empty()) clim = parse_clim(o.clim);
+  std::optional<viz::ColorMap> cmap;
+  if (!o.cmap.empty()) cmap = viz::color_map_by_name(o.cmap);
   if (!offscreen && !std::getenv("DISPLAY"))
     throw Error(ExitCode::usage,
                 "no display (DISPLAY is not set): give --screenshot OUT.png (under xvfb-run -a "
@@ -96,7 +167,25 @@ int view(const ViewOptions& o) {
   viz::SceneOptions so;
   data.field(o.field);  // unknown -> Error naming it
   so.field = o.field;
-  so.time_index = std::isnan(o.time) ? data.times().size() - 1 : data.time_index(o.time);
+  if (o.has_snapshot) {
+    so.time_index = data.snapshot_index(o.snapshot);
+  } else if (std::isnan(o.time)) {
+    so.time_index = data.times().size() - 1;
+  } else {
+    // Adaptive runs store times such as 3599.87 s: take the nearest snapshot, and say which
+    // when it is not the time asked for.
+    so.time_index = data.nearest_time_index(o.time);
+    const double t = data.times()[so.time_index];
+    if (std::abs(t - o.time) > 1e-9 * std::max(1.0, std::abs(o.time)))
+      std::fprintf(
+          stderr,
+          "erodem view: --time %g s: showing the nearest snapshot, %d of 0..%zu at t = %.17g s\n",
+          o.time, static_cast<int>(so.time_index), data.times().size() - 1, t);
+  }
+  so.cmap = cmap;
+  so.clim = clim;
+  so.rescale = o.rescale;
+  so.water = !o.no_water;
   so.exaggeration = o.exaggeration;
   so.water_threshold = o.water_threshold;
   so.max_cells = static_cast<std::size_t>(o.max_cells);
@@ -174,11 +263,19 @@ int view(const ViewOptions& o) {
     std::fprintf(stderr, "erodem view: picked at display (%.1f, %.1f) in %.3f s\n", (*d)[0],
                  (*d)[1], seconds_since(t3));
     std::printf("%s\n", viz::pick_json(data, hit->cell).c_str());
+    if (!o.series.empty()) {
+      write_series_csv(o.series, data.cell_series(hit->cell.col, hit->cell.row));
+      std::fprintf(stderr, "erodem view: wrote %s: cell (col %d, row %d) at %zu snapshots\n",
+                   o.series.c_str(), hit->cell.col, hit->cell.row, data.times().size());
+    }
   }
   if (!o.screenshot.empty()) {
     const auto t4 = clock::now();
     scene.write_png(o.screenshot);
     std::fprintf(stderr, "erodem view: rendered and written in %.2f s\n", seconds_since(t4));
+  }
+  if (!o.screenshot.empty() || !o.pick.empty()) describe_drawing(scene);
+  if (!o.screenshot.empty()) {
     std::printf("wrote %s: %s at t = %g s (%d x %d pixels)\n", o.screenshot.c_str(),
                 o.field.c_str(), data.times()[scene.time_index()], width, height);
   }
@@ -202,7 +299,24 @@ Action add_view(CLI::App& app) {
   sub->add_option("--field", o->field,
                   "Field to colour the terrain by: a stored field (bed, water_depth, sediment, "
                   "erosion, ...), speed, or terrain_class (default: bed)");
-  sub->add_option("--time", o->time, "Stored time to show (s); default: the last snapshot");
+  sub->add_option("--time", o->time,
+                  "Time to show (s): the nearest stored snapshot (named on stderr when not "
+                  "exact); default: the last snapshot");
+  sub->add_option("--snapshot", o->snapshot,
+                  "Snapshot to show by number: 0-based, negative from the end (-1 = last)")
+      ->each([o](const std::string&) { o->has_snapshot = true; });
+  sub->add_option("--cmap", o->cmap,
+                  "Colour map of --field: terrain, water, sediment, speed, diverging (centred "
+                  "on 0), classes; default: the field's own");
+  sub->add_option("--clim", o->clim,
+                  "Colour range LO,HI of --field (its units); values beyond are drawn in the end "
+                  "colours and marked by a triangle on the bar");
+  sub->add_flag("--rescale", o->rescale,
+                "Recompute the colour range at every snapshot (default: one range held over "
+                "all snapshots)");
+  sub->add_flag("--no-water", o->no_water, "Do not draw the water surface");
+  sub->add_option("--series", o->series,
+                  "With --pick: write the picked cell's values at every snapshot to this CSV");
   sub->add_option("--screenshot", o->screenshot, "Render off screen to this PNG and exit");
   sub->add_option("--size", o->size, "Window or image size WxH in pixels (default: 1200x800)");
   sub->add_flag("--overwrite", o->overwrite, "Replace an existing screenshot");

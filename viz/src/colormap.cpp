@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+
+#include "erodem/error.hpp"
 
 namespace erodem::viz {
 
@@ -23,11 +26,13 @@ const std::vector<ColorStop>& color_stops(ColorMap map) {
                                             {0.35, {0.55, 0.10, 0.45}},
                                             {0.65, {0.95, 0.35, 0.15}},
                                             {1.00, {0.99, 0.95, 0.45}}};
-  static const std::vector<ColorStop> diverging{{0.00, {0.13, 0.30, 0.65}},
-                                                {0.25, {0.50, 0.70, 0.88}},
+  // Purple (deposition) - white - orange-brown (erosion): no blue, so that the water drawn
+  // over it (blue, scene.cpp) is not taken for deposition.
+  static const std::vector<ColorStop> diverging{{0.00, {0.30, 0.12, 0.48}},
+                                                {0.25, {0.66, 0.56, 0.80}},
                                                 {0.50, {0.97, 0.97, 0.97}},
-                                                {0.75, {0.92, 0.55, 0.45}},
-                                                {1.00, {0.65, 0.05, 0.12}}};
+                                                {0.75, {0.96, 0.66, 0.30}},
+                                                {1.00, {0.55, 0.25, 0.02}}};
   // grass, mud, rock, snow, water (codes 0..4 of TerrainClass).
   static const std::vector<ColorStop> classes{{0.0, {0.40, 0.65, 0.25}},
                                               {0.25, {0.45, 0.33, 0.20}},
@@ -49,6 +54,25 @@ const std::vector<ColorStop>& color_stops(ColorMap map) {
       break;
   }
   return terrain;
+}
+
+const std::vector<std::string>& color_map_names() {
+  static const std::vector<std::string> names{"terrain", "water",     "sediment",
+                                              "speed",   "diverging", "classes"};
+  return names;
+}
+
+const std::string& color_map_name(ColorMap map) {
+  return color_map_names().at(static_cast<std::size_t>(map));
+}
+
+ColorMap color_map_by_name(const std::string& name) {
+  const auto& names = color_map_names();
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return static_cast<ColorMap>(k);
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw Error(ExitCode::usage, "--cmap: no colour map '" + name + "' (available: " + list + ")");
 }
 
 std::array<double, 3> color_at(ColorMap map, double t) {
@@ -79,21 +103,23 @@ double quantile(std::vector<double>& v, double q) {
 
 }  // namespace
 
-std::array<double, 2> color_range(ColorMap map, const std::vector<float>& values) {
-  if (map == ColorMap::classes) return {0.0, 4.0};
+std::optional<std::array<double, 2>> data_color_range(ColorMap map,
+                                                      const std::vector<float>& values) {
+  if (map == ColorMap::classes) return std::array<double, 2>{0.0, 4.0};
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (float v : values)
     if (std::isfinite(v)) {
       lo = std::min(lo, static_cast<double>(v));
       hi = std::max(hi, static_cast<double>(v));
     }
-  if (!(lo <= hi)) return {-1.0, 1.0};  // no finite value
+  if (!(lo <= hi)) return std::nullopt;  // no finite value
   if (map == ColorMap::diverging) {
     std::vector<double> mag;
     for (float v : values)
       if (std::isfinite(v) && v != 0.0f) mag.push_back(std::abs(static_cast<double>(v)));
-    const double m = mag.empty() ? 0.0 : quantile(mag, kColorQuantile);
-    return m > 0.0 ? std::array<double, 2>{-m, m} : std::array<double, 2>{-1.0, 1.0};
+    const double m = mag.empty() ? 0.0 : quantile(mag, kDivergingQuantile);
+    if (!(m > 0.0)) return std::nullopt;
+    return std::array<double, 2>{-m, m};
   }
   if (map != ColorMap::terrain) {
     std::vector<double> v;
@@ -101,8 +127,18 @@ std::array<double, 2> color_range(ColorMap map, const std::vector<float>& values
       if (std::isfinite(x)) v.push_back(x);
     hi = quantile(v, kColorQuantile);
   }
-  if (!(hi > lo)) return {lo, lo + 1.0};
-  return {lo, hi};
+  if (!(hi > lo)) return std::nullopt;
+  return std::array<double, 2>{lo, hi};
+}
+
+std::array<double, 2> color_range(ColorMap map, const std::vector<float>& values) {
+  if (auto r = data_color_range(map, values)) return *r;
+  double lo = std::numeric_limits<double>::infinity();
+  for (float v : values)
+    if (std::isfinite(v)) lo = std::min(lo, static_cast<double>(v));
+  // no finite value, or an all-zero diverging field
+  if (!std::isfinite(lo) || map == ColorMap::diverging) return {-1.0, 1.0};
+  return {lo, lo + 1.0};  // constant
 }
 
 }  // namespace erodem::viz

@@ -4,26 +4,46 @@
 #include <fmt/format.h>
 #include <unistd.h>
 #include <vtkActor.h>
+#include <vtkActor2D.h>
+#include <vtkAxis.h>
+#include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkCellPicker.h>
+#include <vtkChartLegend.h>
+#include <vtkChartXY.h>
+#include <vtkCommand.h>
+#include <vtkContextActor.h>
+#include <vtkContextScene.h>
+#include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkLight.h>
+#include <vtkLineSource.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
+#include <vtkObjectFactory.h>
 #include <vtkPNGWriter.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPolyDataMapper2D.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
+#include <vtkScalarBarActorInternal.h>
+#include <vtkSphereSource.h>
 #include <vtkStaticCellLocator.h>
+#include <vtkTable.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkTypeInt32Array.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkVariant.h>
 #include <vtkWindowToImageFilter.h>
 
@@ -71,6 +91,64 @@ std::string json_number(double v) {
   return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null";
 }
 
+/// A scalar bar whose above / below range swatches are triangles pointing away from the
+/// bar (the colour map's end colours): the mark that values beyond the range are clipped.
+class ClipBarActor : public vtkScalarBarActor {
+ public:
+  static ClipBarActor* New();
+  using Superclass = vtkScalarBarActor;
+
+ protected:
+  void ConfigureAboveBelowRangeSwatch(bool above) override {
+    vtkScalarBarActor::ConfigureAboveBelowRangeSwatch(above);
+    if (!(above ? this->DrawAboveRangeSwatch : this->DrawBelowRangeSwatch)) return;
+    vtkPolyData* swatch = above ? this->P->AboveRangeSwatch : this->P->BelowRangeSwatch;
+    vtkPoints* box = swatch->GetPoints();
+    if (!box || box->GetNumberOfPoints() != 4) return;
+    // The box is p0, p0 + a, p0 + a + b, p0 + b with a along x and b along y (a vertical
+    // bar): the above triangle stands on the bar's top edge, the below one hangs from its
+    // bottom edge.
+    double p[4][3];
+    for (int k = 0; k < 4; ++k) box->GetPoint(k, p[k]);
+    vtkNew<vtkPoints> pts;
+    const auto mid = [](const double* u, const double* v) {
+      return std::array<double, 3>{0.5 * (u[0] + v[0]), 0.5 * (u[1] + v[1]), 0.0};
+    };
+    if (above) {
+      pts->InsertNextPoint(p[0]);
+      pts->InsertNextPoint(p[1]);
+      pts->InsertNextPoint(mid(p[2], p[3]).data());
+    } else {
+      pts->InsertNextPoint(p[3]);
+      pts->InsertNextPoint(p[2]);
+      pts->InsertNextPoint(mid(p[0], p[1]).data());
+    }
+    vtkNew<vtkCellArray> tri;
+    const vtkIdType ids[3] = {0, 1, 2};
+    tri->InsertNextCell(3, ids);
+    swatch->SetPoints(pts);
+    swatch->SetPolys(tri);
+  }
+};
+vtkStandardNewMacro(ClipBarActor);
+
+/// The water's colour: a pure, light blue that neither the terrain map nor the diverging
+/// map (purple / orange) uses.
+constexpr double kWaterRgb[3] = {0.05, 0.45, 1.0};
+/// Water opacity: kWaterAlphaMin at the draw threshold, rising linearly with the depth to
+/// kWaterAlphaMax at kWaterOpaqueDepth (m) and deeper.
+constexpr double kWaterAlphaMin = 0.35, kWaterAlphaMax = 0.9, kWaterOpaqueDepth = 1.0;
+/// The pick marker's colour (magenta: in none of the maps).
+constexpr double kMarkerRgb[3] = {1.0, 0.0, 1.0};
+
+/// 1, 2 or 5 times a power of ten, the largest not above x (> 0).
+double nice_length(double x) {
+  const double p = std::pow(10.0, std::floor(std::log10(x)));
+  for (double m : {5.0, 2.0, 1.0})
+    if (m * p <= x) return m * p;
+  return p;
+}
+
 }  // namespace
 
 double auto_exaggeration(const Grid& grid, const std::vector<float>& bed) {
@@ -102,9 +180,35 @@ struct Scene::Impl {
   vtkNew<vtkPolyDataMapper> water_mapper;
   vtkNew<vtkActor> water_actor;
   vtkNew<vtkLookupTable> lut;
-  vtkNew<vtkScalarBarActor> bar;
+  vtkNew<ClipBarActor> bar;
   vtkNew<vtkTextActor> status;
   vtkNew<vtkTextActor> pick_text;
+  ColorMap map = ColorMap::terrain;
+  std::array<double, 2> limits{0.0, 1.0};
+  std::array<bool, 2> clipped{false, false};
+  // Scale bar and north arrow: 2-D shapes in display pixels, recomputed before each render.
+  vtkNew<vtkPolyData> overlay;
+  vtkNew<vtkPolyDataMapper2D> overlay_mapper;
+  vtkNew<vtkActor2D> overlay_actor;
+  vtkNew<vtkTextActor> scale_text;
+  vtkNew<vtkTextActor> north_text;
+  vtkNew<vtkCallbackCommand> before_render;
+  ScaleBar scale;
+  double extent = 1.0;  ///< the grid's larger side (m)
+  // The pick marker: a sphere on the picked cell and a pin above it.
+  bool has_pick = false;
+  std::array<double, 3> pick_point{};  ///< world x, y (m) and bed z (m, not exaggerated)
+  vtkNew<vtkSphereSource> marker_sphere;
+  vtkNew<vtkPolyDataMapper> marker_mapper;
+  vtkNew<vtkActor> marker_actor;
+  vtkNew<vtkLineSource> pin;
+  vtkNew<vtkPolyDataMapper> pin_mapper;
+  vtkNew<vtkActor> pin_actor;
+  // The picked cell's time series: a vtkChartXY in its own renderer at the left edge.
+  vtkNew<vtkRenderer> chart_renderer;
+  vtkNew<vtkContextActor> chart_actor;
+  vtkNew<vtkChartXY> chart;
+  vtkNew<vtkTable> series;
   vtkNew<vtkCellPicker> picker;
   vtkNew<vtkStaticCellLocator> locator;
   bool locator_stale = true;
@@ -114,10 +218,12 @@ struct Scene::Impl {
   std::vector<float> coarse_bed;  ///< the drawn bed (m), per vertex
 };
 
-Scene::Scene(ViewData& data, const SceneOptions& o) : data_(data), impl_(std::make_unique<Impl>()) {
+Scene::Scene(ViewData& data, const SceneOptions& o)
+    : data_(data), impl_(std::make_unique<Impl>()), options_(o) {
   auto& m = *impl_;
   data_.field(o.field);  // unknown -> Error
   field_ = o.field;
+  m.water_on = o.water;
   time_index_ = std::min(o.time_index, data_.times().size() - 1);
   water_threshold_ = o.water_threshold;
   const Grid& grid = data_.grid();
@@ -174,28 +280,69 @@ Scene::Scene(ViewData& data, const SceneOptions& o) : data_(data), impl_(std::ma
   m.interaction_actor->VisibilityOff();
   m.renderer->AddActor(m.interaction_actor);
 
+  // Water: per-vertex RGBA (kWaterRgb, opacity by depth).
   m.water_mapper->SetInputData(m.water);
-  m.water_mapper->ScalarVisibilityOff();
+  m.water_mapper->ScalarVisibilityOn();
+  m.water_mapper->SetScalarModeToUsePointData();
+  m.water_mapper->SetColorModeToDirectScalars();
   m.water_actor->SetMapper(m.water_mapper);
-  m.water_actor->GetProperty()->SetColor(0.10, 0.35, 0.85);
-  m.water_actor->GetProperty()->SetOpacity(0.6);
+  m.water_actor->GetProperty()->SetAmbient(0.25);
+  m.water_actor->GetProperty()->SetDiffuse(0.75);
   m.water_actor->GetProperty()->SetSpecular(0.3);
   m.water_actor->GetProperty()->SetSpecularPower(30.0);
   m.water_actor->PickableOff();
-  m.water_actor->SetVisibility(m.has_water_field);
+  m.water_actor->SetVisibility(m.has_water_field && m.water_on);
   m.renderer->AddActor(m.water_actor);
 
   m.bar->SetLookupTable(m.lut);
   m.bar->SetNumberOfLabels(5);
-  m.bar->SetMaximumWidthInPixels(110);
-  m.bar->SetPosition(0.88, 0.12);
-  m.bar->SetWidth(0.1);
+  m.bar->SetMaximumWidthInPixels(130);
+  m.bar->SetPosition(0.84, 0.12);
+  m.bar->SetWidth(0.14);
   m.bar->SetHeight(0.75);
   m.bar->UnconstrainedFontSizeOn();
   m.bar->GetTitleTextProperty()->SetFontSize(16);
   m.bar->GetLabelTextProperty()->SetFontSize(14);
   m.bar->GetAnnotationTextProperty()->SetFontSize(14);
+  m.bar->SetAboveRangeAnnotation(nullptr);
+  m.bar->SetBelowRangeAnnotation(nullptr);
   m.renderer->AddActor2D(m.bar);
+
+  m.overlay_mapper->SetInputData(m.overlay);
+  m.overlay_actor->SetMapper(m.overlay_mapper);
+  m.overlay_actor->GetProperty()->SetColor(1.0, 1.0, 1.0);
+  m.overlay_actor->GetProperty()->SetLineWidth(2.0);
+  m.renderer->AddActor2D(m.overlay_actor);
+  for (vtkTextActor* t : {m.scale_text.Get(), m.north_text.Get()}) {
+    t->GetTextProperty()->SetFontSize(15);
+    t->GetTextProperty()->SetColor(1.0, 1.0, 1.0);
+    t->GetTextProperty()->SetJustificationToCentered();
+    t->GetTextProperty()->SetBold(true);
+    m.renderer->AddActor2D(t);
+  }
+  m.north_text->SetInput("N");
+  m.before_render->SetCallback([](vtkObject*, unsigned long, void* scene, void*) {
+    static_cast<Scene*>(scene)->update_overlays();
+  });
+  m.before_render->SetClientData(this);
+  m.renderer->AddObserver(vtkCommand::StartEvent, m.before_render);
+  m.extent = std::max(grid.nx * grid.dx[grid.ny / 2], grid.ny * grid.dy[grid.ny / 2]);
+
+  m.marker_sphere->SetThetaResolution(24);
+  m.marker_sphere->SetPhiResolution(12);
+  m.marker_mapper->SetInputConnection(m.marker_sphere->GetOutputPort());
+  m.marker_actor->SetMapper(m.marker_mapper);
+  m.pin_mapper->SetInputConnection(m.pin->GetOutputPort());
+  m.pin_actor->SetMapper(m.pin_mapper);
+  for (vtkActor* a : {m.marker_actor.Get(), m.pin_actor.Get()}) {
+    a->GetProperty()->SetColor(kMarkerRgb[0], kMarkerRgb[1], kMarkerRgb[2]);
+    a->GetProperty()->SetAmbient(0.5);
+    a->PickableOff();
+    a->VisibilityOff();
+    m.renderer->AddActor(a);
+  }
+  m.pin_actor->GetProperty()->SetLineWidth(3.0);
+  m.pin_actor->GetProperty()->LightingOff();
 
   m.status->GetTextProperty()->SetFontSize(16);
   m.status->GetTextProperty()->SetColor(1.0, 1.0, 1.0);
@@ -203,10 +350,31 @@ Scene::Scene(ViewData& data, const SceneOptions& o) : data_(data), impl_(std::ma
   m.status->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   m.status->SetPosition(0.01, 0.985);
   m.renderer->AddActor2D(m.status);
+  // The pick panel: the picked cell's values on a dark, framed background.
   m.pick_text->GetTextProperty()->SetFontSize(14);
   m.pick_text->GetTextProperty()->SetColor(1.0, 1.0, 0.85);
+  m.pick_text->GetTextProperty()->SetBackgroundColor(0.0, 0.0, 0.0);
+  m.pick_text->GetTextProperty()->SetBackgroundOpacity(0.65);
+  m.pick_text->GetTextProperty()->FrameOn();
+  m.pick_text->GetTextProperty()->SetFrameColor(kMarkerRgb[0], kMarkerRgb[1], kMarkerRgb[2]);
   m.pick_text->SetDisplayPosition(10, 10);
   m.renderer->AddActor2D(m.pick_text);
+
+  // The time-series chart of the picked cell: hidden until a pick (of a file with several
+  // snapshots); on a light panel at the left edge, above the pick panel.
+  m.chart_renderer->SetViewport(0.0, 0.42, 0.36, 0.82);
+  m.chart_renderer->SetBackground(0.96, 0.96, 0.94);
+  m.chart_renderer->InteractiveOff();
+  m.chart_renderer->DrawOff();
+  m.chart_actor->GetScene()->AddItem(m.chart);
+  m.chart_renderer->AddActor(m.chart_actor);
+  m.chart->SetShowLegend(true);
+  m.chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::LEFT);
+  m.chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+  m.chart->GetAxis(vtkAxis::BOTTOM)->SetTitle("t (s)");
+  m.chart->GetAxis(vtkAxis::LEFT)->SetTitle("depth (m), speed (m/s)");
+  m.chart->GetAxis(vtkAxis::RIGHT)->SetTitle("bed (m)");
+  m.window->AddRenderer(m.chart_renderer);
 
   m.picker->PickFromListOn();
   m.picker->AddPickList(m.terrain_actor);
@@ -227,6 +395,18 @@ vtkRenderer* Scene::renderer() {
 }
 bool Scene::water_visible() const {
   return impl_->water_on && impl_->has_water_field;
+}
+ColorMap Scene::color_map() const {
+  return impl_->map;
+}
+std::array<double, 2> Scene::color_limits() const {
+  return impl_->limits;
+}
+std::array<bool, 2> Scene::clipped() const {
+  return impl_->clipped;
+}
+ScaleBar Scene::scale_bar() const {
+  return impl_->scale;
 }
 
 namespace {
@@ -325,14 +505,30 @@ void Scene::rebuild_geometry() {
     vtkNew<vtkPoints> points;
     points->SetDataTypeToFloat();
     points->SetNumberOfPoints(static_cast<vtkIdType>(nx) * ny);
+    vtkNew<vtkUnsignedCharArray> rgba;
+    rgba->SetNumberOfComponents(4);
+    rgba->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny);
+    rgba->SetName("water_rgba");
     auto* terrain_points = m.terrain->GetPoints();
     for (vtkIdType k = 0; k < static_cast<vtkIdType>(nx) * ny; ++k) {
       double p[3];
       terrain_points->GetPoint(k, p);
-      if (wet(static_cast<std::size_t>(k))) p[2] += depth[static_cast<std::size_t>(k)];
+      const auto ks = static_cast<std::size_t>(k);
+      // Dry corners of a wet quad are transparent: the shore fades out.
+      double alpha = 0.0;
+      if (wet(ks)) {
+        p[2] += depth[ks];
+        alpha = std::min(kWaterAlphaMax,
+                         kWaterAlphaMin + (kWaterAlphaMax - kWaterAlphaMin) * (depth[ks] - thr) /
+                                              std::max(1e-6, kWaterOpaqueDepth - thr));
+      }
       points->SetPoint(k, p);
+      const double c[4] = {255.0 * kWaterRgb[0], 255.0 * kWaterRgb[1], 255.0 * kWaterRgb[2],
+                           255.0 * alpha};
+      rgba->SetTuple(k, c);
     }
     m.water->SetPoints(points);
+    m.water->GetPointData()->SetScalars(rgba);
     m.water->SetPolys(quad_triangles(nx, ny, [&](auto a, auto b, auto c, auto d) {
       return std::isfinite(z[a]) && std::isfinite(z[b]) && std::isfinite(z[c]) &&
              std::isfinite(z[d]) && (wet(a) || wet(b) || wet(c) || wet(d));
@@ -345,14 +541,24 @@ void Scene::update_colors() {
   auto& m = *impl_;
   const ViewField& f = data_.field(field_);
   const std::vector<float>& full = data_.values(field_, time_index_);
-  const auto range = color_range(f.map, full);
-  const Reduce reduce = f.map == ColorMap::classes ? Reduce::sample : Reduce::mean;
+  // --cmap and --clim are for the field they were given with; the others keep their own.
+  const bool asked = field_ == options_.field;
+  m.map = asked && options_.cmap ? *options_.cmap : f.map;
+  if (asked && options_.clim)
+    m.limits = *options_.clim;
+  else if (options_.rescale)
+    m.limits = color_range(m.map, full);
+  else
+    m.limits = data_.held_color_range(field_, m.map);
+  const auto range = m.limits;
+  const Reduce reduce = m.map == ColorMap::classes ? Reduce::sample : Reduce::mean;
   set_point_scalars(m.terrain, f.name, full, lod_, reduce);
   if (m.interaction_lod.factor > lod_.factor)
     set_point_scalars(m.interaction_terrain, f.name, full, m.interaction_lod, reduce);
 
   m.lut->ResetAnnotations();
-  if (f.map == ColorMap::classes) {
+  m.clipped = {false, false};
+  if (m.map == ColorMap::classes) {
     const auto& names = terrain_class_names();
     const int n = static_cast<int>(names.size());
     m.lut->SetNumberOfTableValues(n);
@@ -362,21 +568,40 @@ void Scene::update_colors() {
       m.lut->SetTableValue(k, c[0], c[1], c[2], 1.0);
       m.lut->SetAnnotation(vtkVariant(static_cast<double>(k)), names[k]);
     }
+    m.lut->UseAboveRangeColorOff();
+    m.lut->UseBelowRangeColorOff();
     m.bar->SetNumberOfLabels(0);
     m.bar->DrawAnnotationsOn();
+    // The names beside their swatches, not at the ends of leader lines.
+    m.bar->SetAnnotationLeaderPadding(4.0);
     m.bar->SetTitle("terrain class");
   } else {
     const int n = 256;
     m.lut->SetNumberOfTableValues(n);
     m.lut->SetTableRange(range[0], range[1]);
     for (int k = 0; k < n; ++k) {
-      const auto c = color_at(f.map, k / double(n - 1));
+      const auto c = color_at(m.map, k / double(n - 1));
       m.lut->SetTableValue(k, c[0], c[1], c[2], 1.0);
     }
+    // Values beyond the range keep the end colours on the terrain; the bar marks them
+    // with a triangle (ClipBarActor) at the end they pass.
+    const auto lo = color_at(m.map, 0.0), hi = color_at(m.map, 1.0);
+    m.lut->SetBelowRangeColor(lo[0], lo[1], lo[2], 1.0);
+    m.lut->SetAboveRangeColor(hi[0], hi[1], hi[2], 1.0);
+    for (float v : full)
+      if (std::isfinite(v)) {
+        if (v < range[0]) m.clipped[0] = true;
+        if (v > range[1]) m.clipped[1] = true;
+      }
+    m.lut->SetUseBelowRangeColor(m.clipped[0]);
+    m.lut->SetUseAboveRangeColor(m.clipped[1]);
     m.bar->SetNumberOfLabels(5);
     m.bar->DrawAnnotationsOff();
     m.bar->SetTitle((f.name + (f.units.empty() ? "" : " (" + f.units + ")")).c_str());
   }
+  m.bar->SetDrawBelowRangeSwatch(m.clipped[0]);
+  m.bar->SetDrawAboveRangeSwatch(m.clipped[1]);
+  m.bar->Modified();
   m.lut->SetNanColor(0.45, 0.45, 0.45, 1.0);
   m.lut->Build();
   m.lut->Modified();
@@ -393,9 +618,9 @@ void Scene::update_status() {
                                       lod_.factor, lod_.coarse_nx, lod_.coarse_ny);
   const std::string name = std::filesystem::path(data_.path()).filename().string();
   const std::string units = f.units.empty() || f.units == "1" ? "" : " (" + f.units + ")";
-  m.status->SetInput(fmt::format("{}   {}{}   t = {:g} s [{}/{}]   z x{:.3g}   {}", name, f.name,
-                                 units, times[time_index_], time_index_ + 1, times.size(),
-                                 exaggeration_, lod)
+  m.status->SetInput(fmt::format("{}   {}{}   t = {:g} s (snapshot {} of 0..{})   z x{:.3g}   {}",
+                                 name, f.name, units, times[time_index_], time_index_,
+                                 times.size() - 1, exaggeration_, lod)
                          .c_str());
 }
 
@@ -419,6 +644,7 @@ void Scene::set_exaggeration(double e) {
   m.terrain_actor->SetScale(1.0, 1.0, exaggeration_);
   m.interaction_actor->SetScale(1.0, 1.0, exaggeration_);
   m.water_actor->SetScale(1.0, 1.0, exaggeration_);
+  place_marker();
   update_status();
 }
 
@@ -458,6 +684,125 @@ void Scene::reset_camera(bool top_view) {
   m.renderer->ResetCamera();
   cam->Zoom(top_view ? 1.05 : 1.3);
   m.renderer->ResetCameraClippingRange();
+}
+
+void Scene::place_marker() {
+  auto& m = *impl_;
+  m.marker_actor->SetVisibility(m.has_pick);
+  m.pin_actor->SetVisibility(m.has_pick);
+  if (!m.has_pick) return;
+  const double r = 0.02 * m.extent;
+  const double x = m.pick_point[0], y = m.pick_point[1], z = m.pick_point[2] * exaggeration_;
+  m.marker_sphere->SetCenter(x, y, z);
+  m.marker_sphere->SetRadius(r);
+  m.pin->SetPoint1(x, y, z);
+  m.pin->SetPoint2(x, y, z + 8.0 * r);
+}
+
+void Scene::show_series(int col, int row) {
+  auto& m = *impl_;
+  m.chart->ClearPlots();
+  m.chart_renderer->SetDraw(false);
+  if (data_.times().size() < 2) return;
+  struct Curve {
+    const char* field;
+    const char* label;
+    std::array<unsigned char, 3> rgb;
+    int corner;  // 0: left axis, 1: right axis
+  };
+  std::vector<Curve> curves;
+  for (const Curve& c :
+       {Curve{"water_depth", "depth (m)", {13, 115, 255}, 0},
+        Curve{"speed", "speed (m/s)", {230, 120, 20}, 0}, Curve{"bed", "bed (m)", {90, 60, 40}, 1}})
+    if (data_.has_field(c.field)) curves.push_back(c);
+  if (curves.empty()) return;
+  std::vector<std::string> names;
+  for (const auto& c : curves) names.emplace_back(c.field);
+  const auto series = data_.cell_series(col, row, names);
+  m.series->Initialize();
+  vtkNew<vtkDoubleArray> t;
+  t->SetName("t (s)");
+  for (const auto& s : series) t->InsertNextValue(s.time);
+  m.series->AddColumn(t);
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    vtkNew<vtkDoubleArray> v;
+    v->SetName(curves[k].label);
+    for (const auto& s : series) v->InsertNextValue(s.values[k].second);
+    m.series->AddColumn(v);
+    vtkPlot* plot = m.chart->AddPlot(vtkChart::LINE);
+    plot->SetInputData(m.series, 0, static_cast<vtkIdType>(k + 1));
+    plot->SetColor(curves[k].rgb[0], curves[k].rgb[1], curves[k].rgb[2], 255);
+    plot->SetWidth(2.5);
+    m.chart->SetPlotCorner(plot, curves[k].corner);
+  }
+  m.chart->SetTitle(fmt::format("cell (col {}, row {})", col, row));
+  m.chart->RecalculateBounds();
+  m.chart_renderer->SetDraw(true);
+}
+
+void Scene::update_overlays() {
+  auto& m = *impl_;
+  auto* ren = m.renderer.Get();
+  const int* size = ren->GetSize();
+  const double w = size[0], h = size[1];
+  if (w < 2 || h < 2) return;
+  auto* cam = ren->GetActiveCamera();
+  double f[3], up[3], dop[3];
+  cam->GetFocalPoint(f);
+  cam->GetViewUp(up);
+  cam->GetDirectionOfProjection(dop);
+  const auto display = [&](double x, double y, double z) {
+    ren->SetWorldPoint(x, y, z, 1.0);
+    ren->WorldToDisplay();
+    double d[3];
+    ren->GetDisplayPoint(d);
+    return std::array<double, 2>{d[0], d[1]};
+  };
+  // The screen's horizontal on the ground: direction of projection x view up, made level.
+  double right[3] = {dop[1] * up[2] - dop[2] * up[1], dop[2] * up[0] - dop[0] * up[2], 0.0};
+  double len = std::hypot(right[0], right[1]);
+  if (!(len > 1e-9)) right[0] = 1.0, right[1] = 0.0, len = 1.0;
+  const double probe = 0.01 * m.extent;
+  const auto c = display(f[0], f[1], f[2]);
+  const auto e = display(f[0] + probe * right[0] / len, f[1] + probe * right[1] / len, f[2]);
+  const auto n = display(f[0], f[1] + probe, f[2]);
+  const double px_per_m = std::hypot(e[0] - c[0], e[1] - c[1]) / probe;
+  if (!(px_per_m > 0.0) || !std::isfinite(px_per_m)) return;
+  m.scale.metres = nice_length(0.2 * w / px_per_m);
+  m.scale.pixels = m.scale.metres * px_per_m;
+  m.scale.north_degrees = std::atan2(n[0] - c[0], n[1] - c[1]) * 180.0 / M_PI;
+
+  vtkNew<vtkPoints> pts;
+  vtkNew<vtkCellArray> polys, lines;
+  const auto add = [&](double x, double y) { return pts->InsertNextPoint(x, y, 0.0); };
+  // Scale bar, bottom right: a 6-pixel bar with ticks, its length above.
+  const double x1 = w - 20.0, x0 = x1 - m.scale.pixels, y0 = 22.0;
+  const vtkIdType q[4] = {add(x0, y0), add(x1, y0), add(x1, y0 + 6.0), add(x0, y0 + 6.0)};
+  polys->InsertNextCell(4, q);
+  for (double x : {x0, 0.5 * (x0 + x1), x1}) {
+    const vtkIdType t[2] = {add(x, y0 - 4.0), add(x, y0 + 10.0)};
+    lines->InsertNextCell(2, t);
+  }
+  m.scale_text->SetInput(m.scale.metres >= 1000.0
+                             ? fmt::format("{:g} km", m.scale.metres / 1000.0).c_str()
+                             : fmt::format("{:g} m", m.scale.metres).c_str());
+  m.scale_text->SetDisplayPosition(static_cast<int>(0.5 * (x0 + x1)), static_cast<int>(y0 + 12.0));
+  // North arrow, left of the scale bar: a shaft and a head along north on screen, "N" at
+  // its tip.
+  const double a = m.scale.north_degrees * M_PI / 180.0, L = 36.0;
+  const double ux = std::sin(a), uy = std::cos(a), cx = x0 - 35.0, cy = y0 + 16.0;
+  const double tx = cx + 0.5 * L * ux, ty = cy + 0.5 * L * uy;
+  const vtkIdType shaft[2] = {add(cx - 0.5 * L * ux, cy - 0.5 * L * uy), add(tx, ty)};
+  lines->InsertNextCell(2, shaft);
+  const vtkIdType head[3] = {add(tx, ty), add(tx - 14.0 * ux - 7.0 * uy, ty - 14.0 * uy + 7.0 * ux),
+                             add(tx - 14.0 * ux + 7.0 * uy, ty - 14.0 * uy - 7.0 * ux)};
+  polys->InsertNextCell(3, head);
+  m.north_text->SetDisplayPosition(static_cast<int>(tx + 16.0 * ux),
+                                   static_cast<int>(ty + 16.0 * uy - 8.0));
+  m.overlay->SetPoints(pts);
+  m.overlay->SetPolys(polys);
+  m.overlay->SetLines(lines);
+  m.overlay->Modified();
 }
 
 void Scene::orbit(double degrees) {
@@ -507,6 +852,10 @@ std::optional<PickResult> Scene::pick(double px, double py) {
   }
   r.cell = data_.cell_values(col, row, time_index_);
   m.pick_text->SetInput(describe_pick(data_, r.cell).c_str());
+  m.has_pick = true;
+  m.pick_point = {r.world[0], r.world[1], r.world[2] / exaggeration_};
+  place_marker();
+  show_series(col, row);
   return r;
 }
 

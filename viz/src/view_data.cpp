@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <optional>
 
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
@@ -134,6 +136,34 @@ std::size_t ViewData::time_index(double time) const {
               fmt::format("{}: no snapshot at t = {:g} s (stored: {} s)", path_, time, list));
 }
 
+std::size_t ViewData::nearest_time_index(double time) const {
+  if (!std::isfinite(time))
+    throw Error(ExitCode::usage, fmt::format("--time: expected a finite time (s), got {}", time));
+  double gap = 0.0;
+  for (std::size_t k = 1; k < times_.size(); ++k) gap = std::max(gap, times_[k] - times_[k - 1]);
+  const double slack = std::max(gap, 1e-9 * std::max(1.0, std::abs(time)));
+  if (time < times_.front() - slack || time > times_.back() + slack)
+    throw Error(ExitCode::data,
+                fmt::format("{}: t = {:g} s is outside the stored times ({:g} .. {:g} s, {} "
+                            "snapshot{})",
+                            path_, time, times_.front(), times_.back(), times_.size(),
+                            times_.size() == 1 ? "" : "s"));
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < times_.size(); ++k)
+    if (std::abs(times_[k] - time) < std::abs(times_[best] - time)) best = k;
+  return best;
+}
+
+std::size_t ViewData::snapshot_index(long k) const {
+  const long n = static_cast<long>(times_.size());
+  if (k < -n || k >= n)
+    throw Error(ExitCode::usage,
+                fmt::format("--snapshot {}: out of range ({} snapshot{}: 0..{}, or -{}..-1 from "
+                            "the end)",
+                            k, n, n == 1 ? "" : "s", n - 1, n));
+  return static_cast<std::size_t>(k < 0 ? n + k : k);
+}
+
 bool ViewData::bed_varies() const {
   return reader_ && stored("bed") && times_.size() > 1;
 }
@@ -207,6 +237,70 @@ CellValues ViewData::cell_values(int col, int row, std::size_t index) {
     c.values.emplace_back(f.name, v);
   }
   return c;
+}
+
+std::vector<CellValues> ViewData::cell_series(int col, int row,
+                                              const std::vector<std::string>& names) {
+  const std::size_t i = static_cast<std::size_t>(row) * grid_.nx + col;
+  std::vector<std::string> wanted = names;
+  if (wanted.empty())
+    for (const auto& f : fields_) wanted.push_back(f.name);
+  for (const auto& n : wanted) field(n);  // unknown -> Error
+  std::vector<CellValues> series;
+  for (std::size_t k = 0; k < times_.size(); ++k) {
+    CellValues c;
+    c.col = col;
+    c.row = row;
+    const auto p = grid_.cell_center(col, row);
+    c.x = p[0];
+    c.y = p[1];
+    c.time = times_[k];
+    for (const auto& n : wanted) {
+      const auto it = cache_.find(std::make_pair(n, k));
+      const double v = it != cache_.end() ? it->second[i] : compute(n, k)[i];
+      c.values.emplace_back(n, v);
+    }
+    series.push_back(std::move(c));
+  }
+  return series;
+}
+
+std::array<double, 2> ViewData::held_color_range(const std::string& name, ColorMap map) {
+  field(name);  // unknown -> Error
+  const auto key = std::make_pair(name, map);
+  if (auto it = held_ranges_.find(key); it != held_ranges_.end()) return it->second;
+  // The values of every snapshot pooled (every k-th cell when that would pass kPoolValues),
+  // and the map's range of the pool: the percentiles of the whole run. (A union of the
+  // snapshots' own ranges would let an early snapshot with a few large values, such as
+  // the first slope collapses, set the range for the whole run.)
+  constexpr std::size_t kPoolValues = 4'000'000;
+  const std::size_t cells = static_cast<std::size_t>(grid_.nx) * static_cast<std::size_t>(grid_.ny);
+  const std::size_t n = map == ColorMap::classes ? 1 : times_.size();
+  const std::size_t stride = std::max<std::size_t>(1, (n * cells + kPoolValues - 1) / kPoolValues);
+  // The minimum and maximum are exact (a sampled pool could miss the extreme cell and then
+  // mark the bar as clipped where nothing is).
+  std::vector<float> pool;
+  pool.reserve(n * ((cells + stride - 1) / stride));
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto it = cache_.find(std::make_pair(name, k));
+    const std::vector<float> computed =
+        it != cache_.end() ? std::vector<float>{} : compute(name, k);
+    const std::vector<float>& v = it != cache_.end() ? it->second : computed;
+    for (std::size_t i = 0; i < v.size(); i += stride) pool.push_back(v[i]);
+    for (float x : v)
+      if (std::isfinite(x)) {
+        lo = std::min(lo, static_cast<double>(x));
+        hi = std::max(hi, static_cast<double>(x));
+      }
+  }
+  std::optional<std::array<double, 2>> r = data_color_range(map, pool);
+  if (r && map != ColorMap::diverging && map != ColorMap::classes) {
+    (*r)[0] = lo;
+    if (map == ColorMap::terrain) (*r)[1] = hi;
+  }
+  if (!r) r = color_range(map, values(name, times_.size() - 1));
+  return held_ranges_[key] = *r;
 }
 
 std::string ViewData::describe() const {

@@ -10,14 +10,17 @@
 #include <vtkPointData.h>
 #include <vtkUnsignedCharArray.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 
+#include "erodem/error.hpp"
 #include "erodem/io/results.hpp"
 #include "erodem/viz/colormap.hpp"
 #include "erodem/viz/frame.hpp"
@@ -124,6 +127,37 @@ TEST(VizColor, RangesAndMaps) {
   EXPECT_GT(mid[0] + mid[1] + mid[2], 2.8);
   EXPECT_NE(color_at(ColorMap::diverging, 0.0), color_at(ColorMap::diverging, 1.0));
   EXPECT_EQ(color_at(ColorMap::classes, 2.0 / 4.0), color_stops(ColorMap::classes)[2].rgb);
+}
+
+TEST(VizColor, NamesHeldRangesAndTheDivergingQuantile) {
+  // --cmap names round-trip; an unknown one is a usage error listing them.
+  for (const auto& name : color_map_names())
+    EXPECT_EQ(color_map_name(color_map_by_name(name)), name);
+  try {
+    color_map_by_name("jet");
+    ADD_FAILURE() << "no error for 'jet'";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::usage);
+    EXPECT_NE(std::string(e.what()).find("diverging"), std::string::npos) << e.what();
+  }
+  // No range of its own: all zero, constant, no data.
+  EXPECT_FALSE(data_color_range(ColorMap::diverging, {0.f, 0.f}));
+  EXPECT_FALSE(data_color_range(ColorMap::water, {0.2f, 0.2f}));
+  EXPECT_FALSE(data_color_range(ColorMap::speed, {NAN}));
+  // The diverging range is the kDivergingQuantile quantile of |v| over non-zero values:
+  // 1..100 (and zeros, ignored) -> 90, whatever the sign.
+  std::vector<float> v(150, 0.f);
+  for (int k = 1; k <= 100; ++k) v[static_cast<std::size_t>(k)] = (k % 2 ? 1.f : -1.f) * k;
+  const auto d = color_range(ColorMap::diverging, v);
+  std::printf("diverging range of +-1..100 with 50 zeros: [%g, %g] (quantile %g)\n", d[0], d[1],
+              kDivergingQuantile);
+  EXPECT_EQ(d[1], -d[0]);
+  EXPECT_NEAR(d[1], 1.0 + std::ceil(kDivergingQuantile * 99.0), 1e-12);
+  // No blue in the diverging map: the water's blue stays distinct from deposition.
+  for (double t = 0.0; t <= 1.0; t += 0.05) {
+    const auto c = color_at(ColorMap::diverging, t);
+    EXPECT_FALSE(c[2] > c[0] + 0.1 && c[2] > c[1] + 0.1 && c[0] < 0.2) << "t = " << t;
+  }
 }
 
 TEST(VizTerrainClass, SnowWaterRockMudGrass) {
@@ -266,6 +300,56 @@ every = 40
 fields = ["bed", "water_depth", "sediment", "velocity_x", "velocity_y", "erosion"]
 )";
 
+// Deep water: the hill under 0.5 m, draining to its foot (the tests of the water overlay).
+const char* kWetConfig = R"([dem]
+path = "hill.tif"
+[initial]
+water_depth = 0.5
+[time]
+steps = 60
+dt = 1.0
+[boundary]
+east = "open"
+[output]
+path = "wet.h5"
+every = 20
+fields = ["bed", "water_depth", "velocity_x", "velocity_y"]
+)";
+
+/// The display position `erodem view --pick` reports on stderr ("picked at display (x, y)").
+std::array<double, 2> picked_display(const std::string& output) {
+  const std::regex re("picked at display \\(([-0-9.]+), ([-0-9.]+)\\)");
+  std::smatch m;
+  if (!std::regex_search(output, m, re)) return {NAN, NAN};
+  return {std::stod(m[1]), std::stod(m[2])};
+}
+
+/// RGB of pixel (x, y) in display coordinates (origin bottom left, as VTK reads a PNG).
+std::array<int, 3> pixel(const Image& im, double x, double y) {
+  const int i = static_cast<int>(std::lround(x)), j = static_cast<int>(std::lround(y));
+  const std::size_t k = (static_cast<std::size_t>(j) * im.width + i) * 3;
+  if (i < 0 || j < 0 || i >= im.width || j >= im.height) return {-1, -1, -1};
+  return {im.rgb[k], im.rgb[k + 1], im.rgb[k + 2]};
+}
+
+/// Pixels of the image with x >= x0 within `tol` of `rgb` (0..255) in every channel.
+std::size_t count_colour(const Image& im, int x0, std::array<int, 3> rgb, int tol) {
+  std::size_t n = 0;
+  for (int j = 0; j < im.height; ++j)
+    for (int i = x0; i < im.width; ++i) {
+      const std::size_t k = (static_cast<std::size_t>(j) * im.width + i) * 3;
+      if (std::abs(im.rgb[k] - rgb[0]) <= tol && std::abs(im.rgb[k + 1] - rgb[1]) <= tol &&
+          std::abs(im.rgb[k + 2] - rgb[2]) <= tol)
+        ++n;
+    }
+  return n;
+}
+
+std::array<int, 3> rgb255(const std::array<double, 3>& c) {
+  return {static_cast<int>(c[0] * 255.0), static_cast<int>(c[1] * 255.0),
+          static_cast<int>(c[2] * 255.0)};
+}
+
 }  // namespace
 
 class View : public ::testing::Test {
@@ -279,6 +363,9 @@ class View : public ::testing::Test {
     std::ofstream(dir_ / "c.toml") << kRunConfig;
     const auto r = run_view_cli("run c.toml --backend cpu", dir_, false);
     ASSERT_EQ(r.code, 0) << r.output;
+    std::ofstream(dir_ / "wet.toml") << kWetConfig;
+    const auto w = run_view_cli("run wet.toml --backend cpu", dir_, false);
+    ASSERT_EQ(w.code, 0) << w.output;
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -495,6 +582,12 @@ TEST_F(View, ErrorsNameWhatIsMissing) {
   for (const Case& c :
        {Case{"view run.h5 --field nosuch --screenshot x.png", 65, "nosuch"},
         Case{"view run.h5 --time 12345 --screenshot x.png", 65, "12345"},
+        Case{"view run.h5 --snapshot 4 --screenshot x.png", 2, "--snapshot"},
+        Case{"view run.h5 --snapshot -5 --screenshot x.png", 2, "--snapshot"},
+        Case{"view run.h5 --time 40 --snapshot 1 --screenshot x.png", 2, "--snapshot"},
+        Case{"view run.h5 --cmap jet --screenshot x.png", 2, "jet"},
+        Case{"view run.h5 --clim 1,-1 --screenshot x.png", 2, "--clim"},
+        Case{"view run.h5 --series s.csv --screenshot x.png", 2, "--series"},
         Case{"view missing.h5 --screenshot x.png", 66, "missing.h5"},
         Case{"view run.h5 --size 12 --screenshot x.png", 2, "--size"},
         Case{"view run.h5 --pick 1e9,1e9", 2, "--pick"},
@@ -507,4 +600,317 @@ TEST_F(View, ErrorsNameWhatIsMissing) {
     EXPECT_NE(r.output.find(c.names), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir_ / "x.png"));
   }
+}
+
+TEST_F(View, TimeTakesTheNearestSnapshotAndSnapshotCounts) {
+  // Snapshots at 0, 40, 80, 120 s: 50 s is nearest to 40 s (snapshot 1), 119.5 s to 120 s;
+  // an exact time says nothing; --snapshot -2 is 80 s.
+  struct Case {
+    std::string args, want_stdout, want_stderr;
+  };
+  for (const Case& c :
+       {Case{"--time 50", "at t = 40 s", "nearest snapshot, 1 of 0..3 at t = 40 s"},
+        Case{"--time 119.5", "at t = 120 s", "nearest snapshot, 3 of 0..3"},
+        Case{"--time 80", "at t = 80 s", ""}, Case{"--snapshot -2", "at t = 80 s", ""},
+        Case{"--snapshot 0", "at t = 0 s", ""}}) {
+    const auto r = run_view_cli(
+        "view run.h5 " + c.args + " --screenshot t.png --size 160x120 --overwrite", dir_);
+    std::printf("erodem view %s -> %s", c.args.c_str(), r.output.c_str());
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find(c.want_stdout), std::string::npos) << c.args;
+    if (c.want_stderr.empty())
+      EXPECT_EQ(r.output.find("nearest snapshot"), std::string::npos) << c.args;
+    else
+      EXPECT_NE(r.output.find(c.want_stderr), std::string::npos) << c.args;
+  }
+}
+
+TEST_F(View, ColourRangeIsHeldOverTimeAndClippedEndsAreMarked) {
+  const std::string common = " --size 400x300 --top --overwrite";
+  const auto range = [](const std::string& out) {
+    const std::regex re("range ([-0-9.e+]+) \\.\\. ([-0-9.e+]+)");
+    std::smatch m;
+    return std::regex_search(out, m, re) ? std::array<double, 2>{std::stod(m[1]), std::stod(m[2])}
+                                         : std::array<double, 2>{NAN, NAN};
+  };
+  // Held: the same range at snapshots 1 and 3; --rescale: each snapshot its own.
+  const auto h1 = run_view_cli(
+      "view run.h5 --field water_depth --snapshot 1 --screenshot h1.png" + common, dir_);
+  const auto h3 = run_view_cli(
+      "view run.h5 --field water_depth --snapshot 3 --screenshot h3.png" + common, dir_);
+  const auto r1 = run_view_cli(
+      "view run.h5 --field water_depth --snapshot 1 --rescale --screenshot r1.png" + common, dir_);
+  const auto r3 = run_view_cli(
+      "view run.h5 --field water_depth --snapshot 3 --rescale --screenshot r3.png" + common, dir_);
+  for (const auto* r : {&h1, &h3, &r1, &r3}) ASSERT_EQ(r->code, 0) << r->output;
+  std::printf("held: %g .. %g and %g .. %g; rescaled: %g .. %g and %g .. %g m\n",
+              range(h1.output)[0], range(h1.output)[1], range(h3.output)[0], range(h3.output)[1],
+              range(r1.output)[0], range(r1.output)[1], range(r3.output)[0], range(r3.output)[1]);
+  EXPECT_EQ(range(h1.output), range(h3.output));
+  EXPECT_NE(range(r1.output), range(r3.output));
+  // The held range is the map's range of all snapshots' values pooled: here min .. the 99th
+  // percentile of water_depth over the 4 snapshots.
+  io::ResultReader reader((dir_ / "run.h5").string());
+  std::vector<float> pool;
+  for (std::size_t k = 0; k < reader.times().size(); ++k) {
+    const auto v = reader.read_index("water_depth", k);
+    pool.insert(pool.end(), v.begin(), v.end());
+  }
+  const auto want = color_range(ColorMap::water, pool);
+  std::printf("pooled over the snapshots: %.6g .. %.6g m\n", want[0], want[1]);
+  EXPECT_NEAR(range(h1.output)[0], want[0], 1e-5 * std::abs(want[1]));
+  EXPECT_NEAR(range(h1.output)[1], want[1], 1e-5 * std::abs(want[1]));
+  // --clim inside the erosion's range on both sides (half its minimum and maximum at the last
+  // snapshot): triangles in the end colours beside the bar (x >= 84 % of the width, where
+  // the top view has no terrain); a --clim wider than the data: none.
+  const auto e = reader.read_index("erosion", reader.times().size() - 1);
+  float e_lo = 0.f, e_hi = 0.f;
+  for (float v : e)
+    if (std::isfinite(v)) e_lo = std::min(e_lo, v), e_hi = std::max(e_hi, v);
+  ASSERT_LT(e_lo, 0.f);
+  ASSERT_GT(e_hi, 0.f);
+  char clim[64];
+  std::snprintf(clim, sizeof clim, "%.6g,%.6g", 0.5 * e_lo, 0.5 * e_hi);
+  std::printf("erosion %g .. %g m: --clim %s\n", e_lo, e_hi, clim);
+  const auto narrow = run_view_cli(std::string("view run.h5 --field erosion --clim ") + clim +
+                                       " --screenshot narrow.png" + common,
+                                   dir_);
+  const auto wide = run_view_cli(
+      "view run.h5 --field erosion --clim -100,100 --screenshot wide.png" + common, dir_);
+  ASSERT_EQ(narrow.code, 0) << narrow.output;
+  ASSERT_EQ(wide.code, 0) << wide.output;
+  std::printf("%s%s", narrow.output.c_str(), wide.output.c_str());
+  EXPECT_NE(narrow.output.find("clipped below: yes, above: yes"), std::string::npos);
+  EXPECT_NE(wide.output.find("clipped below: no, above: no"), std::string::npos);
+  const Image n = read_png(dir_ / "narrow.png"), w = read_png(dir_ / "wide.png");
+  const auto lo = rgb255(color_at(ColorMap::diverging, 0.0)),
+             hi = rgb255(color_at(ColorMap::diverging, 1.0));
+  const int x0 = static_cast<int>(0.84 * 400);
+  const std::size_t n_lo = count_colour(n, x0, lo, 3), n_hi = count_colour(n, x0, hi, 3),
+                    w_lo = count_colour(w, x0, lo, 3), w_hi = count_colour(w, x0, hi, 3);
+  std::printf(
+      "end-colour pixels right of x = %d: clipped %zu below, %zu above; not clipped %zu, %zu\n", x0,
+      n_lo, n_hi, w_lo, w_hi);
+  EXPECT_GT(n_lo, w_lo + 40) << "no triangle below the bar";
+  EXPECT_GT(n_hi, w_hi + 40) << "no triangle above the bar";
+}
+
+TEST_F(View, ErosionMapColoursTheBulkAndWaterIsBlue) {
+  // Erosion at the last snapshot, from the file: the cells at the 75th and 90th percentiles
+  // of |erosion| (non-zero) must be coloured (saturation > 40 of 255) in the erosion map,
+  // orange where the bed was lowered, purple where it was raised. (The median is printed.)
+  io::ResultReader reader((dir_ / "run.h5").string());
+  const Grid& g = reader.grid();
+  const auto last = reader.times().size() - 1;
+  const auto e = reader.read_index("erosion", last);
+  std::vector<std::pair<float, std::size_t>> mag;
+  for (std::size_t i = 0; i < e.size(); ++i)
+    if (std::isfinite(e[i]) && e[i] != 0.f) mag.emplace_back(std::abs(e[i]), i);
+  ASSERT_GT(mag.size(), 100u);
+  std::sort(mag.begin(), mag.end());
+  const std::string top = " --field erosion --top --no-water --size 400x400 --overwrite";
+  const auto shot = run_view_cli("view run.h5 --screenshot ero.png" + top, dir_);
+  ASSERT_EQ(shot.code, 0) << shot.output;
+  std::printf("%s", shot.output.c_str());
+  const Image im = read_png(dir_ / "ero.png");
+  for (double q : {0.5, 0.75, 0.9}) {
+    const std::size_t i = mag[static_cast<std::size_t>(q * (mag.size() - 1))].second;
+    const int col = static_cast<int>(i % g.nx), row = static_cast<int>(i / g.nx);
+    const auto p = g.cell_center(col, row);
+    const auto r = run_view_cli(
+        "view run.h5 --pick " + std::to_string(p[0]) + "," + std::to_string(p[1]) + top, dir_);
+    ASSERT_EQ(r.code, 0) << r.output;
+    const auto d = picked_display(r.output);
+    const auto c = pixel(im, d[0], d[1]);
+    const int sat = std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]});
+    std::printf(
+        "|erosion| quantile %.2f: cell (%d, %d) erosion %.4g m at display (%.0f, %.0f): "
+        "rgb (%d, %d, %d), saturation %d\n",
+        q, col, row, e[i], d[0], d[1], c[0], c[1], c[2], sat);
+    if (q < 0.7) continue;
+    EXPECT_GT(sat, 40) << "pale (white) at a typical erosion value";
+    if (e[i] > 0)
+      EXPECT_GT(c[0], c[2]) << "erosion should be orange";
+    else
+      EXPECT_GT(c[2], c[1]) << "deposition should be purple";
+  }
+
+  // Water: a cell 0.3 m deep or more in wet.h5 is blue with the water drawn, and its terrain
+  // colour (not blue) with --no-water.
+  io::ResultReader wet((dir_ / "wet.h5").string());
+  const auto depth = wet.read_index("water_depth", wet.times().size() - 1);
+  std::size_t deep = 0;
+  for (std::size_t i = 0; i < depth.size(); ++i)
+    if (std::isfinite(depth[i]) && depth[i] > depth[deep]) deep = i;
+  // A deep cell away from the edge (the mesh stops at the outer cell centres).
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    const int c = static_cast<int>(i % g.nx), r = static_cast<int>(i / g.nx);
+    if (c > 4 && r > 4 && c < g.nx - 5 && r < g.ny - 5 && depth[i] > 0.3f) {
+      deep = i;
+      break;
+    }
+  }
+  ASSERT_GT(depth[deep], 0.3f);
+  const int col = static_cast<int>(deep % g.nx), row = static_cast<int>(deep / g.nx);
+  const auto p = g.cell_center(col, row);
+  const std::string at = std::to_string(p[0]) + "," + std::to_string(p[1]);
+  const std::string common = " --field bed --top --size 400x400 --overwrite";
+  const auto pk = run_view_cli("view wet.h5 --pick " + at + common, dir_);
+  const auto with = run_view_cli("view wet.h5 --screenshot water.png" + common, dir_);
+  const auto without = run_view_cli("view wet.h5 --no-water --screenshot dry.png" + common, dir_);
+  for (const auto* r : {&pk, &with, &without}) ASSERT_EQ(r->code, 0) << r->output;
+  const auto d = picked_display(pk.output);
+  const auto a = pixel(read_png(dir_ / "water.png"), d[0], d[1]),
+             b = pixel(read_png(dir_ / "dry.png"), d[0], d[1]);
+  std::printf(
+      "cell (%d, %d), %.3f m deep, at display (%.0f, %.0f): water rgb (%d, %d, %d), "
+      "--no-water rgb (%d, %d, %d)\n",
+      col, row, depth[deep], d[0], d[1], a[0], a[1], a[2], b[0], b[1], b[2]);
+  EXPECT_GT(a[2], a[0] + 80) << "water should be blue";
+  EXPECT_GT(a[2], a[1] + 30) << "water should be blue, not cyan or grey";
+  EXPECT_LT(b[2], b[1]) << "--no-water should show the terrain colour";
+}
+
+TEST_F(View, ScaleBarAndNorthArrowMatchTheRenderer) {
+  // Top view: two picks 40 cells apart along a row are (40 dx) m apart on the ground; their
+  // display positions must be (40 dx) * pixels / metres of the scale bar apart.
+  io::ResultReader reader((dir_ / "run.h5").string());
+  const Grid& g = reader.grid();
+  const std::string common = " --top --size 600x400";
+  const auto a = g.cell_center(12, 32), b = g.cell_center(52, 32);
+  const auto ra = run_view_cli(
+      "view run.h5 --pick " + std::to_string(a[0]) + "," + std::to_string(a[1]) + common, dir_);
+  const auto rb = run_view_cli(
+      "view run.h5 --pick " + std::to_string(b[0]) + "," + std::to_string(b[1]) + common, dir_);
+  ASSERT_EQ(ra.code, 0) << ra.output;
+  ASSERT_EQ(rb.code, 0) << rb.output;
+  const std::regex re("scale bar ([0-9.e+]+) m = ([0-9.]+) px; north ([-0-9.]+) deg");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(ra.output, m, re)) << ra.output;
+  const double metres = std::stod(m[1]), px = std::stod(m[2]), north = std::stod(m[3]);
+  const auto da = picked_display(ra.output), db = picked_display(rb.output);
+  const double ground = 40.0 * g.dx[32], on_screen = std::hypot(db[0] - da[0], db[1] - da[1]);
+  std::printf(
+      "scale bar %g m = %.2f px (%.5f px/m); picks %.1f m apart are %.2f px apart "
+      "(%.5f px/m); north %.1f deg\n",
+      metres, px, px / metres, ground, on_screen, on_screen / ground, north);
+  // Exact at the focal point's depth; the picked cells lie lower on the hill, further from the
+  // camera, so they are a little smaller on screen (perspective).
+  EXPECT_NEAR(px / metres, on_screen / ground, 0.03 * on_screen / ground);
+  EXPECT_NEAR(north, 0.0, 0.5);
+  // The bar is 10..20 % of the width (1, 2 or 5 times a power of ten).
+  EXPECT_GE(px, 0.08 * 600);
+  EXPECT_LE(px, 0.2 * 600 + 1);
+  // Oblique (from the south): north still points up the screen.
+  const auto ob = run_view_cli("view run.h5 --screenshot ob.png --size 600x400 --overwrite", dir_);
+  ASSERT_TRUE(std::regex_search(ob.output, m, re)) << ob.output;
+  std::printf("oblique: scale bar %s m = %s px, north %s deg\n", m[1].str().c_str(),
+              m[2].str().c_str(), m[3].str().c_str());
+  EXPECT_NEAR(std::stod(m[3]), 0.0, 0.5);
+  // The arrow and the bar are drawn: white pixels at the bar's place (bottom right) and at
+  // the arrow's (left of the bar).
+  const Image im = read_png(dir_ / "ob.png");
+  std::size_t arrow = 0, bar = 0;
+  for (int j = 0; j < im.height; ++j)
+    for (int i = 0; i < im.width; ++i) {
+      const auto c = pixel(im, i, j);
+      if (c[0] < 240 || c[1] < 240 || c[2] < 240) continue;
+      if (i > 600 - 20 - px - 60 && i < 600 - 20 - px - 10 && j < 70) ++arrow;
+      if (i > 600 - 20 - px - 2 && i < 600 - 18 && j >= 20 && j <= 30) ++bar;
+    }
+  std::printf("white pixels: north arrow %zu, scale bar %zu\n", arrow, bar);
+  EXPECT_GT(arrow, 60u);
+  EXPECT_GT(bar, 100u);
+}
+
+TEST_F(View, PickMarksTheCellAndWritesItsSeries) {
+  io::ResultReader reader((dir_ / "wet.h5").string());
+  const Grid& g = reader.grid();
+  const int col = 20, row = 40;
+  const auto p = g.cell_center(col, row);
+  const std::string at = std::to_string(p[0]) + "," + std::to_string(p[1]);
+  const auto r = run_view_cli("view wet.h5 --top --size 400x400 --overwrite --pick " + at +
+                                  " --series series.csv --screenshot marked.png",
+                              dir_);
+  const auto plain =
+      run_view_cli("view wet.h5 --top --size 400x400 --overwrite --screenshot plain.png", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(plain.code, 0) << plain.output;
+  std::printf("%s", r.output.c_str());
+  // The marker: magenta pixels within 15 px of the picked point, none without a pick.
+  const auto d = picked_display(r.output);
+  const auto magenta = [&](const Image& im) {
+    std::size_t n = 0;
+    for (int j = -15; j <= 15; ++j)
+      for (int i = -15; i <= 15; ++i) {
+        const auto c = pixel(im, d[0] + i, d[1] + j);
+        if (c[0] > 150 && c[2] > 150 && c[1] < 80) ++n;
+      }
+    return n;
+  };
+  const std::size_t marked = magenta(read_png(dir_ / "marked.png")),
+                    unmarked = magenta(read_png(dir_ / "plain.png"));
+  std::printf("magenta pixels around the pick: %zu marked, %zu without a pick\n", marked, unmarked);
+  EXPECT_GT(marked, 30u);
+  EXPECT_EQ(unmarked, 0u);
+  // The chart of the series (left, 42..82 % of the height, 36 % of the width): its light
+  // panel and the speed curve's orange, neither there without a pick.
+  const auto chart = [](const Image& im) {
+    std::array<std::size_t, 2> n{0, 0};
+    for (int j = static_cast<int>(0.45 * im.height); j < static_cast<int>(0.8 * im.height); ++j)
+      for (int i = 2; i < static_cast<int>(0.35 * im.width); ++i) {
+        const auto c = pixel(im, i, j);
+        if (std::abs(c[0] - 245) <= 3 && std::abs(c[1] - 245) <= 3 && std::abs(c[2] - 240) <= 3)
+          ++n[0];
+        if (std::abs(c[0] - 230) <= 25 && std::abs(c[1] - 120) <= 25 && c[2] <= 60) ++n[1];
+      }
+    return n;
+  };
+  const auto with_chart = chart(read_png(dir_ / "marked.png")),
+             no_chart = chart(read_png(dir_ / "plain.png"));
+  std::printf(
+      "chart region: %zu panel and %zu speed-curve pixels with a pick, %zu and %zu "
+      "without\n",
+      with_chart[0], with_chart[1], no_chart[0], no_chart[1]);
+  EXPECT_GT(with_chart[0], 10000u);
+  EXPECT_GT(with_chart[1], 30u);
+  EXPECT_EQ(no_chart[0], 0u);
+  EXPECT_EQ(no_chart[1], 0u);
+  // The series: one row per snapshot, equal to the file's values at the cell.
+  std::ifstream in(dir_ / "series.csv");
+  std::string header;
+  std::getline(in, header);
+  std::printf("series.csv: %s\n", header.c_str());
+  std::vector<std::string> names;
+  for (std::size_t a = 0; a <= header.size();) {
+    std::size_t b = header.find(',', a);
+    if (b == std::string::npos) b = header.size();
+    names.push_back(header.substr(a, b - a));
+    a = b + 1;
+  }
+  const auto column = [&](const std::string& n) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  ASSERT_LT(column("water_depth"), names.size());
+  ASSERT_LT(column("speed"), names.size());
+  ASSERT_LT(column("bed"), names.size());
+  const std::size_t i = static_cast<std::size_t>(row) * g.nx + col;
+  std::size_t rows = 0;
+  for (std::string line; std::getline(in, line); ++rows) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');)
+      v.push_back(cell.empty() ? NAN : std::stod(cell));
+    ASSERT_LT(rows, reader.times().size());
+    ASSERT_EQ(v.size(), names.size()) << line;
+    const auto depth = reader.read_index("water_depth", rows), bed = reader.read_index("bed", rows),
+               vx = reader.read_index("velocity_x", rows),
+               vy = reader.read_index("velocity_y", rows);
+    std::printf("  %s\n", line.c_str());
+    EXPECT_EQ(v[0], reader.times()[rows]);
+    EXPECT_EQ(static_cast<float>(v[column("water_depth")]), depth[i]);
+    EXPECT_EQ(static_cast<float>(v[column("bed")]), bed[i]);
+    EXPECT_FLOAT_EQ(static_cast<float>(v[column("speed")]), std::hypot(vx[i], vy[i]));
+  }
+  EXPECT_EQ(rows, reader.times().size());
 }

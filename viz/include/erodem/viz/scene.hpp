@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "erodem/viz/colormap.hpp"
 #include "erodem/viz/lod.hpp"
 #include "erodem/viz/view_data.hpp"
 
@@ -29,6 +30,21 @@ struct SceneOptions {
   int width = 1200, height = 800;  ///< window or image size (pixels)
   bool offscreen = false;          ///< render off screen (screenshots, --pick)
   bool top_view = false;           ///< look straight down (north up) instead of oblique
+  /// The colour map of `field` instead of its own (--cmap); other fields keep theirs.
+  std::optional<ColorMap> cmap;
+  /// The colour range of `field` (--clim LO,HI) instead of the computed one.
+  std::optional<std::array<double, 2>> clim;
+  /// Recompute the colour range at every snapshot (--rescale) instead of holding one range
+  /// over all snapshots (ViewData::held_color_range).
+  bool rescale = false;
+  bool water = true;  ///< draw the water surface (--no-water: false)
+};
+
+/// The scale bar and north arrow as last drawn: `metres` of ground (at the focal point,
+/// along the screen's horizontal) are `pixels` long on screen; north points
+/// `north_degrees` clockwise from straight up.
+struct ScaleBar {
+  double metres = 0.0, pixels = 0.0, north_degrees = 0.0;
 };
 
 /// A vertical exaggeration that makes the relief about 15 % of the horizontal extent,
@@ -60,6 +76,14 @@ class Scene {
   std::size_t time_index() const { return time_index_; }
   double exaggeration() const { return exaggeration_; }
   bool water_visible() const;
+  /// The colour map and range the terrain is drawn with now.
+  ColorMap color_map() const;
+  std::array<double, 2> color_limits() const;
+  /// Whether the current snapshot has values below / above the colour range (the bar then
+  /// shows a triangle at that end).
+  std::array<bool, 2> clipped() const;
+  /// The scale bar and north arrow as computed for the last render.
+  ScaleBar scale_bar() const;
 
   /// Colours the terrain by `name` (Error(data) when unknown).
   void set_field(const std::string& name);
@@ -79,12 +103,17 @@ class Scene {
 
   /// Renders once (off screen or in the window).
   void render();
+  /// Lays out the scale bar and north arrow for the current camera and window size; called
+  /// before each render (an observer of the renderer's StartEvent).
+  void update_overlays();
   /// Display position (pixels, origin bottom-left) of CRS point (x, y) on the terrain
   /// surface; nullopt when the point is outside the grid or on a nodata cell.
   std::optional<std::array<double, 2>> display_of(double x, double y);
   /// Picks the terrain at display position (px, py) with a vtkCellPicker and maps the hit
-  /// back to the full-resolution cell; nullopt when nothing is hit. Shows the values in the
-  /// pick overlay.
+  /// back to the full-resolution cell; nullopt when nothing is hit. Marks the cell (a
+  /// magenta pin), shows its values in the panel at the bottom left and, for a file with
+  /// several snapshots, its water depth, speed and bed over time in a chart (vtkChartXY)
+  /// above the panel.
   std::optional<PickResult> pick(double px, double py);
   /// Writes the current image as a PNG (through a temporary file in the same folder,
   /// renamed into place); Error(cant_create) or Error(io) naming `path` on failure.
@@ -102,7 +131,10 @@ class Scene {
   std::size_t time_index_ = 0;
   double exaggeration_ = 1.0;
   double water_threshold_ = 0.05;
+  SceneOptions options_;
   void rebuild_geometry();
+  void place_marker();
+  void show_series(int col, int row);
   void update_colors();
   void update_status();
 };

@@ -1,6 +1,7 @@
 // erodem viewer — what the viewer shows: a result file's (or a DEM's) fields over time.
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <string>
@@ -74,6 +75,13 @@ class ViewData {
   /// The index of stored time `time` (s), matched to 1e-9 relative; not stored ->
   /// Error(data) listing the stored times.
   std::size_t time_index(double time) const;
+  /// The index of the snapshot nearest to `time` (s; the earlier one on a tie). A time
+  /// further than the largest gap between snapshots before the first or after the last
+  /// (a single snapshot: further than 1e-9 relative) -> Error(data) with the stored range.
+  std::size_t nearest_time_index(double time) const;
+  /// The index of snapshot `k`: 0-based, negative counts from the end (-1 = the last);
+  /// out of range -> Error(usage) naming --snapshot and the range.
+  std::size_t snapshot_index(long k) const;
   /// Field `name` at snapshot `index` (row-major, NaN = nodata), cached.
   const std::vector<float>& values(const std::string& name, std::size_t index);
   /// The bed (m) at snapshot `index`: the stored bed, else the DEM's or the first stored.
@@ -82,6 +90,14 @@ class ViewData {
   bool bed_varies() const;
   /// Every field's value at cell (col, row) and snapshot `index`.
   CellValues cell_values(int col, int row, std::size_t index);
+  /// cell_values at every snapshot, in time order: the cell's time series, of the fields
+  /// `names` (in that order; empty: every field). Reads each snapshot once, around the cache.
+  std::vector<CellValues> cell_series(int col, int row, const std::vector<std::string>& names = {});
+  /// The colour range of field `name` under `map` held over all snapshots: color_range of
+  /// the values of all snapshots pooled, so the percentiles are the whole run's. Beyond 4 M
+  /// values in all the percentiles are taken of every k-th cell; the minimum and maximum
+  /// stay exact. Computed once per field and map, around the cache.
+  std::array<double, 2> held_color_range(const std::string& name, ColorMap map);
   /// A one-line description: file, grid size, CRS kind, number of snapshots.
   std::string describe() const;
   /// The rule of the terrain classes.
@@ -97,6 +113,7 @@ class ViewData {
   std::vector<float> dem_bed_;
   std::map<std::pair<std::string, std::size_t>, std::vector<float>> cache_;
   std::vector<std::pair<std::string, std::size_t>> cache_order_;
+  std::map<std::pair<std::string, ColorMap>, std::array<double, 2>> held_ranges_;
   bool stored(const std::string& name) const;
   std::vector<float> compute(const std::string& name, std::size_t index);
 };
