@@ -11,6 +11,7 @@
 #include <map>
 
 #include "commands.hpp"
+#include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 
 namespace erodem::cli {
@@ -23,6 +24,9 @@ bool stderr_is_terminal() {
 
 int main(int argc, char** argv) {
   using namespace erodem;
+  // Declared first, destroyed last: every OpenCL object is released before main returns, not
+  // in static destruction after the OpenCL implementation may have torn itself down.
+  const OpenClRuntimes opencl_runtimes;
   CLI::App app{"erodem — hydrology and hydraulic erosion on real terrain"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("erodem ") + ERODEM_VERSION);
