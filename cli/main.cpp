@@ -12,6 +12,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/results.hpp"
 
@@ -25,6 +26,9 @@ bool stderr_is_terminal() {
 
 int main(int argc, char** argv) {
   using namespace erodem;
+  // Declared first, destroyed last: every OpenCL object is released before main returns, not
+  // in static destruction after the OpenCL implementation may have torn itself down.
+  const OpenClRuntimes opencl_runtimes;
   io::skip_hdf5_exit_cleanup();  // one error line, not HDF5's page (corrupt result files)
   CLI::App app{"erodem — hydrology and hydraulic erosion on real terrain"};
   app.require_subcommand(1);

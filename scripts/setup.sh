@@ -14,6 +14,8 @@ DEBIAN_PACKAGES=(
   libgdal-dev gdal-bin libgeographiclib-dev
   libhdf5-dev hdf5-tools
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
+  # Oclgrind: the OpenCL kernels under its memory and data-race checks (ctest Oclgrind)
+  oclgrind
   # the VTK viewer (`erodem view`); VTK's CMake config also needs MPI (pulled in by
   # libvtk9-dev). xvfb-run (xvfb + xauth) and Mesa render it without a screen (tests).
   libvtk9-dev xvfb xauth libgl1-mesa-dri

@@ -118,7 +118,8 @@ std::size_t whole_row_group(std::size_t W, std::size_t limit);
 
 /// The runtime of the device chosen by ERODEM_OPENCL_DEVICE ("<platform>:<device>"
 /// substrings, case-insensitive; either may be empty), else the first GPU, else the first
-/// device; built once per process, device and launch kind. `row_width` is the padded row of
+/// device; built once per device and launch kind and kept (runtime.cpp) until
+/// release_opencl_runtimes(). `row_width` is the padded row of
 /// the grid to run: on CPU devices the kernels are built for whole-row launches when a
 /// work-group of at least min(32, row_width) divides it (and ERODEM_OPENCL_WG is not set).
 /// Throws Error(usage) when there is no device.

@@ -1,12 +1,14 @@
 // erodem — the OpenCL runtime of a device: the device ERODEM_OPENCL_DEVICE selects (else the
 // first GPU, else the first device), its context, the launch kind (whole rows on CPU devices)
-// and the build options, with the program built once per process, device and launch kind.
+// and the build options, with the program built once per device and launch kind and kept until
+// release_opencl_runtimes() (backends.hpp).
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <mutex>
+#include <vector>
 
 #include "erodem/error.hpp"
 #include "opencl/devices.hpp"
@@ -22,9 +24,28 @@ std::size_t whole_row_group(std::size_t W, std::size_t limit) {
   return 1;
 }
 
+namespace {
+
+using RuntimeMap = std::map<std::pair<cl_device_id, bool>, std::shared_ptr<Runtime> >;
+
+/// The runtimes built so far, by device and launch kind (whole rows or not).
+struct RuntimeCache {
+  std::mutex mutex;
+  RuntimeMap runtimes;
+};
+
+/// The process's cache, created on first use and never destroyed: its runtimes are released
+/// by release_opencl_runtimes() only, never by a static destructor, which would run after the
+/// OpenCL implementation may have begun its own teardown (backends.hpp).
+RuntimeCache& runtime_cache() {
+  static RuntimeCache* const cache = new RuntimeCache;
+  return *cache;
+}
+
+}  // namespace
+
 std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width) {
-  static std::mutex mutex;
-  static std::map<std::pair<cl_device_id, bool>, std::shared_ptr<Runtime> > cache;
+  RuntimeCache& cache = runtime_cache();
   const auto devices = enumerate_devices();
   if (devices.empty())
     throw Error(ExitCode::usage,
@@ -57,8 +78,8 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
   const bool whole_rows = chosen->info.type == "CPU" && !(wg_env && *wg_env) &&
                           whole_row_group(row_width, chosen->info.max_work_group) >=
                               std::min<std::size_t>(32, row_width);
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{chosen->device, whole_rows}];
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  auto& slot = cache.runtimes[{chosen->device, whole_rows}];
   if (slot) return slot;
   auto rt = std::make_shared<Runtime>();
   rt->info = chosen->info;
@@ -92,3 +113,21 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
 }
 
 }  // namespace erodem::opencl
+
+namespace erodem {
+
+std::size_t release_opencl_runtimes() {
+  opencl::RuntimeMap taken;
+  {
+    opencl::RuntimeCache& cache = opencl::runtime_cache();
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    taken.swap(cache.runtimes);
+  }
+  std::vector<std::weak_ptr<opencl::Runtime> > released;
+  for (const auto& entry : taken) released.push_back(entry.second);
+  taken.clear();  // the runtimes no backend holds: context and program released here
+  return static_cast<std::size_t>(
+      std::count_if(released.begin(), released.end(), [](const auto& w) { return !w.expired(); }));
+}
+
+}  // namespace erodem

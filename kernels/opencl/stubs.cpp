@@ -14,6 +14,9 @@ std::vector<ClDeviceInfo> list_opencl_devices() {
 bool opencl_available() {
   return false;
 }
+std::size_t release_opencl_runtimes() {
+  return 0;
+}
 std::unique_ptr<Backend> make_opencl_backend(const Terrain&, const Params&) {
   throw Error(ExitCode::usage,
               "backend 'opencl': this build has no OpenCL backend (configure with "

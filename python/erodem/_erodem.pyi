@@ -34,6 +34,10 @@ def resolve_config(config_path: str, settings: Settings) -> str:
     """The fully resolved configuration (TOML text) of a config file ("" for none) with
     ``settings`` (dotted key, TOML value text) applied and validated."""
 
+def release_opencl_runtimes() -> int:
+    """Releases the OpenCL contexts and programs kept for later simulations; returns how many
+    are still held by live simulations. Registered with ``atexit`` when the module loads."""
+
 class Terrain:
     """A DEM on its grid, read with its dem.* settings."""
 

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "erodem/backends.hpp"
 
 namespace py = pybind11;
 
@@ -20,4 +21,12 @@ PYBIND11_MODULE(_erodem, m) {
   erodem::python::add_schema_bindings(m);
   erodem::python::add_terrain_bindings(m);
   erodem::python::add_simulation_bindings(m);
+  // The OpenCL runtimes (contexts, built programs) that outlive the simulations are released
+  // at interpreter exit: atexit runs at the start of the interpreter's finalisation, long
+  // before the C++ static destructors, after which the OpenCL implementation may be gone
+  // (backends.hpp). A simulation still alive then releases its runtime with itself.
+  m.def("release_opencl_runtimes", &erodem::release_opencl_runtimes,
+        "Releases the OpenCL contexts and programs kept for later simulations; returns how many "
+        "are still held by live simulations. Called at interpreter exit.");
+  py::module_::import("atexit").attr("register")(m.attr("release_opencl_runtimes"));
 }

@@ -80,4 +80,28 @@ BackendChoice auto_backend_choice(const std::vector<ClDeviceInfo>& devices,
 /// Error(internal) with the build log when the kernels fail to build.
 std::unique_ptr<Backend> make_opencl_backend(const Terrain& terrain, const Params& params);
 
+/// Releases the OpenCL runtimes the backend keeps between backends: one context and built
+/// program per device and launch kind, so that a second backend on the device does not build
+/// the kernels again. A runtime that a live backend still uses is released with the last such
+/// backend; a backend made afterwards builds its runtime afresh. Returns the number of
+/// runtimes still held by live backends (0 once every backend is gone; 0 without OpenCL).
+///
+/// The runtimes are never released during static destruction: an OpenCL implementation may
+/// have begun its own teardown by then (Oclgrind aborted with "corrupted double-linked list"
+/// when the cache was a static object). A program calls this before it exits, through an
+/// OpenClRuntimes object in `main` (the CLI) or at interpreter exit (the Python module
+/// registers it with `atexit`); without the call the runtimes are left to the operating
+/// system at exit.
+std::size_t release_opencl_runtimes();
+
+/// Calls release_opencl_runtimes() when it goes out of scope: declared first in `main`, it
+/// releases every OpenCL object before `main` returns.
+class OpenClRuntimes {
+ public:
+  OpenClRuntimes() = default;
+  OpenClRuntimes(const OpenClRuntimes&) = delete;
+  OpenClRuntimes& operator=(const OpenClRuntimes&) = delete;
+  ~OpenClRuntimes() { release_opencl_runtimes(); }
+};
+
 }  // namespace erodem
