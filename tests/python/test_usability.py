@@ -1,0 +1,201 @@
+"""Issue 19, the Python user's day: DEM.from_array (numpy and xarray), checked field setters
+and step counts, sweeps run from stdin and unguarded scripts, resume, the sweep table and
+the console entry point."""
+
+import os
+import pickle
+
+import numpy as np
+import pytest
+
+from test_api import WINDOW, small_config
+
+
+def cone(n=48, cell=10.0, height=60.0):
+    """A cone-shaped hill on an n x n grid of `cell` m, its top in the middle."""
+    y, x = np.mgrid[0:n, 0:n]
+    r = np.hypot(x - (n - 1) / 2, y - (n - 1) / 2) * cell
+    return height - r * height / (n * cell / 2)
+
+
+# ---- DEM.from_array -----------------------------------------------------------------------
+
+
+def test_from_array_builds_a_simulation(erodem, tmp_path):
+    z = cone()
+    z[0, 0] = np.nan  # nodata
+    dem = erodem.DEM.from_array(z, cell_size=10.0, crs="EPSG:32611")
+    assert dem.shape == (48, 48) and dem.in_memory and not dem.is_geographic
+    assert np.allclose(dem.dx, 10.0) and np.allclose(dem.area, 100.0)
+    assert "UTM zone 11N" in dem.crs and dem.path.startswith("<array 48 x 48")
+    assert not dem.mask[0, 0] and dem.mask.sum() == 48 * 48 - 1
+    assert np.array_equal(dem.elevation[1:], z[1:].astype(np.float32))
+    sim = erodem.Simulation(dem, "cpu", time__steps=20, rain__rate="50 mm/h",
+                            numerics__threads=1)
+    sim.run(output=tmp_path / "cone.h5")
+    assert sim.steps_done == 20 and sim.ledger["water"] > 0
+    ds = erodem.open_run(tmp_path / "cone.h5")
+    assert ds.attrs["dem_sha256"] == dem.sha256 and ds.attrs["dem_path"] == dem.path
+    ds.close()
+    # pickles as its values (sweep workers), the same terrain again
+    again = pickle.loads(pickle.dumps(dem))
+    assert again.sha256 == dem.sha256
+    assert np.array_equal(again.elevation, dem.elevation, equal_nan=True)
+
+
+def test_from_array_same_terrain_as_read_dem(erodem, tujunga):
+    # the values, transform and CRS of a file give the terrain read_dem reads from it
+    f = erodem.read_dem(tujunga, window=WINDOW)
+    a = erodem.DEM.from_array(f.elevation, transform=f.transform, crs=f.crs)
+    assert np.array_equal(a.elevation, f.elevation, equal_nan=True)
+    assert a.transform == f.transform and a.crs == f.crs
+    assert np.array_equal(a.dx, f.dx) and np.array_equal(a.area, f.area)
+    # south-up rows (positive pixel height) are flipped to north-up
+    x0, px, _, y0, _, py = f.transform
+    s = erodem.DEM.from_array(f.elevation[::-1], transform=(x0, px, 0, y0 + 64 * py, 0, -py),
+                              crs=f.crs)
+    assert np.array_equal(s.elevation, f.elevation) and s.transform == f.transform
+
+
+def test_from_array_geographic_true_cell_sizes(erodem):
+    # a lat/lon file's terrain (ellipsoidal cell sizes by row, GeographicLib) is the one
+    # from_array builds from its values, transform and CRS
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data", "dem",
+                        "dfw", "dfw_srtm3.tif")
+    if not os.path.exists(path):
+        pytest.skip("missing " + path)
+    f = erodem.read_dem(path, window=[0, 0, 40, 30])
+    assert f.is_geographic
+    a = erodem.DEM.from_array(f.elevation, transform=f.transform, crs="EPSG:4326")
+    assert a.is_geographic
+    assert np.allclose(a.dx, f.dx, rtol=1e-12) and np.allclose(a.dy, f.dy, rtol=1e-12)
+    assert np.allclose(a.area, f.area, rtol=1e-12)
+    # 3 arc-seconds near 33 N: about 92.6 m north-south, 78 m east-west (not 3/3600 "m")
+    assert 90 < a.dy[0] < 95 and 70 < a.dx[0] < 85
+    with pytest.raises(ValueError, match="geographic"):
+        erodem.DEM.from_array(f.elevation, cell_size=90.0, crs="EPSG:4326")
+
+
+def test_from_dataarray(erodem):
+    xr = pytest.importorskip("xarray")
+    z = cone(n=30)
+    x = 500000.0 + 10.0 * np.arange(30) + 5.0
+    y = 3800000.0 + 10.0 * np.arange(30)[::-1] + 5.0  # north-up: y decreasing
+    da = xr.DataArray(z, dims=("y", "x"), coords={"y": y, "x": x},
+                      attrs={"crs": "EPSG:32611"})
+    dem = erodem.DEM.from_array(da)
+    assert dem.transform == (500000.0, 10.0, 0.0, 3800300.0, 0.0, -10.0)
+    assert "UTM zone 11N" in dem.crs and np.array_equal(dem.elevation, z.astype(np.float32))
+    # y increasing (south-up storage): the same DEM
+    up = da.isel(y=slice(None, None, -1))
+    assert erodem.DEM.from_array(up).sha256 == dem.sha256
+    # (x, y) order and a band of size 1, the CRS on a spatial_ref coordinate (CF / GDAL)
+    da2 = da.transpose("x", "y").expand_dims("band").copy()
+    da2.attrs = {}
+    da2 = da2.assign_coords(spatial_ref=xr.DataArray(0, attrs={"crs_wkt": dem.crs}))
+    assert erodem.DEM.from_array(da2).sha256 != ""  # builds
+    assert erodem.DEM.from_array(da2).transform == dem.transform
+    # Simulation takes the DataArray itself
+    sim = erodem.Simulation(da, "cpu", time__steps=2, numerics__threads=1)
+    assert sim.shape == (30, 30)
+    # irregular coordinates, lat/lon without a CRS
+    bad = da.assign_coords(x=x + np.r_[np.zeros(29), 3.0])
+    with pytest.raises(ValueError, match="coordinate 'x' is not regularly spaced"):
+        erodem.DEM.from_array(bad)
+    ll = xr.DataArray(z, dims=("lat", "lon"),
+                      coords={"lat": 34 - 0.001 * np.arange(30), "lon": -118 + 0.001 * np.arange(30)})
+    with pytest.raises(ValueError, match="EPSG:4326"):
+        erodem.DEM.from_array(ll)
+    g = erodem.DEM.from_array(ll, crs="EPSG:4326")
+    assert g.is_geographic and 90 < g.dx[0] < 93 and 110 < g.dy[0] < 112
+
+
+def test_from_array_rejects_bad_input(erodem):
+    z = cone(n=8)
+    with pytest.raises(ValueError, match="'z' must be a 2-D array"):
+        erodem.DEM.from_array(z[0], cell_size=1.0)
+    with pytest.raises(ValueError, match="'z' must hold real numbers"):
+        erodem.DEM.from_array(z.astype(complex), cell_size=1.0)
+    inf = z.copy()
+    inf[2, 3] = np.inf
+    with pytest.raises(ValueError, match="infinite values .*row 2, column 3"):
+        erodem.DEM.from_array(inf, cell_size=1.0)
+    with pytest.raises(ValueError, match="no finite value"):
+        erodem.DEM.from_array(np.full((4, 4), np.nan), cell_size=1.0)
+    with pytest.raises(ValueError, match="'cell_size' must be a positive"):
+        erodem.DEM.from_array(z, cell_size=-1.0)
+    with pytest.raises(ValueError, match="give 'cell_size' .* or 'transform'"):
+        erodem.DEM.from_array(z)
+    with pytest.raises(ValueError, match="not both"):
+        erodem.DEM.from_array(z, cell_size=1.0, transform=(0, 1, 0, 0, 0, -1))
+    with pytest.raises(ValueError, match="'transform'.*rotated"):
+        erodem.DEM.from_array(z, transform=(0, 1, 0.1, 0, 0, -1))
+    with pytest.raises(ValueError, match="'crs'"):
+        erodem.DEM.from_array(z, cell_size=1.0, crs="EPSG:999999")
+    with pytest.raises(ValueError, match="DEM.from_array"):
+        erodem.Simulation(z)
+    # nodata values become nodata; the caller's array is not changed
+    z9 = z.copy()
+    z9[0, :] = -9999.0
+    d = erodem.DEM.from_array(z9, cell_size=1.0, nodata=-9999)
+    assert not d.mask[0].any() and (z9[0] == -9999.0).all()
+    # parameter rasters need a file
+    with pytest.raises(ValueError, match="parameter 'flow.manning_n'.*from_array"):
+        erodem.Simulation(d, "cpu", flow__manning_n="n.tif")
+
+
+# ---- field setters and step counts --------------------------------------------------------
+
+
+def test_set_bed_resets_the_erosion_reference(erodem, tujunga):
+    dem = erodem.read_dem(tujunga, window=WINDOW)
+    sim = erodem.Simulation(dem, "cpu", time__steps=10, numerics__threads=1)
+    bed = sim.bed.copy()
+    bed[10:20, 10:20] -= 5.0  # dig a pit
+    sim.bed = bed
+    assert np.nanmax(np.abs(sim.erosion)) == 0.0  # the new reference, not erosion
+    assert np.allclose(sim.field("initial_bed"), bed, equal_nan=True)
+    # with reset_erosion=False the edit counts as erosion
+    bed[30:32, 30:32] -= 2.0
+    sim.set_field("bed", bed, reset_erosion=False)
+    e = sim.erosion
+    assert np.allclose(e[30:32, 30:32], 2.0) and np.nanmax(np.abs(e[:30])) == 0.0
+
+
+def test_setters_refuse_bad_values(erodem, tujunga):
+    sim = erodem.Simulation(erodem.read_dem(tujunga, window=WINDOW), "cpu", time__steps=10,
+                            numerics__threads=1)
+    before = sim.water_depth.copy()
+    h = np.full(sim.shape, 0.1)
+    h[3, 4] = -0.5
+    with pytest.raises(ValueError, match=r"field 'water_depth': 1 value\(s\) at active cells "
+                                         r"are negative \(the first at row 3, column 4"):
+        sim.water_depth = h
+    h[3, 4] = np.nan
+    with pytest.raises(ValueError, match="field 'water_depth'.*NaN or infinite"):
+        sim.set_field("water_depth", h)
+    assert np.array_equal(sim.water_depth, before)  # nothing changed
+    with pytest.raises(ValueError, match="field 'bed'.*NaN"):
+        sim.bed = np.full(sim.shape, np.nan)
+    with pytest.raises(ValueError, match="field 'hardness'.*above 1"):
+        sim.set_field("hardness", np.full(sim.shape, 2.0))
+    with pytest.raises(ValueError, match=r"field 'sediment': expected an array of shape \(64, 64\)"):
+        sim.sediment = np.zeros((3, 3))
+    with pytest.raises(ValueError, match="field 'sediment': expected real numbers"):
+        sim.sediment = np.full(sim.shape, "a")
+    with pytest.raises(ValueError, match="field 'erosion' is derived"):
+        sim.set_field("erosion", np.zeros(sim.shape))
+    with pytest.raises(ValueError, match="unknown field 'depth'"):
+        sim.set_field("depth", np.zeros(sim.shape))
+    # step counts are whole numbers
+    with pytest.raises(ValueError, match="step: 'n' must be a whole number of steps, got 1.5"):
+        sim.step(1.5)
+    with pytest.raises(ValueError, match="run: 'steps' must be a whole number"):
+        sim.run(steps=2.5)
+    with pytest.raises(ValueError, match="'n' must be >= 0"):
+        sim.step(-1)
+    assert sim.steps_done == 0
+    sim.step(2.0)
+    sim.step(np.int64(1))
+    assert sim.steps_done == 3
+
