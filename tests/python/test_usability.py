@@ -199,3 +199,185 @@ def test_setters_refuse_bad_values(erodem, tujunga):
     sim.step(np.int64(1))
     assert sim.steps_done == 3
 
+
+# ---- sweeps: scripts, stdin, resume, Ctrl-C, the table ------------------------------------
+
+SWEEP_SCRIPT = """
+import json, os, sys
+import erodem
+with open(os.environ["MARKER"], "a") as f:
+    f.write("ran\\n")  # once per execution of this script
+table = erodem.sweep(erodem.read_dem({tujunga!r}, window={window!r}),
+                     grid={{"rain.rate": ["40 mm/h", "80 mm/h"]}}, steps=20, workers=2,
+                     output_dir={out!r}, progress=False, initial__water_depth=0.05)
+print(json.dumps({{"errors": list(table["error"]), "steps": [int(v) for v in table["steps"]]}}))
+"""
+
+
+def run_script(tmp_path, tujunga, how):
+    import json
+    import subprocess
+    import sys
+
+    out = str(tmp_path / how)
+    code = SWEEP_SCRIPT.format(tujunga=tujunga, out=out, window=WINDOW)
+    env = dict(os.environ, MARKER=str(tmp_path / (how + ".marker")))
+    if how == "stdin":  # python - <<EOF
+        r = subprocess.run([sys.executable, "-"], input=code, capture_output=True, text=True,
+                           env=env, timeout=300)
+    else:  # a file without the __main__ guard
+        path = tmp_path / "unguarded.py"
+        path.write_text(code)
+        r = subprocess.run([sys.executable, str(path)], capture_output=True, text=True,
+                           env=env, timeout=300)
+    assert r.returncode == 0, r.stderr
+    result = json.loads(r.stdout.strip().splitlines()[-1])
+    runs = (tmp_path / (how + ".marker")).read_text().count("ran")
+    return result, runs
+
+
+def test_sweep_from_stdin(erodem, tujunga, tmp_path):
+    result, runs = run_script(tmp_path, tujunga, "stdin")
+    assert result == {"errors": ["", ""], "steps": [20, 20]} and runs == 1
+
+
+def test_sweep_from_unguarded_script_runs_it_once(erodem, tujunga, tmp_path):
+    result, runs = run_script(tmp_path, tujunga, "unguarded")
+    assert result == {"errors": ["", ""], "steps": [20, 20]}
+    assert runs == 1  # the workers never import the caller's script
+
+
+def small_sweep(erodem, tujunga, out, **kw):
+    cfg, _ = sweep_config(tujunga)
+    kw.setdefault("grid", {"rain.rate": ["40 mm/h", "120 mm/h"], "erosion.min_tilt": [0.02, 0.05]})
+    return erodem.sweep(erodem.read_dem(tujunga, window=WINDOW), config=cfg,
+                        output_dir=out, **kw)
+
+
+def sweep_config(tujunga, steps=30):
+    cfg = small_config(tujunga, steps=steps)
+    del cfg["dem"], cfg["numerics"]
+    return cfg, None
+
+
+def test_sweep_resume_skips_finished_members(erodem, tujunga, tmp_path, capsys):
+    first = small_sweep(erodem, tujunga, tmp_path, workers=1, threads=1, progress=True)
+    err = capsys.readouterr().err
+    assert "4/4" in err and "failed=0" in err  # the tqdm bar: members done, failed
+    assert (first["error"] == "").all()
+    assert list(first.columns[:4]) == ["member", "config_hash", "rain.rate [m/s]",
+                                       "erosion.min_tilt"]
+    assert first["rain.rate [m/s]"].dtype == np.float64
+    assert first["config_hash"].str.len().eq(16).all() and first["config_hash"].nunique() == 4
+    # the table beside the member files, as CSV (and Parquet with pyarrow)
+    import pandas as pd
+
+    csv = pd.read_csv(tmp_path / "sweep.csv", keep_default_na=False)
+    assert list(csv.columns) == list(first.columns)
+    assert np.array_equal(csv["eroded_volume [m^3]"], first["eroded_volume [m^3]"])
+    try:
+        import pyarrow  # noqa: F401
+
+        pq = pd.read_parquet(tmp_path / "sweep.parquet")
+        assert pq.equals(first)
+    except ImportError:
+        pass
+    mtimes = [os.path.getmtime(p) for p in first["output"]]
+    # rerunning into the same folder: every member is skipped, the rows come back
+    t0 = __import__("time").perf_counter()
+    again = small_sweep(erodem, tujunga, tmp_path, workers=1, threads=1, progress=True)
+    print("resumed 4 finished members in %.2f s" % (__import__("time").perf_counter() - t0))
+    assert "4 member(s) already finished" in capsys.readouterr().err
+    assert [os.path.getmtime(p) for p in again["output"]] == mtimes
+    pd.testing.assert_frame_equal(again, first)
+    # a finished member of another configuration is never overwritten silently
+    with pytest.raises(ValueError, match="member_000.h5 was written with another configuration"):
+        small_sweep(erodem, tujunga, tmp_path, workers=1, threads=1, thermal__rate=0.1)
+    with pytest.raises(ValueError, match="member_000.h5 exists; pass resume=True"):
+        small_sweep(erodem, tujunga, tmp_path, workers=1, threads=1, resume=False)
+    # a lost member file is run again, the others skipped
+    os.remove(first["output"][2])
+    part = small_sweep(erodem, tujunga, tmp_path, workers=1, threads=1, progress=False)
+    assert os.path.exists(first["output"][2])
+    assert np.array_equal(part["eroded_volume [m^3]"], first["eroded_volume [m^3]"])
+
+
+def test_sweep_progress_line_without_tqdm(erodem, tujunga, tmp_path, capsys, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    t = small_sweep(erodem, tujunga, tmp_path, workers=1, threads=1,
+                    params=[{"rain.rate": "40 mm/h"}, {"erosion.sediment_capacity": -1.0}],
+                    grid=None)
+    err = capsys.readouterr().err
+    print(err)
+    assert "sweep: 2/2 members done, 1 failed, ETA 0:00" in err
+    assert t["error"][0] == "" and "erosion.sediment_capacity" in t["error"][1]
+
+
+INTERRUPT_SCRIPT = """
+import erodem, sys
+cfg = {cfg!r}
+try:
+    erodem.sweep(erodem.read_dem({tujunga!r}, window={window!r}), config=cfg, workers=2,
+                 threads=1, output_dir={out!r}, progress=False,
+                 grid={{"rain.rate": ["40 mm/h", "60 mm/h", "80 mm/h", "100 mm/h", "120 mm/h",
+                                      "140 mm/h"]}})
+except erodem.SweepInterrupted as e:
+    print("rows", len(e.table))
+    sys.exit(130)
+"""
+
+
+def finished_members(out):
+    """Members whose row file says finished (the worker writes it after the result file)."""
+    import json
+
+    n = 0
+    for name in os.listdir(out) if os.path.isdir(out) else []:
+        if name.startswith("member_") and name.endswith(".json"):
+            try:
+                with open(os.path.join(out, name)) as f:
+                    n += bool(json.load(f).get("finished"))
+            except ValueError:
+                pass
+    return n
+
+
+def test_sweep_ctrl_c_keeps_finished_rows_and_resumes(erodem, tujunga, tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cfg, _ = sweep_config(tujunga, steps=300)
+    out = str(tmp_path / "run")
+    code = INTERRUPT_SCRIPT.format(cfg=cfg, tujunga=tujunga, window=WINDOW, out=out)
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 120
+    while not finished_members(out) and time.time() < deadline:
+        time.sleep(0.05)
+    t0 = time.perf_counter()
+    p.send_signal(signal.SIGINT)
+    stdout, stderr = p.communicate(timeout=60)
+    t_stop = time.perf_counter() - t0
+    print(stderr[-600:])
+    print("stopped %.2f s after Ctrl-C" % t_stop)
+    assert p.returncode == 130, stderr
+    assert "sweep interrupted" in stderr and "to resume, run the same sweep again" in stderr
+    assert t_stop < 5.0
+    done = int(stdout.split()[-1])
+    assert 1 <= done < 6
+    import pandas as pd
+
+    assert len(pd.read_csv(os.path.join(out, "sweep.csv"))) == done
+    # the same call again finishes the rest: the finished members are skipped
+    t = erodem.sweep(erodem.read_dem(tujunga, window=WINDOW), config=cfg, workers=2, threads=1,
+                     output_dir=out, progress=False,
+                     grid={"rain.rate": ["40 mm/h", "60 mm/h", "80 mm/h", "100 mm/h",
+                                         "120 mm/h", "140 mm/h"]})
+    assert (t["error"] == "").all(), list(t["error"])
+    assert (t["steps"] == 300).all() and len(t) == 6
+    assert not [f for f in os.listdir(out) if f.endswith(".partial")]
