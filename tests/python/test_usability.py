@@ -381,3 +381,48 @@ def test_sweep_ctrl_c_keeps_finished_rows_and_resumes(erodem, tujunga, tmp_path)
     assert (t["error"] == "").all(), list(t["error"])
     assert (t["steps"] == 300).all() and len(t) == 6
     assert not [f for f in os.listdir(out) if f.endswith(".partial")]
+
+
+# ---- the console entry point --------------------------------------------------------------
+
+
+def test_console_script_runs_the_bundled_cli(erodem, cli, tmp_path):
+    # pyproject.toml's console script runs erodem._cli:main; the package as `pip install .`
+    # lays it out (CMake's install of the component python: the module and erodem/bin/erodem,
+    # beside the package files) runs its own bundled CLI
+    import shutil
+    import subprocess
+    import sys
+
+    from conftest import BUILD, REPO
+
+    with open(os.path.join(REPO, "pyproject.toml")) as f:
+        assert 'erodem = "erodem._cli:main"' in f.read()
+    r = subprocess.run(["cmake", "--install", BUILD, "--component", "python", "--prefix",
+                        str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    pkg = tmp_path / "erodem"
+    assert os.access(pkg / "bin" / "erodem", os.X_OK)
+    for name in os.listdir(os.path.join(REPO, "python", "erodem")):
+        if name.endswith((".py", ".pyi")):
+            shutil.copy(os.path.join(REPO, "python", "erodem", name), pkg / name)
+    env = dict(os.environ, PYTHONPATH=str(tmp_path))
+    env.pop("ERODEM_CLI", None)
+    main = "import sys; from erodem._cli import main, cli_path; print(cli_path()); sys.exit(main())"
+    r = subprocess.run([sys.executable, "-c", main, "--version"], capture_output=True,
+                       text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.strip().splitlines()
+    print(lines)
+    assert lines[0] == str(pkg / "bin" / "erodem")
+    assert lines[1] == subprocess.run([cli, "--version"], capture_output=True,
+                                      text=True).stdout.strip()
+    # the exit status is the CLI's: a missing config is 66, with its message
+    r = subprocess.run([sys.executable, "-c", main, "run", str(tmp_path / "missing.toml")],
+                       capture_output=True, text=True, env=env)
+    assert r.returncode == 66 and "missing.toml" in r.stderr
+    # a package without a CLI says where to get one (exit 69)
+    os.remove(pkg / "bin" / "erodem")
+    r = subprocess.run([sys.executable, "-c", main, "--version"], capture_output=True,
+                       text=True, env=env)
+    assert r.returncode == 69 and "ERODEM_CLI" in r.stderr, r.stderr
