@@ -167,3 +167,6 @@ class Simulation:
     def shape(self) -> Tuple[int, int]: ...
     @property
     def area(self) -> List[float]: ...
+    @property
+    def active(self) -> npt.NDArray[np.bool_]:
+        """Active cells (ny, nx), False at nodata. A copy."""

@@ -301,9 +301,9 @@ class Simulation:
             self._sim.set_field("initial_bed", a)
 
     def _active(self) -> np.ndarray:
-        """Active cells (bool, ``(ny, nx)``): where the initial bed is not NaN."""
+        """Active cells (bool, ``(ny, nx)``): False at the DEM's nodata cells."""
         if getattr(self, "_mask", None) is None:
-            self._mask = np.isfinite(np.asarray(self._sim.field("initial_bed")))
+            self._mask = np.asarray(self._sim.active)
         return self._mask
 
     bed = property(

@@ -323,7 +323,18 @@ void add_simulation_bindings(py::module_& m) {
                              [](const PySimulation& s) {
                                return py::make_tuple(s.sim().grid().ny, s.sim().grid().nx);
                              })
-      .def_property_readonly("area", [](const PySimulation& s) { return s.sim().grid().area; });
+      .def_property_readonly("area", [](const PySimulation& s) { return s.sim().grid().area; })
+      .def_property_readonly(
+          "active",
+          [](const PySimulation& s) {
+            const Grid& g = s.sim().grid();
+            const Terrain& t = s.sim().terrain();
+            py::array_t<bool> a({static_cast<py::ssize_t>(g.ny), static_cast<py::ssize_t>(g.nx)});
+            bool* out = a.mutable_data();
+            for (std::size_t i = 0; i < g.cells(); ++i) out[i] = t.active(i);
+            return a;
+          },
+          "Active cells: bool (ny, nx), False at the DEM's nodata cells. A copy.");
 }
 
 }  // namespace erodem::python

@@ -41,6 +41,11 @@ def test_from_array_builds_a_simulation(erodem, tmp_path):
     again = pickle.loads(pickle.dumps(dem))
     assert again.sha256 == dem.sha256
     assert np.array_equal(again.elevation, dem.elevation, equal_nan=True)
+    # so a sweep's worker processes run on it
+    t = erodem.sweep(dem, grid={"rain.rate": ["20 mm/h", "50 mm/h"]}, steps=10, workers=2,
+                     output_dir=tmp_path / "sweep", progress=False)
+    assert (t["error"] == "").all(), list(t["error"])
+    assert t["max_depth [m]"][1] > t["max_depth [m]"][0]
 
 
 def test_from_array_same_terrain_as_read_dem(erodem, tujunga):
@@ -198,6 +203,22 @@ def test_setters_refuse_bad_values(erodem, tujunga):
     sim.step(2.0)
     sim.step(np.int64(1))
     assert sim.steps_done == 3
+
+
+def test_setters_ignore_nodata_cells(erodem):
+    # NaN where the DEM has nodata is fine (those cells are not simulated); at an active cell
+    # it is refused
+    z = cone(n=12)
+    z[0, 0] = np.nan
+    sim = erodem.Simulation(erodem.DEM.from_array(z, cell_size=5.0), "cpu", time__steps=2,
+                            numerics__threads=1)
+    h = np.full(sim.shape, 0.1)
+    h[0, 0] = np.nan
+    sim.water_depth = h
+    assert np.isclose(sim.water_depth[5, 5], 0.1)
+    h[0, 1] = np.nan
+    with pytest.raises(ValueError, match="row 0, column 1"):
+        sim.water_depth = h
 
 
 # ---- sweeps: scripts, stdin, resume, Ctrl-C, the table ------------------------------------
