@@ -115,6 +115,33 @@ def test_from_dataarray(erodem):
     assert g.is_geographic and 90 < g.dx[0] < 93 and 110 < g.dy[0] < 112
 
 
+def test_from_dataarray_takes_the_rio_crs_and_nodata(erodem, monkeypatch):
+    # with rioxarray installed, da.rio.crs and da.rio.nodata are used (a stand-in accessor
+    # here: rioxarray is not a dependency)
+    import sys
+    import types
+
+    xr = pytest.importorskip("xarray")
+
+    class Crs:
+        def to_wkt(self):
+            return erodem.DEM.from_array(np.ones((2, 2)), cell_size=1.0, crs="EPSG:32610").crs
+
+    class Rio:
+        crs = Crs()
+        nodata = -32768.0
+
+    monkeypatch.setitem(sys.modules, "rioxarray", types.ModuleType("rioxarray"))
+    monkeypatch.setattr(xr.DataArray, "rio", property(lambda self: Rio()), raising=False)
+    z = cone(n=10)
+    z[4, 4] = -32768.0
+    da = xr.DataArray(z, dims=("y", "x"),
+                      coords={"y": 100.0 - 2.0 * np.arange(10), "x": 2.0 * np.arange(10)})
+    dem = erodem.DEM.from_array(da)
+    assert "UTM zone 10N" in dem.crs and not dem.mask[4, 4] and dem.mask.sum() == 99
+    assert dem.transform == (-1.0, 2.0, 0.0, 101.0, 0.0, -2.0)
+
+
 def test_from_array_rejects_bad_input(erodem):
     z = cone(n=8)
     with pytest.raises(ValueError, match="'z' must be a 2-D array"):
