@@ -6,7 +6,8 @@ config and ``erodem run --set``), the simulation runs in C++ with the GIL releas
 result files are written by the same writer as ``erodem run``.
 
 Public API (``docs/python.md``): :func:`read_dem`, :class:`DEM`, :class:`Simulation`,
-:func:`open_run`, :func:`read_sections`, :func:`sweep` (:exc:`SweepInterrupted`), :func:`parameter_keys`, :func:`parameter_info`,
+:func:`open_run`, :func:`read_sections`, :func:`sweep` (:exc:`SweepInterrupted`),
+:func:`parameter_keys`, :func:`parameter_info`,
 :exc:`UnstableError`.
 """
 

@@ -17,7 +17,6 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import math
 import os
 import subprocess
 import sys
@@ -539,7 +538,8 @@ def sweep(
         t = pd.DataFrame([rows[i] for i in sorted(rows)])
         if t.empty:
             return t
-        front = {"member": t["member"], "config_hash": [specs[i]["config_hash"] for i in t["member"]]}
+        front = {"member": t["member"],
+                 "config_hash": [specs[i]["config_hash"] for i in t["member"]]}
         front.update({k: [v[i] for i in t["member"]] for k, v in columns.items()})
         out = pd.concat([pd.DataFrame(front), t.drop(columns=["member"])], axis=1)
         return out.reset_index(drop=True)
@@ -547,9 +547,7 @@ def sweep(
     bar = _Progress(len(todo), len(specs) - len(todo), progress)
 
     def on_row(row: Dict[str, Any]) -> None:
-        spec = specs[row["member"]]
-        row = dict(row)
-        rows[row["member"]] = row
+        rows[row["member"]] = dict(row)
         bar.update(bool(row["error"]))
 
     try:
@@ -570,6 +568,11 @@ def sweep(
             _run_local(todo, workers, threads, on_row)
     except KeyboardInterrupt:
         bar.close()
+        for s in specs:  # members a worker finished before its row reached this process
+            if s["index"] not in rows:
+                row = _row_on_disk(s)
+                if row is not None:
+                    rows[s["index"]] = row
         t = table()
         _write_table(t, output_dir)
         message = (
@@ -618,11 +621,28 @@ def _finished_rows(specs, resume: bool) -> Dict[int, Dict[str, Any]]:
         if not row.get("finished"):
             s["overwrite"] = True  # this member's own file, its row lost to Ctrl-C: run again
             continue
-        row.pop("config_hash")
-        row.pop("finished")
-        row = {k: (float("nan") if v is None else v) for k, v in row.items()}
-        rows[s["index"]] = row
+        rows[s["index"]] = _table_row(row)
     return rows
+
+
+def _table_row(row: Dict[str, Any]) -> Dict[str, Any]:
+    """A row as its row file holds it, as a table row."""
+    row = {k: v for k, v in row.items() if k not in ("config_hash", "finished")}
+    return {k: (float("nan") if v is None else v) for k, v in row.items()}
+
+
+def _row_on_disk(spec: Dict[str, Any]) -> Optional[Dict[str, Any]]:
+    """The row of a member whose result file is complete and whose row file says finished
+    with its configuration; else None."""
+    try:
+        with open(spec["output"][:-3] + ".json") as f:
+            row = json.load(f)
+    except (OSError, ValueError):
+        return None
+    if (os.path.exists(spec["output"]) and row.get("finished")
+            and row.get("config_hash") == spec["config_hash"]):
+        return _table_row(row)
+    return None
 
 
 def _write_table(table, output_dir: str) -> None:

@@ -108,7 +108,8 @@ def test_from_dataarray(erodem):
     with pytest.raises(ValueError, match="coordinate 'x' is not regularly spaced"):
         erodem.DEM.from_array(bad)
     ll = xr.DataArray(z, dims=("lat", "lon"),
-                      coords={"lat": 34 - 0.001 * np.arange(30), "lon": -118 + 0.001 * np.arange(30)})
+                      coords={"lat": 34 - 0.001 * np.arange(30),
+                              "lon": -118 + 0.001 * np.arange(30)})
     with pytest.raises(ValueError, match="EPSG:4326"):
         erodem.DEM.from_array(ll)
     g = erodem.DEM.from_array(ll, crs="EPSG:4326")
@@ -211,7 +212,8 @@ def test_setters_refuse_bad_values(erodem, tujunga):
         sim.bed = np.full(sim.shape, np.nan)
     with pytest.raises(ValueError, match="field 'hardness'.*above 1"):
         sim.set_field("hardness", np.full(sim.shape, 2.0))
-    with pytest.raises(ValueError, match=r"field 'sediment': expected an array of shape \(64, 64\)"):
+    with pytest.raises(ValueError,
+                       match=r"field 'sediment': expected an array of shape \(64, 64\)"):
         sim.sediment = np.zeros((3, 3))
     with pytest.raises(ValueError, match="field 'sediment': expected real numbers"):
         sim.sediment = np.full(sim.shape, "a")
