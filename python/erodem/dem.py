@@ -321,16 +321,16 @@ def _from_dataarray(da: Any, cell_size: Any, crs: Any, transform: Any, nodata: A
         da = da.transpose()
         d0, d1 = d1, d0
     ydim, xdim = da.dims
-    if crs is None:
-        rio = None
-        try:
-            import rioxarray  # noqa: F401  (registers the .rio accessor)
+    rio_crs = rio_nodata = None
+    try:
+        import rioxarray  # noqa: F401  (registers the .rio accessor)
 
-            rio = da.rio
-        except ImportError:
-            pass
-        if rio is not None and rio.crs is not None:
-            crs = rio.crs
+        rio_crs, rio_nodata = da.rio.crs, da.rio.nodata
+    except Exception:  # no rioxarray, or an array it cannot read: the attributes below
+        pass
+    if crs is None:
+        if rio_crs is not None:
+            crs = rio_crs
         else:
             for key in ("crs", "crs_wkt", "spatial_ref"):
                 if isinstance(da.attrs.get(key), str) and da.attrs[key]:
@@ -341,8 +341,8 @@ def _from_dataarray(da: Any, cell_size: Any, crs: Any, transform: Any, nodata: A
                 if gm in da.coords:
                     attrs = da.coords[gm].attrs
                     crs = attrs.get("crs_wkt") or attrs.get("spatial_ref") or None
-        if nodata is None and rio is not None and rio.nodata is not None:
-            nodata = rio.nodata
+    if nodata is None:
+        nodata = rio_nodata
     if nodata is None:
         for key in ("_FillValue", "nodata", "missing_value"):
             v = da.attrs.get(key, da.encoding.get(key) if hasattr(da, "encoding") else None)
