@@ -42,10 +42,11 @@ if ! python3 -c 'import numpy, h5py, xarray, h5netcdf' 2>/dev/null; then
   python3 -m pip install -q numpy h5py xarray h5netcdf
 fi
 # The Python bindings (python/, docs/python.md): pybind11 (Debian pybind11-dev above, or pip),
-# the build backend of `pip install .`, and what the package and its tests use.
-if ! python3 -c 'import scikit_build_core, pybind11, pandas, dask, distributed, tqdm, matplotlib, pytest' 2>/dev/null; then
-  echo "setup: installing Python packages: scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest"
-  python3 -m pip install -q scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest
+# the build backend of `pip install .`, and what the package and its tests use (pyarrow: the
+# sweep table as Parquet).
+if ! python3 -c 'import scikit_build_core, pybind11, pandas, dask, distributed, tqdm, matplotlib, pytest, pyarrow' 2>/dev/null; then
+  echo "setup: installing Python packages: scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest pyarrow"
+  python3 -m pip install -q scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest pyarrow
 fi
 
 # PoCL compiles kernels into a cache; keep it in a writable place.

@@ -23,6 +23,7 @@ REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
 
 CAPACITIES = [0.0025, 0.005, 0.01, 0.02]  # erosion.sediment_capacity K_c (s)
 RAIN_RATES = ["10 mm/h", "20 mm/h", "40 mm/h"]  # rain.rate
+KC = "erosion.sediment_capacity [s]"  # the sweep table's column: SI numbers, unit in the name
 
 
 def import_erodem():
@@ -46,11 +47,11 @@ def plot(table, path):
     from matplotlib.ticker import FormatStrFormatter, NullFormatter
 
     ok = table[table["error"] == ""].copy()
-    ok["rain_mm_h"] = ok["rain.rate"].str.split().str[0].astype(float)
+    ok["rain_mm_h"] = ok["rain.rate [m/s]"] * 3.6e6  # m/s -> mm/h
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     for rain, g in ok.groupby("rain_mm_h"):
-        g = g.sort_values("erosion.sediment_capacity")
-        a.plot(g["erosion.sediment_capacity"], g["eroded_volume"], "o-", label="%g mm/h" % rain)
+        g = g.sort_values(KC)
+        a.plot(g[KC], g["eroded_volume [m^3]"], "o-", label="%g mm/h" % round(rain, 6))
     a.set_xscale("log")
     a.set_yscale("log")
     a.set_xlabel("sediment capacity K_c (s)")
@@ -58,9 +59,9 @@ def plot(table, path):
     a.set_title("eroded volume vs sediment capacity")
     a.legend(title="rain rate")
     a.grid(True, which="both", alpha=0.3)
-    for kc, g in ok.groupby("erosion.sediment_capacity"):
+    for kc, g in ok.groupby(KC):
         g = g.sort_values("rain_mm_h")
-        b.plot(g["rain_mm_h"], g["eroded_volume"], "s-", label="K_c = %g s" % kc)
+        b.plot(g["rain_mm_h"], g["eroded_volume [m^3]"], "s-", label="K_c = %g s" % kc)
     b.set_xscale("log")
     b.set_yscale("log")
     b.set_xlabel("rain rate (mm/h)")
@@ -71,9 +72,9 @@ def plot(table, path):
     for ax in (a, b):
         ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
         ax.xaxis.set_minor_formatter(NullFormatter())
-    a.set_xticks(sorted(ok["erosion.sediment_capacity"].unique()))
-    b.set_xticks(sorted(ok["rain_mm_h"].unique()))
-    minutes = ok["time"].max() / 60.0
+    a.set_xticks(sorted(ok[KC].unique()))
+    b.set_xticks(sorted(ok["rain_mm_h"].round(6).unique()))
+    minutes = ok["time [s]"].max() / 60.0
     fig.suptitle("Big Tujunga, 256 x 256 cells of 30 m, %g min of rain (erodem.sweep, %d members)"
                  % (minutes, len(table)))
     tmp = path + ".tmp.png"
@@ -108,9 +109,7 @@ def main():
         overwrite=True,
     )
     wall = time.perf_counter() - t0
-    csv = os.path.join(args.out, "sweep.csv")
-    table.to_csv(csv + ".tmp", index=False)
-    os.replace(csv + ".tmp", csv)
+    csv = os.path.join(args.out, "sweep.csv")  # written by erodem.sweep
     with pd.option_context("display.width", 200, "display.max_columns", 20):
         print(table.drop(columns=["output"]).to_string())
     failed = table[table["error"] != ""]

@@ -114,6 +114,7 @@ CrsInfo describe_crs(const std::string& crs) {
     OSRFreeSRSArray(matches);
     CPLFree(confidence);
   }
+  info.wkt = wkt_of(h, crs);
   info.geographic = OSRIsGeographic(h) != 0;
   info.projected = OSRIsProjected(h) != 0;
   char* unit = nullptr;

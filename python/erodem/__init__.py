@@ -6,7 +6,8 @@ config and ``erodem run --set``), the simulation runs in C++ with the GIL releas
 result files are written by the same writer as ``erodem run``.
 
 Public API (``docs/python.md``): :func:`read_dem`, :class:`DEM`, :class:`Simulation`,
-:func:`open_run`, :func:`read_sections`, :func:`sweep`, :func:`parameter_keys`, :func:`parameter_info`,
+:func:`open_run`, :func:`read_sections`, :func:`sweep` (:exc:`SweepInterrupted`),
+:func:`parameter_keys`, :func:`parameter_info`,
 :exc:`UnstableError`.
 """
 
@@ -29,6 +30,7 @@ __all__ = [
     "parameter_keys",
     "read_dem",
     "sweep",
+    "SweepInterrupted",
 ]
 
 __version__ = "0.1.0"
@@ -42,4 +44,4 @@ for _obj in (DEM, Simulation, open_run, parameter_info, parameter_keys, read_dem
     _obj.__module__ = __name__
 del _obj
 
-from .sweep import sweep  # noqa: E402  (needs Simulation above)
+from .sweep import SweepInterrupted, sweep  # noqa: E402  (needs Simulation above)

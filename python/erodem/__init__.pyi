@@ -20,6 +20,17 @@ def parameter_info(key: str) -> Dict[str, str]: ...
 class DEM:
     settings: Dict[str, Any]
     def __init__(self, settings: Mapping[str, Any]) -> None: ...
+    @classmethod
+    def from_array(
+        cls,
+        z: Any,
+        cell_size: Optional[float] = ...,
+        crs: Any = ...,
+        transform: Any = ...,
+        nodata: Optional[float] = ...,
+    ) -> "DEM": ...
+    @property
+    def in_memory(self) -> bool: ...
     @property
     def elevation(self) -> npt.NDArray[np.float32]: ...
     @property
@@ -75,7 +86,9 @@ class Simulation:
         overwrite: bool = ...,
     ) -> Dict[str, float]: ...
     def field(self, name: str) -> np.ndarray: ...
-    def set_field(self, name: str, values: npt.ArrayLike) -> None: ...
+    def set_field(
+        self, name: str, values: npt.ArrayLike, *, reset_erosion: bool = ...
+    ) -> None: ...
     bed: np.ndarray
     water_depth: np.ndarray
     sediment: np.ndarray
@@ -129,7 +142,13 @@ def sweep(
     config: Union[Mapping[str, Any], _Path, None] = ...,
     every: Optional[_Quantity] = ...,
     overwrite: bool = ...,
+    resume: bool = ...,
+    progress: bool = ...,
     threads: Optional[int] = ...,
     **fixed: Any,
 ) -> Any:
     """A pandas.DataFrame, one row per member."""
+
+class SweepInterrupted(KeyboardInterrupt):
+    table: Any
+    output_dir: str

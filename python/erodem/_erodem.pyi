@@ -42,6 +42,19 @@ class Terrain:
     """A DEM on its grid, read with its dem.* settings."""
 
     def __init__(self, settings: Settings) -> None: ...
+    @staticmethod
+    def from_array(
+        z: npt.ArrayLike,
+        transform: Sequence[float],
+        has_transform: bool,
+        cell_size: float,
+        crs: str,
+        source: str,
+        sha256: str,
+    ) -> "Terrain":
+        """A terrain from elevations in memory (see erodem.DEM.from_array)."""
+    @property
+    def in_memory(self) -> bool: ...
     @property
     def elevation(self) -> npt.NDArray[np.float32]:
         """Bed elevation (m), (ny, nx), NaN at nodata. A copy."""
@@ -158,3 +171,6 @@ class Simulation:
     def shape(self) -> Tuple[int, int]: ...
     @property
     def area(self) -> List[float]: ...
+    @property
+    def active(self) -> npt.NDArray[np.bool_]:
+        """Active cells (ny, nx), False at nodata. A copy."""

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _erodem
 from ._params import Settings, _settings
-from .dem import DEM, read_dem
+from .dem import DEM, _is_dataarray, read_dem
 
 
 def _progress_bar(total: float, unit: str):
@@ -77,7 +77,14 @@ class Simulation:
         **params: Any,
     ):
         restart_arg = _restart_arg(restart)
-        if dem is not None and not isinstance(dem, DEM):
+        if _is_dataarray(dem):
+            dem = DEM.from_array(dem)
+        elif isinstance(dem, np.ndarray):
+            raise ValueError(
+                "Simulation: 'dem' is a numpy array; build the DEM with "
+                "erodem.DEM.from_array(z, cell_size=...) (or transform=..., crs=...) and pass it"
+            )
+        elif dem is not None and not isinstance(dem, DEM):
             dem = read_dem(dem)
         config_path = ""
         settings: Settings = []
@@ -131,14 +138,12 @@ class Simulation:
         Raises
         ------
         ValueError
-            ``n`` is negative.
+            ``n`` is not a whole number >= 0 (``1.5`` is refused, not rounded).
         UnstableError
             The state turned NaN or negative, or violated the CFL bound (the message names
             the step, time and cell).
         """
-        n = int(n)
-        if n < 0:
-            raise ValueError("step: 'n' must be >= 0, got %d" % n)
+        n = _whole_steps("step", "n", n)
         self._sim.advance(n, False, math.inf, self.chunk_seconds, False)
 
     def run(
@@ -194,8 +199,8 @@ class Simulation:
         """
         if steps is not None and duration is not None:
             raise ValueError("run: give 'steps' or 'duration', not both")
-        if steps is not None and int(steps) < 0:
-            raise ValueError("run: 'steps' must be >= 0, got %d" % int(steps))
+        if steps is not None:
+            steps = _whole_steps("run", "steps", steps)
         t_end = None
         if duration is not None:
             t_end = self.time + _duration_seconds(duration)
@@ -269,16 +274,37 @@ class Simulation:
         """
         return self._sim.field(name)
 
-    def set_field(self, name: str, values: Any) -> None:
+    def set_field(self, name: str, values: Any, *, reset_erosion: bool = True) -> None:
         """Replaces field ``name`` with ``values`` (array-like of shape ``(ny, nx)``, SI
         units) on any backend (an upload on OpenCL).
+
+        Values at active cells are checked first and nothing is changed when they are bad:
+        they must be finite, and at least 0 for amounts (depths, sediment, snow, soil,
+        fluxes, Manning n, rain factor, ...), within [0, 1] for ``hardness``. Values at
+        nodata cells are not used (NaN is fine there).
+
+        Setting ``bed`` also sets ``initial_bed`` to the same values, so the edit is the
+        new reference of :attr:`erosion` and is not reported as erosion; with
+        ``reset_erosion=False`` the initial bed stays, and the edit counts as erosion or
+        deposition.
 
         Raises
         ------
         ValueError
-            Unknown field, wrong shape, or the derived field ``erosion``.
+            Unknown field, wrong shape, values that are not real numbers, NaN or infinite
+            or out of range at an active cell (the message names the field, the count and
+            the first cell), or the derived fields ``erosion`` and ``shear_stress``.
         """
-        self._sim.set_field(name, np.asarray(values, dtype=np.float64))
+        a = _checked_field(name, values, self.shape, self._active())
+        self._sim.set_field(name, a)
+        if name == "bed" and reset_erosion:
+            self._sim.set_field("initial_bed", a)
+
+    def _active(self) -> np.ndarray:
+        """Active cells (bool, ``(ny, nx)``): False at the DEM's nodata cells."""
+        if getattr(self, "_mask", None) is None:
+            self._mask = np.asarray(self._sim.active)
+        return self._mask
 
     bed = property(
         lambda self: self.field("bed"),
@@ -409,6 +435,72 @@ class Simulation:
             self.steps_done,
             self.time,
         )
+
+
+#: Fields that hold amounts (>= 0); hardness is also <= 1.
+_NON_NEGATIVE = frozenset(
+    (
+        "water_depth", "sediment", "flux_left", "flux_right", "flux_top", "flux_bottom",
+        "hardness", "wetness", "manning_n", "rain_factor", "snow", "snow_liquid",
+        "snow_slide_share", "soil_thickness", "infiltrated", "infiltration_ksat",
+        "infiltration_suction_deficit", "infiltration_store", "terrain_class", "talus_slope",
+    )
+)
+
+
+def _checked_field(name: str, values: Any, shape: Tuple[int, int], active: np.ndarray):
+    """``values`` for field ``name`` as float64 ``(ny, nx)``, checked at the active cells;
+    ValueError naming the field and the reason otherwise."""
+    if name in ("erosion", "shear_stress"):
+        raise ValueError(
+            "field '%s' is derived (computed from the state when read) and cannot be set%s"
+            % (name, "; set bed or initial_bed" if name == "erosion" else "")
+        )
+    if name not in _erodem.field_names():
+        raise ValueError(
+            "unknown field '%s' (known: %s)" % (name, ", ".join(_erodem.field_names()))
+        )
+    a = np.asarray(values)
+    if a.dtype == bool or a.dtype.kind not in "iuf":
+        raise ValueError("field '%s': expected real numbers, got dtype %s" % (name, a.dtype))
+    if a.shape != tuple(shape):
+        raise ValueError(
+            "field '%s': expected an array of shape %s, got %s" % (name, tuple(shape), a.shape)
+        )
+    a = np.array(a, dtype=np.float64)
+    bad = active & ~np.isfinite(a)
+    what = "NaN or infinite"
+    if not bad.any() and name in _NON_NEGATIVE:
+        bad = active & (a < 0)
+        what = "negative"
+        if not bad.any() and name == "hardness":
+            bad = active & (a > 1)
+            what = "above 1 (hardness is within [0, 1])"
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise ValueError(
+            "field '%s': %d value(s) at active cells are %s (the first at row %d, column %d: "
+            "%r); nothing was changed" % (name, int(bad.sum()), what, r, c, float(a[r, c]))
+        )
+    return a
+
+
+def _whole_steps(where: str, arg: str, n: Any) -> int:
+    """``n`` as a whole number of steps >= 0; ValueError naming ``arg`` otherwise."""
+    if isinstance(n, (bool, np.bool_)):
+        raise ValueError("%s: '%s' must be a whole number of steps, got %r" % (where, arg, n))
+    if isinstance(n, (int, np.integer)):
+        v = int(n)
+    elif isinstance(n, (float, np.floating)) and math.isfinite(n) and float(n).is_integer():
+        v = int(n)
+    else:
+        raise ValueError(
+            "%s: '%s' must be a whole number of steps, got %r (steps are not split: run "
+            "duration=... for a time)" % (where, arg, n)
+        )
+    if v < 0:
+        raise ValueError("%s: '%s' must be >= 0, got %d" % (where, arg, v))
+    return v
 
 
 def _restart_arg(restart: Union[str, os.PathLike, Tuple[Any, Any], None]) -> str:

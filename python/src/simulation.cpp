@@ -18,6 +18,7 @@
 #include "erodem/io/config.hpp"
 #include "erodem/io/results.hpp"
 #include "erodem/io/run_session.hpp"
+#include "erodem/parameter_rasters.hpp"
 #include "erodem/schema.hpp"
 #include "terrain.hpp"
 
@@ -26,6 +27,22 @@ namespace py = pybind11;
 namespace erodem::python {
 
 namespace {
+
+/// A DEM from an array has no file to read the parameter rasters on its grid with: raster
+/// files are refused at once, naming the parameter.
+void check_no_rasters(const Params& p) {
+  std::string key;
+  for (const auto& r : parameter_rasters())
+    if (key.empty() && !parameter_raster_path(r, p).empty()) key = r.key;
+  if (key.empty() && !p.rain.grids.empty()) key = "rain.grids";
+  if (key.empty() && !p.snow.temperature_grids.empty()) key = "snow.temperature_grids";
+  if (!key.empty())
+    throw Error(ExitCode::config,
+                fmt::format("parameter '{}': a raster file needs a DEM read from a file "
+                            "(erodem.read_dem); this DEM comes from an array (DEM.from_array). "
+                            "Give a uniform value, or write the DEM to a GeoTIFF and read it",
+                            key));
+}
 
 /// A simulation driven from Python: an io::RunSession. Not thread-safe: one call at a time
 /// (a second thread calling advance() while one runs gets RuntimeError).
@@ -44,6 +61,7 @@ class PySimulation {
                                      : Params();
     apply_settings(p, settings);
     if (terrain) p.dem = terrain->dem;
+    if (terrain && terrain->in_memory) check_no_rasters(p);
     validate(p, !config_path.empty()  ? config_path
                 : config_from_restart ? io::split_restart(restart).first + " (config_toml)"
                                       : "parameters");
@@ -305,7 +323,18 @@ void add_simulation_bindings(py::module_& m) {
                              [](const PySimulation& s) {
                                return py::make_tuple(s.sim().grid().ny, s.sim().grid().nx);
                              })
-      .def_property_readonly("area", [](const PySimulation& s) { return s.sim().grid().area; });
+      .def_property_readonly("area", [](const PySimulation& s) { return s.sim().grid().area; })
+      .def_property_readonly(
+          "active",
+          [](const PySimulation& s) {
+            const Grid& g = s.sim().grid();
+            const Terrain& t = s.sim().terrain();
+            py::array_t<bool> a({static_cast<py::ssize_t>(g.ny), static_cast<py::ssize_t>(g.nx)});
+            bool* out = a.mutable_data();
+            for (std::size_t i = 0; i < g.cells(); ++i) out[i] = t.active(i);
+            return a;
+          },
+          "Active cells: bool (ny, nx), False at the DEM's nodata cells. A copy.");
 }
 
 }  // namespace erodem::python

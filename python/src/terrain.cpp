@@ -4,9 +4,16 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
 
 #include "bindings.hpp"
+#include "erodem/error.hpp"
+#include "erodem/io/geodesy.hpp"
+#include "erodem/io/raster.hpp"
 #include "erodem/io/setup.hpp"
 #include "erodem/schema.hpp"
 
@@ -32,6 +39,92 @@ PyTerrain load(const Settings& settings) {
   return t;
 }
 
+/// A terrain from elevations in memory (erodem.DEM.from_array, which checks the arguments
+/// first): `z` (ny, nx) in m, row 0 north, NaN at nodata. With `has_transform`, `transform`
+/// is the GDAL geotransform of the top-left corner in the units of `crs` (degrees for a
+/// geographic CRS: cell sizes and areas then come from its ellipsoid, as read_dem computes
+/// them; metres without a CRS); else the cells are squares of `cell_size` m. `source` names
+/// it (as the path of a file would) and `sha256` is the checksum of its values.
+PyTerrain from_array(const py::array_t<double, py::array::c_style | py::array::forcecast>& z,
+                     const std::array<double, 6>& transform, bool has_transform, double cell_size,
+                     const std::string& crs, const std::string& source, const std::string& sha256) {
+  if (z.ndim() != 2 || z.shape(0) < 1 || z.shape(1) < 1)
+    throw Error(ExitCode::config, "DEM.from_array: 'z' must be a non-empty 2-D array");
+  PyTerrain out;
+  out.in_memory = true;
+  out.dem.path = source;  // names it in messages and in the config a result file records
+  Terrain& t = out.terrain;
+  Grid& g = t.grid;
+  const int ny = static_cast<int>(z.shape(0)), nx = static_cast<int>(z.shape(1));
+  io::CrsInfo info;
+  if (!crs.empty()) {
+    try {
+      info = io::describe_crs(crs);
+    } catch (const Error& e) {
+      throw Error(ExitCode::config, "DEM.from_array: 'crs' " + crs + ": " + e.what());
+    }
+  }
+  if (has_transform) {
+    if (transform[2] != 0.0 || transform[4] != 0.0)
+      throw Error(ExitCode::config,
+                  "DEM.from_array: 'transform': rotated geotransforms are not supported");
+    g.nx = nx;
+    g.ny = ny;
+    g.georef.transform = transform;
+    g.georef.has_transform = true;
+    g.georef.crs_wkt = info.wkt;
+    if (info.geographic) {
+      g.georef.is_geographic = true;
+      const double deg = info.unit_factor;
+      io::set_geographic_rows(g, info.ellipsoid, transform[3] * deg, transform[5] * deg,
+                              transform[1] * deg, "DEM.from_array");
+    } else {
+      const double unit = crs.empty() ? 1.0 : info.unit_factor;
+      const double dx = std::fabs(transform[1]) * unit, dy = std::fabs(transform[5]) * unit;
+      if (!(std::isfinite(dx) && dx > 0.0 && std::isfinite(dy) && dy > 0.0))
+        throw Error(ExitCode::config,
+                    "DEM.from_array: 'transform': the pixel sizes must be finite and non-zero");
+      g.dx.assign(static_cast<std::size_t>(ny), dx);
+      g.dy.assign(static_cast<std::size_t>(ny), dy);
+      g.area.assign(static_cast<std::size_t>(ny), dx * dy);
+    }
+  } else {
+    if (!(std::isfinite(cell_size) && cell_size > 0.0))
+      throw Error(ExitCode::config, "DEM.from_array: 'cell_size' must be a positive length (m)");
+    if (info.geographic)
+      throw Error(ExitCode::config,
+                  "DEM.from_array: 'crs' " + crs +
+                      " is geographic (lat/lon): give 'transform' in degrees instead of "
+                      "'cell_size'");
+    g = Grid::uniform(nx, ny, cell_size);
+    g.georef.has_transform = false;
+    if (!crs.empty()) {
+      g.georef.crs_wkt = info.wkt;
+      for (double* v : {&g.georef.transform[0], &g.georef.transform[1], &g.georef.transform[3],
+                        &g.georef.transform[5]})
+        *v /= info.unit_factor;
+    }
+  }
+  g.validate();
+  t.bed.assign(z.data(), z.data() + z.size());
+  std::vector<std::uint8_t> mask(t.bed.size(), 1);
+  std::size_t n_valid = 0;
+  for (std::size_t i = 0; i < t.bed.size(); ++i) {
+    if (std::isfinite(t.bed[i])) {
+      ++n_valid;
+    } else {
+      mask[i] = 0;
+      t.bed[i] = std::nan("");
+    }
+  }
+  if (n_valid == 0)
+    throw Error(ExitCode::config, "DEM.from_array: 'z' has no finite value (every cell nodata)");
+  if (n_valid < t.bed.size()) t.mask = std::move(mask);
+  t.source = source;
+  t.source_sha256 = sha256;
+  return out;
+}
+
 /// A row-major (ny, nx) numpy array of `values` converted to T (a copy).
 template <class T, class V>
 py::array_t<T> grid_array(const std::vector<V>& values, const Grid& g) {
@@ -48,6 +141,13 @@ void add_terrain_bindings(py::module_& m) {
                         "A DEM on its grid, read with its dem.* settings (see erodem.read_dem).")
       .def(py::init(&load), py::arg("settings"),
            "Reads the DEM described by `settings`, a list of (dem.* key, TOML value text).")
+      .def_static("from_array", &from_array, py::arg("z"), py::arg("transform"),
+                  py::arg("has_transform"), py::arg("cell_size"), py::arg("crs"), py::arg("source"),
+                  py::arg("sha256"),
+                  "A terrain from elevations in memory (see erodem.DEM.from_array).")
+      .def_property_readonly(
+          "in_memory", [](const PyTerrain& t) { return t.in_memory; },
+          "Built from an array (DEM.from_array) rather than read from a file.")
       .def_property_readonly(
           "elevation",
           [](const PyTerrain& t) { return grid_array<float>(t.terrain.bed, t.terrain.grid); },

@@ -11,10 +11,10 @@ import pytest
 from test_api import WINDOW, small_config
 
 METRICS = [
-    "eroded_volume",
-    "deposited_volume",
-    "outflow_volume",
-    "max_depth",
+    "eroded_volume [m^3]",
+    "deposited_volume [m^3]",
+    "outflow_volume [m^3]",
+    "max_depth [m]",
     "closure_error",
     "material_closure_error",
 ]
@@ -29,7 +29,7 @@ def sweep_args(tujunga):
 
 def assert_same_tables(a, b):
     assert list(a["member"]) == list(b["member"])
-    for col in METRICS + ["steps", "time"]:
+    for col in METRICS + ["steps", "time [s]", "config_hash"]:
         assert np.array_equal(a[col].to_numpy(), b[col].to_numpy()), col
     for pa, pb in zip(a["output"], b["output"]):
         with h5py.File(pa, "r") as fa, h5py.File(pb, "r") as fb:
@@ -48,18 +48,21 @@ def test_sweep_two_workers_match_serial(erodem, tujunga, tmp_path):
     t0 = time.perf_counter()
     par = erodem.sweep(dem, grid=grid, config=cfg, workers=2, output_dir=tmp_path / "par")
     t_par = time.perf_counter() - t0
-    print(par[["member", "erosion.sediment_capacity", "rain.rate"] + METRICS + ["wall_time"]].to_string())
+    print(par[["member", "erosion.sediment_capacity [s]", "rain.rate [m/s]"] + METRICS
+              + ["wall_time [s]"]].to_string())
     print("4 members: serial %.2f s, 2 workers %.2f s (process start included)" % (t_serial, t_par))
     assert len(par) == 4 and (par["error"] == "").all(), par["error"].tolist()
-    assert list(par["rain.rate"]) == ["40 mm/h", "120 mm/h"] * 2
-    assert (par["eroded_volume"] > 0).all() and (par["steps"] == 120).all()
+    # unit strings as numbers in SI, the unit in the column name
+    assert np.allclose(par["rain.rate [m/s]"], [0.04 / 3600, 0.12 / 3600] * 2, rtol=1e-12)
+    assert list(par["erosion.sediment_capacity [s]"]) == [0.02, 0.02, 0.1, 0.1]
+    assert (par["eroded_volume [m^3]"] > 0).all() and (par["steps"] == 120).all()
     # relative to what moved (docs/model.md section 7): float32 rounding of the depth updates
     # and of the bed pair's residual is some 1e-7 of it; a ledger that missed a term would
     # be off by whole percents
     assert (par["closure_error"].abs() < 1e-4).all()
     assert (par["material_closure_error"].abs() < 1e-4).all()
     # more rain, more erosion (same capacity)
-    assert par["eroded_volume"][1] > par["eroded_volume"][0]
+    assert par["eroded_volume [m^3]"][1] > par["eroded_volume [m^3]"][0]
     assert all(os.path.exists(p) for p in par["output"])
     assert_same_tables(serial, par)
 
@@ -75,9 +78,9 @@ def test_failed_member_is_reported_in_its_row(erodem, tujunga, tmp_path):
                          workers=2, output_dir=tmp_path)
     for e in table["error"]:
         print("error:", e or "(none)")
-    assert table["error"][0] == "" and table["eroded_volume"][0] > 0
+    assert table["error"][0] == "" and table["eroded_volume [m^3]"][0] > 0
     assert "ValueError" in table["error"][1] and "erosion.sediment_capacity" in table["error"][1]
-    assert np.isnan(table["eroded_volume"][1]) and table["output"][1] == ""
+    assert np.isnan(table["eroded_volume [m^3]"][1]) and table["output"][1] == ""
     assert "UnstableError" in table["error"][2] and "step 1" in table["error"][2]
     with pytest.raises(ValueError, match="grid"):
         erodem.sweep(tujunga, grid={"rain.rate": []}, output_dir=tmp_path)
@@ -117,7 +120,7 @@ def test_sweep_over_flow_schemes(erodem, tujunga, tmp_path):
     assert list(table["flow.scheme"]) == ["pipes", "local_inertial", "shallow_water"]
     assert (table["closure_error"].abs() < 1e-4).all()
     assert (table["material_closure_error"].abs() < 1e-4).all()
-    assert (table["eroded_volume"] > 0).all()
+    assert (table["eroded_volume [m^3]"] > 0).all()
     for scheme, path in zip(table["flow.scheme"], table["output"]):
         with h5py.File(path, "r") as f:
             q = np.abs(f["restart/momentum_x"][-1]).max()

@@ -95,6 +95,7 @@ struct CrsInfo {
   std::string unit;          ///< its linear (projected) or angular (geographic) unit's name
   double unit_factor = 1.0;  ///< metres per linear unit, or degrees per angular unit
   Ellipsoid ellipsoid;       ///< the CRS's ellipsoid
+  std::string wkt;           ///< the CRS as WKT (as a DEM's crs_wkt holds it)
 };
 
 /// Describes a CRS given as WKT (or anything GDAL's user input takes). An empty or
