@@ -453,7 +453,7 @@ TEST(Set, ErrorsStartWithSet) {
   EXPECT_EQ(msg.rfind("--set: 'flow.shceme': unknown parameter", 0), 0u) << msg;
   EXPECT_NE(msg.find("did you mean 'flow.scheme'"), std::string::npos) << msg;
   msg = config_error_message([&] { erodem::apply_setting(p, "rain.rate", "-1"); });
-  EXPECT_EQ(msg.rfind("--set: 'rain.rate': expected a rate >= 0", 0), 0u) << msg;
+  EXPECT_EQ(msg.rfind("--set: 'rain.rate': expected a rate in [0, 1]", 0), 0u) << msg;
   msg = config_error_message([&] { erodem::apply_setting(p, "rain.rate"); });
   EXPECT_EQ(msg.rfind("--set: expected key=value", 0), 0u) << msg;
 }
