@@ -97,6 +97,24 @@ inline const Params& default_params() {
   return p;
 }
 
+/// The water volume (m^3) and the area (m^2) of the cells north [0] and south [1] of row
+/// `divide` of `sim`'s grid (the row itself, a wall, left out): two basins' budgets.
+struct Basins {
+  double volume[2] = {0, 0}, area[2] = {0, 0};
+};
+inline Basins basin_volumes(const Simulation& sim, int divide) {
+  const Grid& g = sim.grid();
+  const auto d = sim.field(FieldId::water_depth);
+  Basins b;
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c) {
+      if (r == divide) continue;
+      b.volume[r > divide] += d[static_cast<std::size_t>(r) * g.nx + c] * g.area[r];
+      b.area[r > divide] += g.area[r];
+    }
+  return b;
+}
+
 /// Parameters with every process off and closed boundaries.
 inline Params quiet_params(FlowScheme scheme, double dt) {
   Params p;

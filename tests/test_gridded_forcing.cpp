@@ -153,14 +153,9 @@ TEST_P(GriddedForcing, NetcdfRainWithIrregularTimesGivesTheTrapezoidIntegral) {
   EXPECT_EQ(terrain.rain_grid_times, (std::vector<double>{0, 600, 2400, 6000}));
   auto sim = make_simulation(std::move(terrain), p, target());
   sim.run();
-  const auto d = sim.field(FieldId::water_depth);
-  double volume[2] = {0, 0}, area[2] = {0, 0};
-  for (int r = 0; r < ny; ++r)
-    for (int c = 0; c < nx; ++c) {
-      if (r == 5) continue;
-      volume[r > 5] += d[static_cast<std::size_t>(r) * nx + c] * g.area[r];
-      area[r > 5] += g.area[r];
-    }
+  const Basins basins = basin_volumes(sim, 5);
+  const double* volume = basins.volume;
+  const double* area = basins.area;
   const double expect[2] = {24.5 * 3600 * mm_h * area[0], 17.5 * 3600 * mm_h * area[1]};
   double worst = 0;
   for (int k = 0; k < 2; ++k) {
