@@ -222,14 +222,24 @@ std::vector<float> ViewData::compute(const std::string& name, std::size_t index)
   return classify_terrain(grid_, b, wet, class_rule, snow);
 }
 
-CellValues ViewData::cell_values(int col, int row, std::size_t index) {
+namespace {
+
+/// Cell (col, row) of `grid` at `time` (s), its centre in the grid's coordinates, no values yet.
+CellValues cell_at(const Grid& grid, int col, int row, double time) {
   CellValues c;
   c.col = col;
   c.row = row;
-  const auto p = grid_.cell_center(col, row);
+  const auto p = grid.cell_center(col, row);
   c.x = p[0];
   c.y = p[1];
-  c.time = times_.at(index);
+  c.time = time;
+  return c;
+}
+
+}  // namespace
+
+CellValues ViewData::cell_values(int col, int row, std::size_t index) {
+  CellValues c = cell_at(grid_, col, row, times_.at(index));
   const std::size_t i = static_cast<std::size_t>(row) * grid_.nx + col;
   for (const auto& f : fields_) {
     // Copy the value before the next values() call can evict the vector.
@@ -248,13 +258,7 @@ std::vector<CellValues> ViewData::cell_series(int col, int row,
   for (const auto& n : wanted) field(n);  // unknown -> Error
   std::vector<CellValues> series;
   for (std::size_t k = 0; k < times_.size(); ++k) {
-    CellValues c;
-    c.col = col;
-    c.row = row;
-    const auto p = grid_.cell_center(col, row);
-    c.x = p[0];
-    c.y = p[1];
-    c.time = times_[k];
+    CellValues c = cell_at(grid_, col, row, times_[k]);
     for (const auto& n : wanted) {
       const auto it = cache_.find(std::make_pair(n, k));
       const double v = it != cache_.end() ? it->second[i] : compute(n, k)[i];
