@@ -1,7 +1,8 @@
-// erodem — the float32 cube root shared by the CPU reference and the OpenCL kernels
-// (kernels/common/compat.h): its error against the exact root over a sample of every binade
-// of its range [1e-30, 1e38] (bound: 1 ulp), and the local-inertial face's floor that keeps
-// the root in that range and the friction term finite (kernels/common/flow.h).
+// erodem — the float32 cube root shared by the CPU reference and the OpenCL kernels, and the
+// float64 one of the CPU reference (kernels/common/compat.h): their errors against the exact
+// root over a sample of every binade of their range [1e-30, 1e38] (bound: 1 ulp), and the
+// local-inertial face's floor that keeps the root in that range and the friction term finite
+// (kernels/common/flow.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -71,6 +72,53 @@ TEST(Cbrt, FirstGuessWithinItsBound) {
   }
   std::printf("cbrt_f32_guess: max relative error %.4f (bound 0.033)\n", worst);
   EXPECT_LE(worst, 0.033);
+}
+
+/// |y - cbrt(x)| in units of the last place of the double nearest the exact root (long
+/// double's cbrtl as the exact root: 64-bit mantissa on x86-64, 11 bits beyond double's).
+double ulp_error_f64(double x, double y) {
+  const long double exact = cbrtl(static_cast<long double>(x));
+  const double nearest = static_cast<double>(exact);
+  const double ulp = std::nextafter(nearest, std::numeric_limits<double>::infinity()) - nearest;
+  return static_cast<double>(std::fabs(static_cast<long double>(y) - exact) / ulp);
+}
+
+TEST(Cbrt, Float64WithinOneUlpOverEveryBinadeOfItsRange) {
+  // cbrt_f64_positive (the CPU float64 reference's root, a float guess and one Halley step):
+  // 2^22 spaced bit patterns of [1e-30, 1e38] and a million random mantissas near 1, where
+  // the flow's depths are. Bound 1 ulp, as for the C library's cbrt it replaced; the float
+  // guess alone is off by ~1e6 double ulps, a Halley step with a wrong sign by far more.
+  std::uint64_t lo, hi;
+  const double dlo = ERODEM_CBRT_MIN, dhi = ERODEM_CBRT_MAX;
+  std::memcpy(&lo, &dlo, sizeof lo);
+  std::memcpy(&hi, &dhi, sizeof hi);
+  double worst = 0, worst_x = 0;
+  std::uint64_t count = 0;
+  auto check = [&](double x) {
+    const double e = ulp_error_f64(x, cell::cbrt_f64_positive(x));
+    if (e > worst) worst = e, worst_x = x;
+    ++count;
+  };
+  const std::uint64_t stride = (hi - lo) >> 22;
+  for (std::uint64_t b = lo; b < hi; b += stride) {
+    double x;
+    std::memcpy(&x, &b, sizeof x);
+    check(x);
+  }
+  check(dhi);
+  std::uint64_t state = 88172645463325252ull;  // xorshift64: the same sample every run
+  for (int k = 0; k < 1000000; ++k) {
+    state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+    check(0.5 + static_cast<double>(state >> 11) * 0x1p-53 * 7.5);  // [0.5, 8)
+  }
+  std::printf(
+      "cbrt_f64_positive: %llu values in [%g, %g], max error %.3f ulp at x = %.17g "
+      "(bound 1 ulp)\n",
+      static_cast<unsigned long long>(count), dlo, dhi, worst, worst_x);
+  EXPECT_LE(worst, 1.0);
+  EXPECT_TRUE(std::isnan(cell::cbrt_f64_positive(std::nan(""))));
+  EXPECT_EQ(cell::cbrt_f64_positive(27.0), 3.0);
+  EXPECT_EQ(cell::cbrt_f64_positive(0.125), 0.5);
 }
 
 // A face whose flow depth h_f is at or below ERODEM_FACE_DEPTH_MIN is dry even where

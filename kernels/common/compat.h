@@ -105,8 +105,8 @@ typedef std::uint8_t erodem_kind_t;
  * faces, clipping) turn one ulp into visible differences after many steps. This one uses
  * only correctly rounded +, -, *, / (FP_CONTRACT off in the kernels): a bit-level first
  * guess and two Halley steps, within 1 ulp of the exact root (tests/test_cbrt.cpp).
- * erodem_cbrt_positive(x) is this function for float and the C library's cbrt for double
- * (the CPU float64 reference). */
+ * erodem_cbrt_positive(x) is this function for float and cbrt_f64_positive (below) for
+ * double (the CPU float64 reference). */
 #ifdef __OPENCL_C_VERSION__
 ERODEM_INLINE unsigned int erodem_float_bits(float x) {
   return as_uint(x);
@@ -172,13 +172,25 @@ ERODEM_END_NAMESPACE
 #else
 namespace erodem {
 namespace cell {
+/* Cube root of a double x in [ERODEM_CBRT_MIN, ERODEM_CBRT_MAX] (the CPU float64 reference):
+ * cbrt_f32_positive of x rounded to float (within 1 float ulp, 1.2e-7, of the root of x) and
+ * one Halley step in double (cubic convergence: 1.2e-7 -> 1e-21, below double rounding), so
+ * within 1 ulp of the exact root (tests/test_cbrt.cpp, against long double). Branch-free and
+ * without a call, so the loops that take it vectorise; the C library's cbrt, a call, kept the
+ * local-inertial face loop scalar: float64 flow ran 11.6x slower than float32 at 1024²
+ * (docs/performance.md, float64). */
+inline double cbrt_f64_positive(double x) {
+  const double y = static_cast<double>(cbrt_f32_positive(static_cast<float>(x)));
+  const double y3 = y * y * y;
+  return y - y * ((y3 - x) / (y3 + y3 + x));
+}
 /* The cube root of x in [ERODEM_CBRT_MIN, ERODEM_CBRT_MAX]: cbrt_f32_positive for float,
- * the C library's cbrt for double. */
+ * cbrt_f64_positive for double. */
 inline float erodem_cbrt_positive(float x) {
   return cbrt_f32_positive(x);
 }
 inline double erodem_cbrt_positive(double x) {
-  return std::cbrt(x);
+  return cbrt_f64_positive(x);
 }
 }  // namespace cell
 }  // namespace erodem
@@ -192,7 +204,8 @@ inline double erodem_cbrt_positive(double x) {
  * polynomial to r^7 (error below 6e-9), times 2^-n built from its bits; 0 beyond x = 87 (below
  * the smallest normal float). The weight by its Taylor series to x^7 below x = 0.5 (error
  * below 2e-8), else from exp(-x). Branch-free (the choices are products with 0 or 1), so
- * loops vectorise. For double: the C library's exp and expm1 (the CPU float64 reference). */
+ * loops vectorise. For double (the CPU float64 reference): exp_neg_f64 and relax_weight_f64
+ * below, the same construction to double's precision. */
 ERODEM_BEGIN_NAMESPACE
 ERODEM_INLINE float exp_neg_f32(float x) {
   const float xc = x < 87.0f ? x : 87.0f;
@@ -227,6 +240,64 @@ ERODEM_INLINE float relax_weight_f32(float x) {
 }
 ERODEM_END_NAMESPACE
 
+#ifndef __OPENCL_C_VERSION__
+namespace erodem {
+namespace cell {
+/* 1/k! for k = 0 .. 15, each the double nearest it. */
+constexpr double kInverseFactorial[16] = {1.0,
+                                          1.0,
+                                          0.5,
+                                          1.66666666666666667e-1,
+                                          4.16666666666666667e-2,
+                                          8.33333333333333333e-3,
+                                          1.38888888888888889e-3,
+                                          1.98412698412698413e-4,
+                                          2.48015873015873016e-5,
+                                          2.75573192239858907e-6,
+                                          2.75573192239858907e-7,
+                                          2.50521083854417188e-8,
+                                          2.08767569878680990e-9,
+                                          1.60590438368216146e-10,
+                                          1.14707455977297247e-11,
+                                          7.64716373181981648e-13};
+/* sum over k = 0 .. n of (-x)^k / (k + shift)! by Horner's rule from the highest term (n +
+ * shift <= 15). Called with constant n and shift, the loop unrolls into the written-out
+ * polynomial, and the cell loops that take it still vectorise. */
+inline double alternating_factorial_series(double x, int shift, int n) {
+  double p = (n % 2 ? -1.0 : 1.0) * kInverseFactorial[n + shift];
+  for (int k = n - 1; k >= 0; --k) p = p * x + (k % 2 ? -1.0 : 1.0) * kInverseFactorial[k + shift];
+  return p;
+}
+/* exp(-x) for x >= 0 in double, as exp_neg_f32: x = n ln 2 + r, |r| <= 0.35 (ln 2 in two
+ * parts: the first has 32 significant bits, so n ln2_hi is exact for n < 2^21), exp(-r) by its
+ * Taylor polynomial to r^13 (tail below 5e-18), times 2^-n from its bits; 0 beyond x = 708
+ * (exp(-708) = 3.3e-308, just above the smallest normal double; the C library would give
+ * subnormals up to 745). Within 2 ulps of the exact value (tests/test_exp.cpp, against long
+ * double). The C library's exp, a call, kept the physical erosion law's cell loop scalar:
+ * its float64 pass ran 14x slower than float32 (docs/performance.md, float64). */
+inline double exp_neg_f64(double x) {
+  const double xc = x < 708.0 ? x : 708.0;
+  const int n = static_cast<int>(xc * 1.4426950408889634 + 0.5);
+  const double r = (xc - n * 0.693147180369123816490) - n * 1.90821492927058770002e-10;
+  const double p = alternating_factorial_series(r, 0, 13);
+  const std::uint64_t bits = static_cast<std::uint64_t>(1023 - n) << 52;
+  double scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  const double in_range = static_cast<double>(x < 708.0); /* a product, not a select */
+  return p * scale * in_range;
+}
+/* (1 - exp(-x)) / x for x >= 0 in double (1 at x = 0): its Taylor series to x^14 below x =
+ * 0.5 (tail below 2e-18), else from exp_neg_f64; within 2 ulps (tests/test_exp.cpp). */
+inline double relax_weight_f64(double x) {
+  const double p = alternating_factorial_series(x, 1, 14);
+  const double big = (1.0 - exp_neg_f64(x)) / (x > 0.5 ? x : 1.0);
+  const double large = static_cast<double>(x > 0.5);
+  return large * big + (1.0 - large) * p;
+}
+}  // namespace cell
+}  // namespace erodem
+#endif
+
 #ifdef __OPENCL_C_VERSION__
 #define erodem_exp_neg(x) exp_neg_f32(x)
 #define erodem_relax_weight(x) relax_weight_f32(x)
@@ -237,13 +308,13 @@ inline float erodem_exp_neg(float x) {
   return exp_neg_f32(x);
 }
 inline double erodem_exp_neg(double x) {
-  return std::exp(-x);
+  return exp_neg_f64(x);
 }
 inline float erodem_relax_weight(float x) {
   return relax_weight_f32(x);
 }
 inline double erodem_relax_weight(double x) {
-  return x > 0 ? -std::expm1(-x) / x : 1.0;
+  return relax_weight_f64(x);
 }
 }  // namespace cell
 }  // namespace erodem
