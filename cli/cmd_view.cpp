@@ -43,6 +43,7 @@ struct ViewOptions {
   bool overwrite = false, top = false, timing = false;
 };
 
+#ifdef ERODEM_HAVE_VIEWER
 /// "WxH" in pixels.
 std::pair<int, int> parse_size(const std::string& s) {
   int w = 0, h = 0;
@@ -109,7 +110,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-#ifdef ERODEM_HAVE_VIEWER
 /// What was drawn, on stderr: the colour map and range, the clipped ends, the scale bar and
 /// the north arrow (the figures the tests check against the pixels).
 void describe_drawing(const viz::Scene& scene) {
