@@ -261,6 +261,16 @@ TEST_F(Cli, InfoDescribesAResultFile) {
   EXPECT_NE(j.output.find("\"times_s\": [0, 50, 100]"), std::string::npos) << j.output;
   EXPECT_NE(j.output.find("\"restart_state\": true"), std::string::npos) << j.output;
   EXPECT_NE(j.output.find("\"steps\": 200"), std::string::npos) << j.output;
+  EXPECT_NE(j.output.find("\"restart_times_s\": [0, 50, 100]"), std::string::npos) << j.output;
+  // With the state at every other snapshot (and the last): the times that have it.
+  ASSERT_EQ(run_cli("run c.toml --set output.restart_every=2 --output some.h5", dir_).code, 0);
+  const auto some = run_cli("info some.h5", dir_);
+  EXPECT_NE(some.output.find("the full state at 2 of the 3 snapshots: erodem run CONFIG "
+                             "--restart some.h5:TIME with TIME one of 0, 100 s"),
+            std::string::npos)
+      << some.output;
+  EXPECT_NE(run_cli("info some.h5 --json", dir_).output.find("\"restart_times_s\": [0, 100]"),
+            std::string::npos);
 }
 
 TEST_F(Cli, MissingFilesExit66) {

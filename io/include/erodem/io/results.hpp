@@ -75,7 +75,8 @@ class ResultWriter {
   ResultWriter& operator=(const ResultWriter&) = delete;
 
   /// Appends the configured output fields at the simulation's current time (inactive cells
-  /// NaN), writes the buffered diagnostics and gauge rows, and flushes the file.
+  /// NaN), the restart state at every output.restart_every-th snapshot (the first, t = 0,
+  /// included), writes the buffered diagnostics and gauge rows, and flushes the file.
   void snapshot(const Simulation& sim);
   /// Buffers one row of diagnostics (and gauge samples) after a step of `sim`. The gauges
   /// read gauge_fields() at gauge_cells(): the step's probe samples when `sim` has them as
@@ -94,7 +95,10 @@ class ResultWriter {
   bool snapshot_due(const Simulation& sim) const;
   /// record_step(), then snapshot() when due.
   void step_done(const Simulation& sim);
-  /// Takes a final snapshot unless the current step has one, then finish().
+  /// The run's last snapshot: a snapshot of `sim`'s current step unless it has one, and
+  /// with the restart state (output.restart_state) whatever output.restart_every says.
+  void last_snapshot(const Simulation& sim);
+  /// last_snapshot(), then finish().
   void finish(const Simulation& sim);
   /// Writes what is buffered, closes the file, writes the .xmf sidecar and renames both
   /// into place. Without `overwrite`, a file created at `path` meanwhile is an error.
@@ -109,15 +113,21 @@ class ResultWriter {
   /// Where the file is until finish().
   const std::string& partial() const { return partial_; }
   std::size_t snapshots() const { return times_.size(); }
+  /// The snapshots stored with their restart state (output.restart_every).
+  std::size_t states() const { return states_; }
   /// Step of the last snapshot (-1 before the first).
   long last_snapshot_step() const { return last_snapshot_step_; }
 
  private:
+  void take_snapshot(const Simulation& sim, bool last);
+  void store_state(const Simulation& sim);  // one row of restart/
+
   struct Impl;
   std::string path_, partial_;
   bool overwrite_;
   std::unique_ptr<Impl> impl_;
   std::vector<double> times_;
+  std::size_t states_ = 0;
   long last_snapshot_step_ = -1;
 };
 
@@ -156,11 +166,16 @@ class ResultReader {
   const Grid& grid() const { return grid_; }
   /// The per-step diagnostics.
   std::vector<Diagnostics> diagnostics() const;
-  /// Whether the file holds the full state at its snapshots (output.restart_state).
+  /// Whether the file holds the full state at some snapshots (output.restart_state).
   bool has_restart_state() const;
-  /// The full state at snapshot `index`, to continue the run from (Simulation::restore).
-  /// No restart state -> Error(ExitCode::data) saying how to get one; index out of range
-  /// -> Error(ExitCode::usage).
+  /// The times whose full state the file holds (s; restart/time, every
+  /// output.restart_every-th snapshot and the last; in files before 2026-11-27 every
+  /// snapshot); empty without restart state.
+  std::vector<double> restart_times() const;
+  /// The full state at restart_times()[index], to continue the run from
+  /// (Simulation::restore). No restart state -> Error(ExitCode::data) saying how to get one;
+  /// index out of range -> Error(ExitCode::usage). Reads both layouts: restart/time with
+  /// once-per-value fields (NAME_row), and the older one, a row per snapshot.
   RestartPoint restart_point(std::size_t index) const;
   /// Gauge series (empty when the run had none).
   GaugeSeries gauges() const;
