@@ -3,6 +3,7 @@
 // and GDAL read the files as they are.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -294,7 +295,9 @@ TEST(Results, PartialFileSurvivesWithoutFinish) {
   EXPECT_FALSE(fs::exists(path));
   EXPECT_FALSE(fs::exists(dir.file("crash.xmf")));
   const std::string partial = erodem::io::partial_path(path);
-  EXPECT_EQ(partial, dir.file(".crash.h5.partial"));
+  // unique to the process: .crash.h5.HOST-PID.partial
+  EXPECT_EQ(partial, dir.file(".crash.h5." + erodem::io::host_name() + "-" +
+                              std::to_string(getpid()) + ".partial"));
   ASSERT_TRUE(fs::exists(partial));
   ResultReader r(partial);
   EXPECT_EQ(r.times(), (std::vector<double>{0.0, 1.5}));
@@ -343,7 +346,7 @@ TEST(Results, GaugeOutsideTheGridIsAConfigError) {
                 &msg),
             ExitCode::config);
   EXPECT_NE(msg.find("output.gauges[2]"), std::string::npos) << msg;
-  EXPECT_FALSE(fs::exists(dir.file(".g.h5.partial")));
+  EXPECT_FALSE(fs::exists(erodem::io::partial_path(dir.file("g.h5"))));
 }
 
 TEST(Results, ReaderRejectsMissingAndForeignFiles) {

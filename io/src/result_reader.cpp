@@ -48,7 +48,7 @@ ResultReader::ResultReader(const std::string& path) : path_(path) {
   if (!fs::exists(path, ec)) throw Error(ExitCode::no_input, path + ": no such file");
   if (H5Fis_hdf5(path.c_str()) <= 0) not_ours(path, "not an HDF5 file");
   file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (file_ < 0) throw Error(ExitCode::data, path + ": cannot open" + h5_reason());
+  if (file_ < 0) throw Error(ExitCode::data, path + ": cannot open" + h5_open_reason(path));
   try {
     if (H5Aexists(file_, "erodem_version") <= 0) not_ours(path, "no erodem_version attribute");
     // Root attributes (text ones).

@@ -6,10 +6,12 @@
 #include <hdf5.h>
 #include <hdf5_hl.h>
 #include <ogr_srs_api.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <ctime>
@@ -83,7 +85,32 @@ std::string geotransform_text(const std::array<double, 6>& t) {
 
 std::string partial_path(const std::string& path) {
   const fs::path p(path);
-  return (p.parent_path() / ("." + p.filename().string() + ".partial")).string();
+  return (p.parent_path() /
+          fmt::format(".{}.{}-{}.partial", p.filename().string(), host_name(), getpid()))
+      .string();
+}
+
+void remove_stale_partials(const std::string& path) {
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  const std::string prefix = "." + p.filename().string() + "." + host_name() + "-";
+  const std::string suffix = ".partial";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    const std::string digits =
+        name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    if (digits.size() > 9 ||
+        !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == getpid() || pid <= 0 || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);  // its process has ended: a run that stopped early
+  }
 }
 
 std::string xdmf_path(const std::string& path) {
@@ -259,6 +286,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     : path_(path), partial_(partial_path(path)), overwrite_(overwrite) {
   QuietH5 quiet;
   check_output_path(path, overwrite);  // folder exists and is writable, no file in the way
+  seen_ = file_identity(path);         // what --overwrite may replace at finish()
   if (grid.nx <= 0 || grid.ny <= 0)
     throw Error(ExitCode::internal, path + ": result file for an empty grid");
 
@@ -296,7 +324,8 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   H5Pset_attr_creation_order(fcpl, kCreationOrder);
   m.file = H5Id(H5Fcreate(partial_.c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT));
   if (!m.file.valid())
-    throw Error(ExitCode::cant_create, partial_ + ": cannot create" + h5_reason());
+    throw Error(ExitCode::cant_create, partial_ + ": cannot create" + h5_open_reason(partial_));
+  remove_stale_partials(path);
 
   // Root attributes.
   const std::pair<const char*, std::string> root_attrs[] = {
@@ -726,19 +755,37 @@ void ResultWriter::finish() {
   m.close();
   impl_.reset();
 
-  std::error_code ec;
-  if (!overwrite_ && fs::exists(path_, ec))
-    throw Error(ExitCode::cant_create, path_ +
-                                           ": exists (created during the run); not overwritten "
-                                           "(give --overwrite); the results are in " +
-                                           partial_);
-
+  publish();
   write_xdmf(path_, grid, xname, yname, times_, infos);
+}
 
-  fs::rename(partial_, path_, ec);
-  if (ec)
-    throw Error(ExitCode::io,
-                path_ + ": cannot rename " + partial_ + " into place: " + ec.message());
+void ResultWriter::publish(bool force_link) const {
+  // Never over a file another process put at `path` during the run: without overwrite
+  // nothing may be there, with it only the file seen at the start (or nothing).
+  const FileIdentity now = file_identity(path_);
+  const std::string kept = "; this run's results are in " + partial_;
+  if (overwrite_ && now.exists) {
+    if (now != seen_)
+      throw Error(ExitCode::cant_create,
+                  path_ +
+                      (seen_.exists ? ": replaced by another process during the run"
+                                    : ": created by another process during the run") +
+                      "; not overwritten" + kept);
+    std::error_code ec;
+    fs::rename(partial_, path_, ec);
+    if (ec)
+      throw Error(ExitCode::io,
+                  path_ + ": cannot rename " + partial_ + " into place: " + ec.message() + kept);
+    return;
+  }
+  const int err = rename_no_replace(partial_, path_, force_link);
+  if (err == EEXIST)
+    throw Error(ExitCode::cant_create,
+                path_ + ": exists (created by another process during the run); not overwritten" +
+                    (overwrite_ ? "" : " (give --overwrite)") + kept);
+  if (err != 0)
+    throw Error(ExitCode::io, path_ + ": cannot rename " + partial_ +
+                                  " into place: " + std::strerror(err) + kept);
 }
 
 }  // namespace erodem::io

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "erodem/grid.hpp"
+#include "erodem/io/paths.hpp"
 #include "erodem/params.hpp"
 #include "erodem/simulation.hpp"
 
@@ -43,9 +44,12 @@ struct Provenance {
   static Provenance of(const Simulation& sim, const std::string& command_line);
 };
 
-/// The temporary name a result file is written under until ResultWriter::finish():
-/// "dir/run.h5" -> "dir/.run.h5.partial".
+/// The temporary name a result file is written under until ResultWriter::finish(), unique
+/// to this process: "dir/run.h5" -> "dir/.run.h5.HOST-PID.partial" (host_name(), getpid()).
 std::string partial_path(const std::string& path);
+/// Removes the partial files of `path` left by processes of this host that have ended
+/// (".run.h5.HOST-PID.partial" whose PID does not exist); those of other hosts stay.
+void remove_stale_partials(const std::string& path);
 /// The XDMF sidecar of a result file: "dir/run.h5" -> "dir/run.xmf".
 std::string xdmf_path(const std::string& path);
 
@@ -100,9 +104,16 @@ class ResultWriter {
   void last_snapshot(const Simulation& sim);
   /// last_snapshot(), then finish().
   void finish(const Simulation& sim);
-  /// Writes what is buffered, closes the file, writes the .xmf sidecar and renames both
-  /// into place. Without `overwrite`, a file created at `path` meanwhile is an error.
+  /// Writes what is buffered, closes the file, renames it into place (publish()) and writes
+  /// the .xmf sidecar.
   void finish();
+  /// Renames the closed partial file to path(), never over a file another process put there
+  /// during the run: without `overwrite` nothing may be at path() (renameat2
+  /// RENAME_NOREPLACE, or link + unlink where the file system refuses it: rename_no_replace;
+  /// `force_link` takes that way, for the tests), with it only the file that was there when
+  /// the writer was made (same device, inode, mtime and size) or nothing. Otherwise
+  /// Error(ExitCode::cant_create) naming path() and partial(), which keeps the results.
+  void publish(bool force_link = false) const;
   /// Writes what is buffered and closes the file without renaming it: it stays at
   /// partial(), a readable result file (as the destructor leaves it). No-op once closed.
   void close();
@@ -125,6 +136,7 @@ class ResultWriter {
   struct Impl;
   std::string path_, partial_;
   bool overwrite_;
+  FileIdentity seen_;  // the file at path_ when the writer was made
   std::unique_ptr<Impl> impl_;
   std::vector<double> times_;
   std::size_t states_ = 0;
