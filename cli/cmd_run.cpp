@@ -208,7 +208,13 @@ int run(const RunOptions& o) {
   const long ran = sim.steps_done() - session.first_step();
   std::printf("ran %ld steps to t = %.6g s in %.3f s wall (%.3g cell-steps/s)\n", ran, sim.time(),
               wall, cells * static_cast<double>(ran) / wall);
-  // the file's size, and per snapshot (the restart state is most of it: output.restart_state)
+  // the file's size, and per snapshot (the restart state is most of it: output.restart_state,
+  // at every output.restart_every-th snapshot and the last)
+  const std::string with_state =
+      !p.output.restart_state ? ""
+      : writer.states() == writer.snapshots()
+          ? " with the restart state"
+          : fmt::format(" with the restart state at {} of them", writer.states());
   std::error_code size_error;
   const double megabytes =
       static_cast<double>(std::filesystem::file_size(writer.path(), size_error)) / 1e6;
@@ -218,8 +224,7 @@ int run(const RunOptions& o) {
       writer.path().c_str(), writer.snapshots(), p.output.fields.size(), ran,
       size_error ? 0.0 : megabytes,
       size_error || writer.snapshots() == 0 ? 0.0 : megabytes / writer.snapshots(),
-      p.output.restart_state ? " with the restart state" : "",
-      io::xdmf_path(writer.path()).c_str());
+      with_state.c_str(), io::xdmf_path(writer.path()).c_str());
   // The closures last, relative to what moved (ledger.hpp), for scripts that read the tail.
   const Ledger& L = sim.ledger();
   std::printf(

@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "erodem/error.hpp"
+#include "erodem/io/results.hpp"
 
 #ifdef ERODEM_HAVE_VIEWER
 #include "erodem/viz/colormap.hpp"
@@ -81,8 +82,7 @@ std::array<double, 2> parse_clim(const std::string& s) {
 /// The picked cell's time series as CSV: time_s, then every field (NaN: empty).
 void write_series_csv(const std::string& path, const std::vector<viz::CellValues>& series) {
   const std::filesystem::path target(path);
-  const std::filesystem::path tmp =
-      target.parent_path() / (std::string(".") + target.filename().string() + ".partial");
+  const std::filesystem::path tmp = erodem::io::partial_path(path);  // unique to this process
   {
     std::FILE* f = std::fopen(tmp.string().c_str(), "w");
     if (!f) throw Error(ExitCode::cant_create, path + ": could not create the file");

@@ -1,6 +1,8 @@
 // `erodem info RESULT.h5`: what a result file holds — who wrote it and how (version,
 // command, backend), the grid, the fields and snapshot times, whether and where it can be
 // restarted, and the run's books at its last step (the ledger's volumes, closures, maxima).
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -53,6 +55,7 @@ int info_result(const std::string& path, bool json) {
   const auto& times = r.times();
   const auto diag = r.diagnostics();
   const bool restartable = r.has_restart_state();
+  const auto restart_times = r.restart_times();  // output.restart_every: maybe not all
   std::error_code ec;
   const auto bytes = fs::file_size(path, ec);
   double dx_min = g.dx.empty() ? 0 : g.dx.front(), dx_max = dx_min;
@@ -83,6 +86,10 @@ int info_result(const std::string& path, bool json) {
     for (std::size_t i = 0; i < times.size(); ++i) t += (i ? ", " : "") + json_number(times[i]);
     field("times_s", t + "]");
     field("restart_state", restartable ? "true" : "false");
+    std::string rt = "[";
+    for (std::size_t i = 0; i < restart_times.size(); ++i)
+      rt += (i ? ", " : "") + json_number(restart_times[i]);
+    field("restart_times_s", rt + "]");
     field("steps", std::to_string(diag.size()));
     std::string d = "{";
     for (std::size_t i = 0; i < diagnostics_series().size(); ++i) {
@@ -112,11 +119,15 @@ int info_result(const std::string& path, bool json) {
                 num(times.back()).c_str());
   if (restartable) {
     std::vector<std::string> t;
-    for (double v : times) t.push_back(num(v));
+    for (double v : restart_times) t.push_back(num(v));
+    const std::string at =
+        restart_times.size() == times.size()
+            ? std::string("every snapshot")
+            : fmt::format("{} of the {} snapshots", restart_times.size(), times.size());
     std::printf(
-        "restart      the full state at every snapshot: erodem run CONFIG --restart "
-        "%s:TIME with TIME one of %s s\n",
-        path.c_str(), join(t).c_str());
+        "restart      the full state at %s: erodem run CONFIG --restart %s:TIME with TIME one "
+        "of %s s\n",
+        at.c_str(), path.c_str(), join(t).c_str());
   } else {
     std::printf("restart      none (written with output.restart_state = false)\n");
   }

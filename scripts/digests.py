@@ -5,7 +5,8 @@ result bit for bit (docs/architecture.md, "Keeping results bit-identical").
 Runs the reference scenarios through the built `erodem` CLI on every target (CPU float32 and
 float64, OpenCL float32 where there is a device) and prints the SHA-256 of every dataset of
 the result file: the field snapshots, `diagnostics/`, `gauges/` and `restart/` (provenance
-attributes, which hold times and versions, are not hashed). The scenarios are the storm of
+attributes, which hold times and versions, are not hashed; a restart field stored once per
+value is hashed as a row per stored time, so files of the older layout compare). The scenarios are the storm of
 tests/scenarios.hpp `tujunga_storm` on the 256^2 Big Tujunga crop (local inertial +
 conservative transport with adaptive steps; pipes + semi-Lagrangian with fixed steps) and the
 two runs of tests/test_restart.cpp (a synthetic valley with rain series, erosion, thermal
@@ -172,12 +173,16 @@ def opencl_available(erodem):
 
 
 def dataset_digests(path):
-    """{dataset path: sha256 of its bytes (C order, stored dtype)} for every dataset."""
+    """{dataset path: sha256 of its bytes (C order, stored dtype)} for every dataset. A
+    restart field stored once per value (restart/NAME with restart/NAME_row, 2026-11-27) is
+    hashed expanded to its row at each stored time, as files before that stored it, so the
+    digests of the two layouts compare."""
     out = {}
 
     def visit(name, obj):
         if isinstance(obj, h5py.Dataset):
-            data = obj[()]
+            rows = obj.parent.get(obj.name.rsplit("/", 1)[1] + "_row")
+            data = obj[()] if rows is None else obj[()][rows[()]]
             if isinstance(data, bytes):
                 raw = data
             else:

@@ -38,6 +38,16 @@ class Cli : public ::testing::Test {
       if (e.path().filename().string().rfind(prefix, 0) == 0) ++n;
     return n;
   }
+  /// The partial file of result `name` (".NAME.HOST-PID.partial"); empty when there is none.
+  fs::path partial_of(const std::string& name) const {
+    const std::string prefix = "." + name + ".";
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      const std::string f = e.path().filename().string();
+      if (f.rfind(prefix, 0) == 0 && f.size() > 8 && f.substr(f.size() - 8) == ".partial")
+        return e.path();
+    }
+    return {};
+  }
   fs::path dir_;
 };
 
@@ -94,7 +104,7 @@ TEST_F(Cli, RunWritesFieldsAndPrintsLedger) {
   EXPECT_NE(r.output.find("closure"), std::string::npos);
   EXPECT_NE(r.output.find("wrote out.h5"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(dir_ / "out.xmf"));
-  EXPECT_FALSE(fs::exists(dir_ / ".out.h5.partial"));
+  EXPECT_TRUE(partial_of("out.h5").empty());
   {
     const erodem::io::ResultReader out((dir_ / "out.h5").string());
     EXPECT_EQ(out.times().size(), 3u);  // steps 0, 100 (output.every) and 200
@@ -261,6 +271,16 @@ TEST_F(Cli, InfoDescribesAResultFile) {
   EXPECT_NE(j.output.find("\"times_s\": [0, 50, 100]"), std::string::npos) << j.output;
   EXPECT_NE(j.output.find("\"restart_state\": true"), std::string::npos) << j.output;
   EXPECT_NE(j.output.find("\"steps\": 200"), std::string::npos) << j.output;
+  EXPECT_NE(j.output.find("\"restart_times_s\": [0, 50, 100]"), std::string::npos) << j.output;
+  // With the state at every other snapshot (and the last): the times that have it.
+  ASSERT_EQ(run_cli("run c.toml --set output.restart_every=2 --output some.h5", dir_).code, 0);
+  const auto some = run_cli("info some.h5", dir_);
+  EXPECT_NE(some.output.find("the full state at 2 of the 3 snapshots: erodem run CONFIG "
+                             "--restart some.h5:TIME with TIME one of 0, 100 s"),
+            std::string::npos)
+      << some.output;
+  EXPECT_NE(run_cli("info some.h5 --json", dir_).output.find("\"restart_times_s\": [0, 100]"),
+            std::string::npos);
 }
 
 TEST_F(Cli, MissingFilesExit66) {
@@ -286,10 +306,11 @@ TEST_F(Cli, UnstableRunExit75NamesTheCell) {
   EXPECT_NE(r.output.find("cell (col"), std::string::npos);
   // The final name is not created; the steps so far stay in the partial file.
   EXPECT_EQ(files_matching("out"), 0u);
-  EXPECT_TRUE(fs::exists(dir_ / ".out.h5.partial"));
-  EXPECT_NE(r.output.find(".out.h5.partial"), std::string::npos) << r.output;
+  const fs::path partial = partial_of("out.h5");
+  ASSERT_FALSE(partial.empty());
+  EXPECT_NE(r.output.find(partial.filename().string()), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("was not created"), std::string::npos) << r.output;
-  EXPECT_GE(erodem::io::ResultReader((dir_ / ".out.h5.partial").string()).times().size(), 1u);
+  EXPECT_GE(erodem::io::ResultReader(partial.string()).times().size(), 1u);
 }
 
 TEST_F(Cli, DumpConfigRoundTripsAndUsageErrors) {

@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "cli_runner.hpp"
@@ -320,7 +323,8 @@ TEST_F(RestartErrors, ClearMessagesAndExitCodes) {
   };
   for (const Expect& e : {
            Expect{"a time not stored (the stored ones are listed)",
-                  "--output b.h5 --restart a.h5:0.55", 2, "the file holds t = 0, 1, 2 s"},
+                  "--output b.h5 --restart a.h5:0.55", 2,
+                  "the file holds the state at t = 0, 1, 2 s (3 times)"},
            Expect{"a missing file", "--output b.h5 --restart nothere.h5", 66, "nothere.h5"},
            Expect{"no restart state", "--output b.h5 --restart plain.h5", 65, "no restart state"},
            Expect{"another grid", "--set dem.size=32 --output b.h5 --restart a.h5", 65, "40 x 40"},
@@ -339,7 +343,66 @@ TEST_F(RestartErrors, ClearMessagesAndExitCodes) {
   EXPECT_EQ(erodem::io::ResultReader((dir_ / "c.h5").string()).restart_point(0).steps, 20);
   // Nothing left behind by the failed runs.
   EXPECT_FALSE(fs::exists(dir_ / "b.h5"));
-  EXPECT_FALSE(fs::exists(dir_ / ".b.h5.partial"));
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_NE(e.path().filename().string().rfind(".b.h5.", 0), 0u) << e.path();
+}
+
+TEST_F(RestartErrors, RestartEveryStoresEveryNthStateAndTheLast) {
+  // Snapshots at steps 0, 10, 20, 30, 40 and 45; the state at the 1st, 4th and the last.
+  const std::string run =
+      "run config.toml --backend cpu --set time.steps=45 --set output.every=10 ";
+  ASSERT_EQ(run_cli(run + "--output every1.h5", dir_).code, 0);
+  const auto r = run_cli(run + "--set output.restart_every=3 --output every3.h5", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("MB per snapshot with the restart state at 3 of them)"),
+            std::string::npos)
+      << r.output;
+  const erodem::io::ResultReader all((dir_ / "every1.h5").string()),
+      some((dir_ / "every3.h5").string());
+  ASSERT_EQ(some.times().size(), 6u);
+  const auto& t = some.times();
+  EXPECT_EQ(some.restart_times(), (std::vector<double>{t[0], t[3], t[5]}));
+  EXPECT_EQ(all.restart_times(), t);
+  // The same states as the file with all of them; the once-per-value fields (initial_bed,
+  // which no sweep writes) in one row.
+  for (const auto& [i, j] : {std::pair{0, 0}, std::pair{3, 1}, std::pair{5, 2}}) {
+    const auto pa = all.restart_point(i), pb = some.restart_point(j);
+    EXPECT_EQ(pa.steps, pb.steps);
+    EXPECT_EQ(std::memcmp(&pa.ledger, &pb.ledger, sizeof pa.ledger), 0);
+    ASSERT_EQ(pa.fields.size(), pb.fields.size());
+    for (std::size_t k = 0; k < pa.fields.size(); ++k)
+      EXPECT_EQ(differing(pa.fields[k], pb.fields[k]), 0u) << k;
+  }
+  const auto sizes =
+      std::pair{fs::file_size(dir_ / "every1.h5"), fs::file_size(dir_ / "every3.h5")};
+  std::printf("[restart_every] 6 snapshots: %ju bytes with the state at each, %ju at 3 of them\n",
+              static_cast<std::uintmax_t>(sizes.first), static_cast<std::uintmax_t>(sizes.second));
+  EXPECT_LT(sizes.second, sizes.first);
+  // From a stored state: the run goes on as the full one did, bit for bit.
+  const auto from =
+      run_cli(run + "--output from.h5 --restart every3.h5:" + std::to_string(t[3]), dir_);
+  ASSERT_EQ(from.code, 0) << from.output;
+  const erodem::io::ResultReader b((dir_ / "from.h5").string());
+  ASSERT_EQ(b.times().size(), 3u);
+  for (std::size_t j = 0; j < 3; ++j)
+    for (const auto& f : all.fields())
+      EXPECT_EQ(differing(all.read_index(f, 3 + j), b.read_index(f, j)), 0u) << f << " " << j;
+  // A snapshot without its state, and a bad value.
+  for (const auto& [args, code, message] :
+       {std::tuple{"--output c.h5 --restart every3.h5:" + std::to_string(t[1]), 2,
+                   std::string("that snapshot has no stored state (output.restart_every); the "
+                               "file holds the state at t = 0, ")},
+        std::tuple{std::string("--set output.restart_every=0 --output c.h5"), 78,
+                   std::string("output.restart_every")}}) {
+    const auto e = run_cli(run + args, dir_);
+    std::printf("  exit %d: %s", e.code, e.output.c_str());
+    EXPECT_EQ(e.code, code) << e.output;
+    EXPECT_NE(e.output.find(message), std::string::npos) << e.output;
+    if (code == 2) {
+      EXPECT_NE(e.output.find("(3 times)"), std::string::npos) << e.output;
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "c.h5"));
 }
 
 }  // namespace

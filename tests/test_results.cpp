@@ -3,6 +3,7 @@
 // and GDAL read the files as they are.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -223,6 +224,39 @@ TEST(Results, WriteAndReadBack) {
   EXPECT_EQ(xmf.find("<Grid Name=\"t6\""), std::string::npos);
 }
 
+TEST(Results, AFieldStoredOncePerValueGetsARowWhenItChanges) {
+  // initial_bed, which no sweep writes, is stored once per value: a second row only when it
+  // changes between steps (as Python's `sim.bed = ...` changes it), and each stored time
+  // restarts with its own.
+  using erodem::FieldId;
+  erodem::test::TempDir dir("erodem_results_");
+  const std::string path = dir.file("once.h5");
+  auto sim = small_run(4, 1);
+  ResultWriter w(path, sim, "", false);
+  const auto original = sim.field(FieldId::initial_bed);
+  w.snapshot(sim);
+  sim.step();
+  w.step_done(sim);
+  auto edited = original;
+  for (auto& z : edited) z += 2.0;
+  sim.backend().set_field(FieldId::initial_bed, edited);
+  edited = sim.field(FieldId::initial_bed);  // as the run's precision keeps it
+  for (int k = 0; k < 3; ++k) {
+    sim.step();
+    w.step_done(sim);
+  }
+  w.finish(sim);
+  const ResultReader r(path);
+  ASSERT_EQ(r.restart_times().size(), 5u);
+  std::size_t k = 0;
+  while (erodem::state_fields()[k] != FieldId::initial_bed) ++k;
+  for (std::size_t i = 0; i < 5; ++i)
+    EXPECT_EQ(r.restart_point(i).fields[k], i < 2 ? original : edited) << i;
+  std::printf(
+      "[once per value] initial_bed edited after step 1: stored times 0, 1 restart with "
+      "the original, 2 to 4 with the edit\n");
+}
+
 TEST(Results, GeographicGridsUseLatLon) {
   using namespace erodem;
   erodem::test::TempDir dir("erodem_results_");
@@ -294,7 +328,9 @@ TEST(Results, PartialFileSurvivesWithoutFinish) {
   EXPECT_FALSE(fs::exists(path));
   EXPECT_FALSE(fs::exists(dir.file("crash.xmf")));
   const std::string partial = erodem::io::partial_path(path);
-  EXPECT_EQ(partial, dir.file(".crash.h5.partial"));
+  // unique to the process: .crash.h5.HOST-PID.partial
+  EXPECT_EQ(partial, dir.file(".crash.h5." + erodem::io::host_name() + "-" +
+                              std::to_string(getpid()) + ".partial"));
   ASSERT_TRUE(fs::exists(partial));
   ResultReader r(partial);
   EXPECT_EQ(r.times(), (std::vector<double>{0.0, 1.5}));
@@ -343,7 +379,7 @@ TEST(Results, GaugeOutsideTheGridIsAConfigError) {
                 &msg),
             ExitCode::config);
   EXPECT_NE(msg.find("output.gauges[2]"), std::string::npos) << msg;
-  EXPECT_FALSE(fs::exists(dir.file(".g.h5.partial")));
+  EXPECT_FALSE(fs::exists(erodem::io::partial_path(dir.file("g.h5"))));
 }
 
 TEST(Results, ReaderRejectsMissingAndForeignFiles) {

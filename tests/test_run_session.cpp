@@ -146,7 +146,7 @@ TEST(RunSession, PiecesAndAPreloadedTerrainGiveTheOneRunFile) {
     pieces.finish();
   }
   ASSERT_TRUE(fs::exists(dir.file("one.h5")) && fs::exists(dir.file("pieces.h5")));
-  EXPECT_FALSE(fs::exists(dir.file(".pieces.h5.partial")));
+  EXPECT_FALSE(fs::exists(erodem::io::partial_path(dir.file("pieces.h5"))));
   const ResultReader a(dir.file("one.h5")), b(dir.file("pieces.h5"));
   ASSERT_EQ(a.times(), b.times());
   std::size_t values = 0;
@@ -185,12 +185,12 @@ TEST(RunSession, AnUnstableStepIsRecordedAndNamed) {
     const std::string m = e.what();
     std::printf("[run_session] %s\n", m.c_str());
     EXPECT_NE(m.find("the results up to step 1 (t = 60 s) are in "), std::string::npos) << m;
-    EXPECT_NE(m.find(".out.h5.partial; "), std::string::npos) << m;
+    EXPECT_NE(m.find(erodem::io::partial_path(dir.file("out.h5")) + "; "), std::string::npos) << m;
     EXPECT_NE(m.find("out.h5 was not created"), std::string::npos) << m;
   }
   s.close_output();
   EXPECT_FALSE(fs::exists(dir.file("out.h5")));
-  const ResultReader r(dir.file(".out.h5.partial"));
+  const ResultReader r(erodem::io::partial_path(dir.file("out.h5")));
   EXPECT_EQ(r.times().size(), 2u);  // t = 0 and the failing step
   EXPECT_EQ(r.diagnostics().size(), 1u);
 }
@@ -206,7 +206,7 @@ TEST(RunSession, AbandonKeepsThePartialFileWithOneSnapshotOfTheStep) {
     EXPECT_FALSE(s.writing());
     EXPECT_NE(s.partial_note().find("up to step " + std::to_string(stop_at)), std::string::npos);
     EXPECT_FALSE(fs::exists(dir.file(name)));
-    const ResultReader r(dir.file("." + name + ".partial"));
+    const ResultReader r(erodem::io::partial_path(dir.file(name)));
     EXPECT_EQ(r.times().size(), 2u) << stop_at;  // t = 0 and the step reached, once
     EXPECT_EQ(r.restart_point(r.times().size() - 1).steps, stop_at);
     EXPECT_EQ(r.diagnostics().size(), static_cast<std::size_t>(stop_at));

@@ -547,14 +547,26 @@ void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps) {
   }
 }
 
-bool bed_changes(const Params& params) {
+namespace {
+
+/// Whether a sweep of the step (on the cells only, or on any domain) writes `field`.
+bool sweeps_write(const Params& params, const std::string& field, bool cells_only) {
   for (const auto& [p, s] : step_sweeps(params))
-    if (s.domain == Domain::cells)
+    if (s.domain == Domain::cells || !cells_only)
       for (const auto& u : s.uses)
-        if (std::string(u.field) == "bed" &&
-            (u.access == Access::write || u.access == Access::update))
+        if (field == u.field && (u.access == Access::write || u.access == Access::update))
           return true;
   return false;
+}
+
+}  // namespace
+
+bool bed_changes(const Params& params) {
+  return sweeps_write(params, "bed", true);
+}
+
+bool step_writes(const Params& params, const std::string& field) {
+  return sweeps_write(params, field, false);
 }
 
 SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes) {

@@ -374,7 +374,10 @@ const std::vector<Descriptor>& descriptor_table() {
       points(ERODEM_FIELD(output.gauges),
              "gauge points [[x, y], ...] in the DEM's CRS: depth, level and speed every step"),
       boolean(ERODEM_FIELD(output.restart_state),
-              "store the full state at each snapshot, so a run can restart from it"),
+              "store the full state at the snapshots, so a run can restart from them"),
+      integer(ERODEM_FIELD(output.restart_every), at_least(1),
+              "snapshots between stored states: the state at every N-th snapshot (the first "
+              "included) and always at the last"),
 
       choice(ERODEM_FIELD(numerics.precision),
              Choices<Precision>{{"float32", Precision::float32}, {"float64", Precision::float64}},

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "erodem/error.hpp"
+#include "erodem/io/paths.hpp"
 #include "erodem/io/results.hpp"
 
 namespace erodem::io {
@@ -24,6 +25,23 @@ std::string h5_reason() {
       },
       &msg);
   return msg.empty() ? "" : ": " + msg;
+}
+
+std::string h5_open_reason(const std::string& path) {
+  std::string reason = h5_reason();
+  bool lock = false;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_DOWNWARD,
+      [](unsigned, const H5E_error2_t* e, void* out) -> herr_t {
+        if (e->desc != nullptr && std::strstr(e->desc, "lock") != nullptr)
+          *static_cast<bool*>(out) = true;
+        return 0;
+      },
+      &lock);
+  if (!lock) return reason;
+  const std::string holder = lock_holder(path);
+  return reason + "; another process has it open (HDF5 file lock" +
+         (holder.empty() || holder == "another process" ? "" : ", held by " + holder) + ")";
 }
 
 [[noreturn]] void write_failed(const std::string& path, const std::string& what) {

@@ -34,6 +34,10 @@ class QuietH5 {
 
 /// ": <innermost HDF5 message>" or "" when the error stack is empty.
 std::string h5_reason();
+/// h5_reason() of a file that would not open or be created at `path`; when HDF5 says the
+/// file is locked, also that another process has it open and which one when /proc/locks
+/// tells (paths.hpp lock_holder).
+std::string h5_open_reason(const std::string& path);
 
 /// An owned HDF5 identifier of any kind, closed by its kind's close function.
 class H5Id {

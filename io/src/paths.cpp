@@ -1,10 +1,19 @@
 #include "erodem/io/paths.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 
 #include "erodem/error.hpp"
 
@@ -27,6 +36,73 @@ void check_output_path(const std::string& path, bool overwrite) {
   if (!overwrite && fs::exists(p, ec))
     throw Error(ExitCode::cant_create,
                 path + ": exists; not overwritten (give --overwrite to replace it)");
+}
+
+bool FileIdentity::operator==(const FileIdentity& o) const {
+  if (!exists || !o.exists) return exists == o.exists;
+  return device == o.device && inode == o.inode && mtime.tv_sec == o.mtime.tv_sec &&
+         mtime.tv_nsec == o.mtime.tv_nsec && size == o.size;
+}
+
+FileIdentity file_identity(const std::string& path) {
+  struct stat st {};
+  FileIdentity id;
+  if (::stat(path.c_str(), &st) != 0) return id;
+  id.exists = true;
+  id.device = st.st_dev;
+  id.inode = st.st_ino;
+  id.mtime = st.st_mtim;
+  id.size = st.st_size;
+  return id;
+}
+
+int rename_no_replace(const std::string& from, const std::string& to, bool force_link) {
+  if (!force_link) {
+    if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+    if (errno != EINVAL && errno != ENOSYS && errno != EOPNOTSUPP) return errno;
+  }
+  // The file system cannot rename without replacing: a hard link is never made over an
+  // existing file either.
+  if (::link(from.c_str(), to.c_str()) != 0) return errno;
+  ::unlink(from.c_str());  // published; a leftover second name would be harmless
+  return 0;
+}
+
+std::string lock_holder(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return "";
+  std::ifstream locks("/proc/locks");
+  std::string line;
+  bool locked = false;
+  while (std::getline(locks, line)) {
+    // "1: FLOCK  ADVISORY  WRITE 1234 fe:00:5669940 0 EOF"; waiters ("1: -> FLOCK ...") skipped
+    if (line.find("->") != std::string::npos) continue;
+    std::istringstream in(line);
+    std::string number, kind, mode, access, pid, where;
+    if (!(in >> number >> kind >> mode >> access >> pid >> where)) continue;
+    unsigned dev_major = 0, dev_minor = 0;
+    unsigned long long inode = 0;
+    if (std::sscanf(where.c_str(), "%x:%x:%llu", &dev_major, &dev_minor, &inode) != 3) continue;
+    if (inode != st.st_ino || dev_major != major(st.st_dev) || dev_minor != minor(st.st_dev))
+      continue;
+    locked = true;
+    if (pid.empty() || pid[0] == '-') continue;  // an OFD lock names no process
+    std::ifstream cmd("/proc/" + pid + "/cmdline", std::ios::binary);
+    std::string args((std::istreambuf_iterator<char>(cmd)), std::istreambuf_iterator<char>());
+    while (!args.empty() && args.back() == '\0') args.pop_back();
+    std::replace(args.begin(), args.end(), '\0', ' ');
+    return "process " + pid + (args.empty() ? "" : " (" + args + ")");
+  }
+  return locked ? "another process" : "";
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0 || buf[0] == '\0') return "localhost";
+  std::string name(buf);
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+  return name;
 }
 
 }  // namespace erodem::io

@@ -48,7 +48,7 @@ ResultReader::ResultReader(const std::string& path) : path_(path) {
   if (!fs::exists(path, ec)) throw Error(ExitCode::no_input, path + ": no such file");
   if (H5Fis_hdf5(path.c_str()) <= 0) not_ours(path, "not an HDF5 file");
   file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (file_ < 0) throw Error(ExitCode::data, path + ": cannot open" + h5_reason());
+  if (file_ < 0) throw Error(ExitCode::data, path + ": cannot open" + h5_open_reason(path));
   try {
     if (H5Aexists(file_, "erodem_version") <= 0) not_ours(path, "no erodem_version attribute");
     // Root attributes (text ones).
@@ -183,19 +183,28 @@ bool ResultReader::has_restart_state() const {
   return exists(file_, "restart/steps");
 }
 
+std::vector<double> ResultReader::restart_times() const {
+  QuietH5 quiet;
+  if (!has_restart_state()) return {};
+  if (exists(file_, "restart/time")) return read_doubles(file_, "restart/time", path_);
+  // before 2026-11-27: a state at every snapshot
+  const auto steps = read_doubles(file_, "restart/steps", path_);
+  return {times_.begin(), times_.begin() + std::min(times_.size(), steps.size())};
+}
+
 RestartPoint ResultReader::restart_point(std::size_t index) const {
   QuietH5 quiet;
   if (!has_restart_state())
     throw Error(ExitCode::data, path_ +
                                     ": holds no restart state (it was written with "
                                     "output.restart_state = false, or by an older erodem)");
+  const auto times = restart_times();
   const auto steps = read_doubles(file_, "restart/steps", path_);
-  if (index >= times_.size() || index >= steps.size())
-    throw Error(ExitCode::usage,
-                fmt::format("{}: no restart state at snapshot {} (the file holds {})", path_, index,
-                            std::min(times_.size(), steps.size())));
+  if (index >= times.size() || index >= steps.size())
+    throw Error(ExitCode::usage, fmt::format("{}: no restart state {} (the file holds {})", path_,
+                                             index, std::min(times.size(), steps.size())));
   RestartPoint p;
-  p.time = times_[index];
+  p.time = times[index];
   p.steps = static_cast<long>(steps[index]);
   // Files of erodem before the bed residual and the moved volumes (2026-11-25) or the snow pack
   // (2026-11-26) lack those: they start at 0 (the residual then holds nothing yet, as in any
@@ -214,6 +223,14 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
       p.fields.emplace_back(grid_.cells(), 0.0);
       continue;
     }
+    // a field stored once per value: its row at this time in NAME_row
+    hsize_t row = index;
+    if (exists(file_, name + "_row")) {
+      const auto rows = read_doubles(file_, name + "_row", path_);
+      if (index >= rows.size() || !(rows[index] >= 0))
+        not_ours(path_, name + "_row does not cover the stored times");
+      row = static_cast<hsize_t>(rows[index]);
+    }
     H5Id ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
     if (!ds.valid()) not_ours(path_, "no dataset " + name);
     H5Id space(H5Dget_space(ds));
@@ -221,9 +238,9 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
     if (H5Sget_simple_extent_ndims(space) != 3) not_ours(path_, name + " is not (time, y, x)");
     H5Sget_simple_extent_dims(space, dims.data(), nullptr);
     if (dims[1] != static_cast<hsize_t>(grid_.ny) || dims[2] != static_cast<hsize_t>(grid_.nx) ||
-        dims[0] <= index)
-      not_ours(path_, name + " does not match the grid and the snapshots");
-    const std::array<hsize_t, 3> start{index, 0, 0}, count{1, dims[1], dims[2]};
+        dims[0] <= row)
+      not_ours(path_, name + " does not match the grid and the stored times");
+    const std::array<hsize_t, 3> start{row, 0, 0}, count{1, dims[1], dims[2]};
     H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
     H5Id mem(H5Screate_simple(3, count.data(), nullptr));
     std::vector<double> values(grid_.cells());

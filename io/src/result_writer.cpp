@@ -6,10 +6,12 @@
 #include <hdf5.h>
 #include <hdf5_hl.h>
 #include <ogr_srs_api.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <ctime>
@@ -83,7 +85,32 @@ std::string geotransform_text(const std::array<double, 6>& t) {
 
 std::string partial_path(const std::string& path) {
   const fs::path p(path);
-  return (p.parent_path() / ("." + p.filename().string() + ".partial")).string();
+  return (p.parent_path() /
+          fmt::format(".{}.{}-{}.partial", p.filename().string(), host_name(), getpid()))
+      .string();
+}
+
+void remove_stale_partials(const std::string& path) {
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  const std::string prefix = "." + p.filename().string() + "." + host_name() + "-";
+  const std::string suffix = ".partial";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    const std::string digits =
+        name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    if (digits.size() > 9 ||
+        !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == getpid() || pid <= 0 || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);  // its process has ended: a run that stopped early
+  }
 }
 
 std::string xdmf_path(const std::string& path) {
@@ -131,12 +158,20 @@ struct ResultWriter::Impl {
   std::vector<double> pending_section_time;
   std::array<std::vector<double>, 4> pending_section;  // [series][row * n + section]
   std::vector<std::int64_t> pending_section_steps;
-  // restart/: the full state at every snapshot (output.restart_state)
+  // restart/: the full state at every output.restart_every-th snapshot and the last
+  // (output.restart_state); a state field no sweep of the step writes is stored once per
+  // value (`once`): its rows in restart/NAME, and restart/NAME_row says which is whose
   bool restart = false;
+  long restart_every = 1;
   bool restart_f64 = false;          // float64 runs keep their state in float64
   std::vector<H5Id> restart_fields;  // state_fields(), in order
-  H5Id restart_steps;
+  std::vector<bool> once;            // per state field: stored once per value
+  std::vector<H5Id> restart_rows;    // per state field: its NAME_row dataset (once fields)
+  std::vector<std::vector<double>> last_stored;  // per state field: its last row (once)
+  std::vector<std::int32_t> row_count;           // per state field: rows stored (once)
+  H5Id restart_time, restart_steps;
   std::vector<H5Id> restart_ledger;  // ledger_entries(), in order
+  bool last_has_state = false;       // whether the last snapshot stored the state
   bool bed_changes = true;           // erosion or thermal on: the bed is read at every gauge sample
   std::vector<double> bed;           // the bed at the gauges, when it does not change
 
@@ -230,8 +265,10 @@ struct ResultWriter::Impl {
     section_step.reset();
     section_time.reset();
     for (auto& d : restart_fields) d.reset();
+    for (auto& d : restart_rows) d.reset();
     for (auto& d : restart_ledger) d.reset();
     restart_steps.reset();
+    restart_time.reset();
     diag_step.reset();
     gauge_step.reset();
     gauge_time.reset();
@@ -249,6 +286,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     : path_(path), partial_(partial_path(path)), overwrite_(overwrite) {
   QuietH5 quiet;
   check_output_path(path, overwrite);  // folder exists and is writable, no file in the way
+  seen_ = file_identity(path);         // what --overwrite may replace at finish()
   if (grid.nx <= 0 || grid.ny <= 0)
     throw Error(ExitCode::internal, path + ": result file for an empty grid");
 
@@ -259,6 +297,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   m.output = params.output;
   m.bed_changes = bed_changes(params);  // a sweep of the step writes the bed (process.hpp)
   m.restart = params.output.restart_state;
+  m.restart_every = params.output.restart_every;
   m.restart_f64 = params.numerics.precision == Precision::float64;
   for (const auto& name : m.output.fields) m.fields.emplace_back(field_info(name), H5Id());
   // Gauges must lie on the grid.
@@ -285,7 +324,8 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   H5Pset_attr_creation_order(fcpl, kCreationOrder);
   m.file = H5Id(H5Fcreate(partial_.c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT));
   if (!m.file.valid())
-    throw Error(ExitCode::cant_create, partial_ + ": cannot create" + h5_reason());
+    throw Error(ExitCode::cant_create, partial_ + ": cannot create" + h5_open_reason(partial_));
+  remove_stale_partials(path);
 
   // Root attributes.
   const std::pair<const char*, std::string> root_attrs[] = {
@@ -402,40 +442,55 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   }
 
   // restart/: every state field in the precision of the run (so a restart is exact), the
-  // step count and the ledger, at every snapshot.
+  // step count and the ledger, at every output.restart_every-th snapshot and the last, on
+  // their own time axis restart/time; a field no sweep of the step writes, once per value.
   if (m.restart) {
     H5Id group = m.create_group("restart");
     put_text(group, "comment",
-             "the full state at each snapshot time, for erodem run --restart FILE:TIME; not "
-             "masked: inactive cells hold their internal values",
+             "the full state at the times restart/time (output.restart_every), for erodem run "
+             "--restart FILE:TIME; not masked: inactive cells hold their internal values; a "
+             "field with a NAME_row dataset is stored once per value, NAME_row giving the row "
+             "of NAME at each time",
              partial_);
+    m.restart_time = m.coordinate(group, "time", H5T_IEEE_F64LE, nullptr, 0, true);
+    put_text(m.restart_time, "units", "s", partial_);
+    put_text(m.restart_time, "long_name", "times of the stored states", partial_);
     const hid_t type = m.restart_f64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE;
+    auto per_state = [&](const std::string& name, hid_t t, const char* unit,
+                         const std::string& long_name) {
+      H5Id ds =
+          create_dataset(group, name, t, {0}, {H5S_UNLIMITED}, {512}, false, nullptr, partial_);
+      checked(H5DSattach_scale(ds, m.restart_time, 0), partial_, "restart/" + name);
+      put_text(ds, "units", unit, partial_);
+      put_text(ds, "long_name", long_name, partial_);
+      return ds;
+    };
     for (FieldId id : state_fields()) {
       const auto& info = field_info(id);
+      const bool once = !step_writes(params, info.name);
       H5Id ds = create_dataset(group, info.name, type, {0, ny, nx}, {H5S_UNLIMITED, ny, nx},
                                {1, std::min<hsize_t>(ny, 512), std::min<hsize_t>(nx, 512)}, true,
                                nullptr, partial_);
-      checked(H5DSattach_scale(ds, m.time, 0), partial_, std::string("restart/") + info.name);
+      if (!once)
+        checked(H5DSattach_scale(ds, m.restart_time, 0), partial_,
+                std::string("restart/") + info.name);
       checked(H5DSattach_scale(ds, y, 1), partial_, std::string("restart/") + info.name);
       checked(H5DSattach_scale(ds, x, 2), partial_, std::string("restart/") + info.name);
       put_text(ds, "units", info.units, partial_);
       put_text(ds, "long_name", info.long_name, partial_);
       m.restart_fields.push_back(std::move(ds));
+      m.once.push_back(once);
+      m.restart_rows.push_back(once ? per_state(std::string(info.name) + "_row", H5T_STD_I32LE, "1",
+                                                std::string("row of restart/") + info.name +
+                                                    " holding the state at each time")
+                                    : H5Id());
     }
-    auto per_snapshot = [&](const char* name, hid_t t, const char* unit,
-                            const std::string& long_name) {
-      H5Id ds =
-          create_dataset(group, name, t, {0}, {H5S_UNLIMITED}, {512}, false, nullptr, partial_);
-      checked(H5DSattach_scale(ds, m.time, 0), partial_, std::string("restart/") + name);
-      put_text(ds, "units", unit, partial_);
-      put_text(ds, "long_name", long_name, partial_);
-      return ds;
-    };
-    m.restart_steps = per_snapshot("steps", H5T_STD_I64LE, "1", "steps done");
+    m.last_stored.resize(m.once.size());
+    m.row_count.assign(m.once.size(), 0);
+    m.restart_steps = per_state("steps", H5T_STD_I64LE, "1", "steps done");
     for (const auto& e : ledger_entries())
-      m.restart_ledger.push_back(per_snapshot((std::string("ledger_") + e.name).c_str(),
-                                              H5T_IEEE_F64LE, "m3",
-                                              std::string("ledger entry ") + e.name));
+      m.restart_ledger.push_back(per_state(std::string("ledger_") + e.name, H5T_IEEE_F64LE, "m3",
+                                           std::string("ledger entry ") + e.name));
   }
 
   // gauges/: one row per step, one column per gauge.
@@ -531,7 +586,59 @@ void ResultWriter::close() {
   impl_.reset();
 }
 
+void ResultWriter::store_state(const Simulation& sim) {
+  Impl& m = *impl_;
+  const RestartPoint point = sim.restart_point();
+  std::vector<float> state32(m.restart_f64 ? 0 : sim.grid().cells());
+  for (std::size_t k = 0; k < point.fields.size(); ++k) {
+    const auto& v = point.fields[k];
+    const std::string name = std::string("restart/") + field_info(state_fields()[k]).name;
+    if (m.once[k]) {  // a new row only when the values differ from the last one stored
+      const bool same =
+          m.row_count[k] > 0 && m.last_stored[k].size() == v.size() &&
+          std::memcmp(m.last_stored[k].data(), v.data(), v.size() * sizeof(double)) == 0;
+      const std::int32_t row = same ? m.row_count[k] - 1 : m.row_count[k];
+      append_rows(m.restart_rows[k], H5T_NATIVE_INT32, 1, &row, partial_, name + "_row");
+      if (same) continue;
+      m.last_stored[k] = v;
+      ++m.row_count[k];
+    }
+    if (m.restart_f64) {
+      append_rows(m.restart_fields[k], H5T_NATIVE_DOUBLE, 1, v.data(), partial_, name);
+    } else {
+      for (std::size_t i = 0; i < v.size(); ++i) state32[i] = static_cast<float>(v[i]);
+      append_rows(m.restart_fields[k], H5T_NATIVE_FLOAT, 1, state32.data(), partial_, name);
+    }
+  }
+  const std::int64_t steps = point.steps;
+  append_rows(m.restart_steps, H5T_NATIVE_INT64, 1, &steps, partial_, "restart/steps");
+  for (std::size_t k = 0; k < ledger_entries().size(); ++k) {
+    const double v = point.ledger.*ledger_entries()[k].member;
+    append_rows(m.restart_ledger[k], H5T_NATIVE_DOUBLE, 1, &v, partial_,
+                std::string("restart/ledger_") + ledger_entries()[k].name);
+  }
+  // The time last: a file cut short lists only the complete states.
+  const double t = sim.time();
+  append_rows(m.restart_time, H5T_NATIVE_DOUBLE, 1, &t, partial_, "restart/time");
+  ++states_;
+}
+
 void ResultWriter::snapshot(const Simulation& sim) {
+  take_snapshot(sim, false);
+}
+
+void ResultWriter::last_snapshot(const Simulation& sim) {
+  if (!impl_) return;
+  if (last_snapshot_step_ != sim.steps_done()) return take_snapshot(sim, true);
+  if (impl_->restart && !impl_->last_has_state) {  // the state of the last snapshot
+    QuietH5 quiet;
+    store_state(sim);
+    impl_->last_has_state = true;
+    checked(H5Fflush(impl_->file, H5F_SCOPE_GLOBAL), partial_, "(flushing)");
+  }
+}
+
+void ResultWriter::take_snapshot(const Simulation& sim, bool last) {
   if (!impl_) throw Error(ExitCode::internal, path_ + ": snapshot after finish()");
   QuietH5 quiet;
   Impl& m = *impl_;
@@ -546,32 +653,14 @@ void ResultWriter::snapshot(const Simulation& sim) {
       f32[i] = terrain.active(i) ? static_cast<float>(values[i]) : std::nanf("");
     append_rows(ds, H5T_NATIVE_FLOAT, 1, f32.data(), partial_, info.name);
   }
-  if (m.restart) {
-    const RestartPoint point = sim.restart_point();
-    std::vector<float> state32(m.restart_f64 ? 0 : g.cells());
-    for (std::size_t k = 0; k < point.fields.size(); ++k) {
-      const auto& v = point.fields[k];
-      const std::string name = std::string("restart/") + field_info(state_fields()[k]).name;
-      if (m.restart_f64) {
-        append_rows(m.restart_fields[k], H5T_NATIVE_DOUBLE, 1, v.data(), partial_, name);
-      } else {
-        for (std::size_t i = 0; i < v.size(); ++i) state32[i] = static_cast<float>(v[i]);
-        append_rows(m.restart_fields[k], H5T_NATIVE_FLOAT, 1, state32.data(), partial_, name);
-      }
-    }
-    const std::int64_t steps = point.steps;
-    append_rows(m.restart_steps, H5T_NATIVE_INT64, 1, &steps, partial_, "restart/steps");
-    for (std::size_t k = 0; k < ledger_entries().size(); ++k) {
-      const double v = point.ledger.*ledger_entries()[k].member;
-      append_rows(m.restart_ledger[k], H5T_NATIVE_DOUBLE, 1, &v, partial_,
-                  std::string("restart/ledger_") + ledger_entries()[k].name);
-    }
-  }
+  const bool state = m.restart && (last || times_.size() % m.restart_every == 0);
+  if (state) store_state(sim);
   // The time last: a file cut short mid-snapshot lists only the complete snapshots.
   const double t = sim.time();
   append_rows(m.time, H5T_NATIVE_DOUBLE, 1, &t, partial_, "time");
   times_.push_back(t);
   last_snapshot_step_ = sim.steps_done();
+  m.last_has_state = state;
   m.flush_pending();
   checked(H5Fflush(m.file, H5F_SCOPE_GLOBAL), partial_, "(flushing)");
 }
@@ -650,7 +739,7 @@ void ResultWriter::step_done(const Simulation& sim) {
 }
 
 void ResultWriter::finish(const Simulation& sim) {
-  if (impl_ && last_snapshot_step_ != sim.steps_done()) snapshot(sim);
+  last_snapshot(sim);
   finish();
 }
 
@@ -666,19 +755,37 @@ void ResultWriter::finish() {
   m.close();
   impl_.reset();
 
-  std::error_code ec;
-  if (!overwrite_ && fs::exists(path_, ec))
-    throw Error(ExitCode::cant_create, path_ +
-                                           ": exists (created during the run); not overwritten "
-                                           "(give --overwrite); the results are in " +
-                                           partial_);
-
+  publish();
   write_xdmf(path_, grid, xname, yname, times_, infos);
+}
 
-  fs::rename(partial_, path_, ec);
-  if (ec)
-    throw Error(ExitCode::io,
-                path_ + ": cannot rename " + partial_ + " into place: " + ec.message());
+void ResultWriter::publish(bool force_link) const {
+  // Never over a file another process put at `path` during the run: without overwrite
+  // nothing may be there, with it only the file seen at the start (or nothing).
+  const FileIdentity now = file_identity(path_);
+  const std::string kept = "; this run's results are in " + partial_;
+  if (overwrite_ && now.exists) {
+    if (now != seen_)
+      throw Error(ExitCode::cant_create,
+                  path_ +
+                      (seen_.exists ? ": replaced by another process during the run"
+                                    : ": created by another process during the run") +
+                      "; not overwritten" + kept);
+    std::error_code ec;
+    fs::rename(partial_, path_, ec);
+    if (ec)
+      throw Error(ExitCode::io,
+                  path_ + ": cannot rename " + partial_ + " into place: " + ec.message() + kept);
+    return;
+  }
+  const int err = rename_no_replace(partial_, path_, force_link);
+  if (err == EEXIST)
+    throw Error(ExitCode::cant_create,
+                path_ + ": exists (created by another process during the run); not overwritten" +
+                    (overwrite_ ? "" : " (give --overwrite)") + kept);
+  if (err != 0)
+    throw Error(ExitCode::io, path_ + ": cannot rename " + partial_ +
+                                  " into place: " + std::strerror(err) + kept);
 }
 
 }  // namespace erodem::io

@@ -32,14 +32,20 @@ bool has_parameter_rasters(const Params& p) {
   return !p.rain.grids.empty() || !p.snow.temperature_grids.empty();
 }
 
-/// The snapshot of `reader` at `time` (the last one when no time is given). Times match to
-/// 1e-6 relative or 1 ms, since a time on a command line is rounded.
+/// The stored state of `reader` at `time` (an index of restart_times(); the last one when no
+/// time is given). Times match to 1e-6 relative or 1 ms, since a time on a command line is
+/// rounded.
 std::size_t restart_index(const ResultReader& reader, std::optional<double> time,
                           const std::string& label) {
-  const auto& times = reader.times();
-  if (times.empty()) throw Error(ExitCode::data, reader.path() + ": holds no snapshot");
+  const auto times = reader.restart_times();
+  if (times.empty()) {
+    if (reader.times().empty()) throw Error(ExitCode::data, reader.path() + ": holds no snapshot");
+    reader.restart_point(0);  // throws: no restart state, and how to get one
+  }
   if (!time) return times.size() - 1;
-  const std::size_t i = reader.nearest_time_index(*time);
+  std::size_t i = 0;
+  for (std::size_t k = 1; k < times.size(); ++k)
+    if (std::abs(times[k] - *time) < std::abs(times[i] - *time)) i = k;
   if (std::abs(times[i] - *time) <= std::max(1e-3, 1e-6 * std::abs(*time))) return i;
   std::string list;
   for (std::size_t k = 0; k < times.size(); ++k) {
@@ -49,9 +55,15 @@ std::size_t restart_index(const ResultReader& reader, std::optional<double> time
     }
     list += fmt::format("{}{:.10g}", list.empty() ? "" : ", ", times[k]);
   }
-  throw Error(ExitCode::usage, fmt::format("{} {}:{:.10g}: no snapshot at that time; the "
-                                           "file holds t = {} s",
-                                           label, reader.path(), *time, list));
+  const bool snapshot = std::any_of(reader.times().begin(), reader.times().end(), [&](double t) {
+    return std::abs(t - *time) <= std::max(1e-3, 1e-6 * std::abs(*time));
+  });
+  throw Error(ExitCode::usage,
+              fmt::format("{} {}:{:.10g}: {}; the file holds the state at t = {} s ({} time{})",
+                          label, reader.path(), *time,
+                          snapshot ? "that snapshot has no stored state (output.restart_every)"
+                                   : "no snapshot at that time",
+                          list, times.size(), times.size() == 1 ? "" : "s"));
 }
 
 /// "section.key = value" of a TOML text written by dump_toml, one entry per key line.
@@ -213,7 +225,7 @@ void RunSession::finish() {
 
 void RunSession::abandon() {
   if (!writing()) return;
-  if (writer_->last_snapshot_step() != sim_->steps_done()) writer_->snapshot(*sim_);
+  writer_->last_snapshot(*sim_);  // with its restart state, to continue from
   writer_->close();
 }
 

@@ -168,9 +168,11 @@ class Simulation:
         output : str or path-like, optional
             Write an ``.h5`` result file as ``erodem run`` does (a snapshot now, diagnostics
             every step, snapshots per ``output.every``/``output.interval``, a final
-            snapshot, the ``.xmf`` sidecar). It is written under ``.<name>.partial`` and
-            renamed when the run completes; after Ctrl-C or an unstable step the partial
-            file stays, holding the results so far.
+            snapshot, the ``.xmf`` sidecar). It is written under a name unique to the
+            process, ``.<name>.<host>-<pid>.partial``, and renamed when the run completes,
+            never over a file another process put at ``output`` meanwhile (``OSError``,
+            exit code 73; the partial file keeps the results); after Ctrl-C or an unstable
+            step the partial file stays, holding the results so far.
         every : int or float or str, optional
             Snapshot interval: an int is steps (``output.every``), a float or a string
             with a unit is simulated time (``output.interval``, s).

@@ -80,6 +80,32 @@ def _members(
     return members
 
 
+def _remove_stale_partials(output: str) -> None:
+    """Removes the partial files of ``output`` (``.<name>.<host>-<pid>.partial``, and the
+    ``.<name>.partial`` of erodem before 2026-11-27) that no running process on this host
+    writes: those of this host whose process has ended. Those of other hosts stay."""
+    import socket
+
+    folder, name = os.path.split(output)
+    host = "".join(c if c.isalnum() or c in "._-" else "_" for c in socket.gethostname())
+    prefix = "." + name + "." + host + "-"
+    legacy = os.path.join(folder, "." + name + ".partial")
+    if os.path.exists(legacy):
+        os.remove(legacy)
+    for entry in os.listdir(folder or "."):
+        pid = entry[len(prefix):-len(".partial")]
+        if not (entry.startswith(prefix) and entry.endswith(".partial") and pid.isdigit()):
+            continue
+        try:
+            os.kill(int(pid), 0)
+            continue  # still running
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            continue  # another user's live process
+        os.remove(os.path.join(folder, entry))
+
+
 def run_member(spec: Dict[str, Any]) -> Dict[str, Any]:
     """Runs one sweep member and returns its table row. Never raises for a failing run:
     the error (type and message) goes into the row's ``error`` column.
@@ -101,10 +127,8 @@ def run_member(spec: Dict[str, Any]) -> Dict[str, Any]:
         settings.update(spec["params"])
         if spec.get("threads"):
             settings["numerics.threads"] = spec["threads"]
-        partial = os.path.join(os.path.dirname(spec["output"]),
-                               "." + os.path.basename(spec["output"]) + ".partial")
-        if os.path.exists(partial) and not os.path.exists(spec["output"]):
-            os.remove(partial)  # this member's own unfinished file from an interrupted sweep
+        if not os.path.exists(spec["output"]):
+            _remove_stale_partials(spec["output"])  # unfinished files of an interrupted sweep
         row_file = spec["output"][:-3] + ".json"
         if spec.get("config_hash"):
             # claims the member's files for this configuration before the result file exists:

@@ -373,6 +373,29 @@ def test_results_match_cli_bit_for_bit(erodem, cli, tujunga, tmp_path, backend, 
 # ---- restart ----------------------------------------------------------------------------
 
 
+def restart_rows(f, name):
+    """restart/NAME of an open result file with a row per stored state: a field stored once
+    per value (restart/NAME_row) expanded to its value at each stored time."""
+    ds = f["restart"][name]
+    if name + "_row" in f["restart"]:
+        return ds[:][f["restart"][name + "_row"][:]]
+    return ds[:]
+
+
+def to_older_layout(path):
+    """Rewrites a result file in the layout of erodem before 2026-11-27 (a restart state at
+    every snapshot, each field a row per snapshot, no restart/time)."""
+    with h5py.File(path, "a") as f:
+        g = f["restart"]
+        assert len(g["time"]) == len(f["time"]), "older files hold a state at every snapshot"
+        for name in [n[:-4] for n in g if n.endswith("_row")]:
+            rows = restart_rows(f, name)
+            del g[name], g[name + "_row"]
+            g.create_dataset(name, data=rows, maxshape=(None,) + rows.shape[1:],
+                             chunks=(1,) + rows.shape[1:], compression="gzip")
+        del g["time"]
+
+
 def assert_continues(full_path, restarted_path, k):
     """The file of a run restarted from snapshot ``k`` of ``full_path`` holds exactly the
     rest of it: the snapshots from ``k`` on (fields and restart state) and the diagnostics
@@ -384,8 +407,11 @@ def assert_continues(full_path, restarted_path, k):
             assert np.array_equal(a[f][k:], b[f][:], equal_nan=True), "field %s differs" % f
             n += b[f].size
         for name in a["restart"]:
-            assert np.array_equal(a["restart"][name][k:], b["restart"][name][:]), name
-            n += b["restart"][name].size
+            if name.endswith("_row"):
+                continue  # compared through the field it indexes
+            x, y = restart_rows(a, name)[k:], restart_rows(b, name)
+            assert np.array_equal(x, y), name
+            n += y.size
         first = int(a["restart/steps"][k])
         rows = len(b["diagnostics/time"])
         assert rows == len(a["diagnostics/time"]) - first
@@ -467,7 +493,7 @@ def test_bad_restart_raises_naming_the_file_or_time(erodem, tujunga, tmp_path):
         ("a missing file", dict(restart=tmp_path / "nothere.h5"), FileNotFoundError, 66,
          "nothere.h5"),
         ("a time not stored", dict(restart=a + ":0.55"), ValueError, 2,
-         r"restart .*a\.h5:0\.55: no snapshot at that time; the file holds t = 0, "),
+         r"restart .*a\.h5:0\.55: no snapshot at that time; the file holds the state at t = 0, "),
         ("a time not stored, tuple form", dict(restart=(a, "3 h")), ValueError, 2,
          r"a\.h5:10800: no snapshot at that time"),
         ("no restart state", dict(restart=str(tmp_path / "plain.h5")), ValueError, 65,
@@ -566,8 +592,9 @@ def test_ctrl_c_stops_a_run_cleanly(erodem, tujunga, tmp_path):
     assert "KeyboardInterrupt" in err
     assert p.returncode != 0
     assert latency < 10.0
-    partial = tmp_path / ".long.h5.partial"
-    assert not out.exists() and partial.exists()
+    partials = list(tmp_path.glob(".long.h5.*.partial"))  # .long.h5.HOST-PID.partial
+    assert not out.exists() and len(partials) == 1
+    partial = partials[0]
     with h5py.File(partial, "r") as f:
         steps = len(f["diagnostics"]["time"])
         times = f["time"][:]
@@ -612,15 +639,22 @@ def test_ctrl_c_interrupts_step_between_steps(erodem, tujunga, tmp_path):
     assert latency < 10.0
 
 
-def test_a_file_from_before_the_snow_pack_restarts_without_snow(erodem, tujunga, tmp_path):
-    # Files written before the snow pack (2026-11-26) lack restart/snow and
-    # restart/ledger_snow_melted: they restart with neither (0), exactly as a file that has
-    # them at 0; a state field that was always there is still required, by name.
+def run_and_copy(erodem, tujunga, tmp_path):
+    """A 20-step run with snapshots at steps 0, 10 and 20 written to ``new.h5``, and a copy
+    of it, ``old.h5``, to rewrite as an older erodem would have written it (returned)."""
     cfg = small_config(tujunga, steps=20)
     cfg["output"]["every"] = 10
     erodem.Simulation(config=cfg, backend="cpu").run(output=tmp_path / "new.h5")
     old = tmp_path / "old.h5"
     shutil.copy(tmp_path / "new.h5", old)
+    return old
+
+
+def test_a_file_from_before_the_snow_pack_restarts_without_snow(erodem, tujunga, tmp_path):
+    # Files written before the snow pack (2026-11-26) lack restart/snow and
+    # restart/ledger_snow_melted: they restart with neither (0), exactly as a file that has
+    # them at 0; a state field that was always there is still required, by name.
+    old = run_and_copy(erodem, tujunga, tmp_path)
     with h5py.File(old, "a") as f:
         assert float(np.abs(f["restart/snow"][:]).max()) == 0.0
         del f["restart/snow"]
@@ -639,3 +673,26 @@ def test_a_file_from_before_the_snow_pack_restarts_without_snow(erodem, tujunga,
         erodem.Simulation(restart="%s:%r" % (old, t), backend="cpu")
     print("restart from a file without the snow pack: %d fields and %d ledger entries equal to "
           "the restart from the file with it" % (len(erodem.FIELDS), len(a.ledger)))
+
+
+def test_a_file_with_a_state_per_snapshot_still_restarts(erodem, tujunga, tmp_path):
+    # Files written before 2026-11-27 hold every state field, initial_bed too, at every
+    # snapshot and have no restart/time: they restart exactly as the new layout, where the
+    # fields no sweep writes are stored once per value (restart/NAME + NAME_row).
+    old = run_and_copy(erodem, tujunga, tmp_path)
+    with h5py.File(tmp_path / "new.h5", "r") as f:
+        once = sorted(n[:-4] for n in f["restart"] if n.endswith("_row"))
+        assert "initial_bed" in once and f["restart/initial_bed"].shape[0] == 1
+        t = float(f["time"][1])
+    to_older_layout(old)
+    with h5py.File(old, "r") as f:
+        assert "time" not in f["restart"] and f["restart/initial_bed"].shape[0] == 3
+    a = erodem.Simulation(restart="%s:%r" % (tmp_path / "new.h5", t), backend="cpu")
+    b = erodem.Simulation(restart="%s:%r" % (old, t), backend="cpu")
+    a.step(5)
+    b.step(5)
+    assert a.ledger == b.ledger
+    for name in erodem.FIELDS:
+        assert np.array_equal(a.field(name), b.field(name), equal_nan=True), name
+    print("restart from the older layout (a state per snapshot) and the new one (%d fields "
+          "once per value: %s): %d fields equal" % (len(once), ", ".join(once), len(erodem.FIELDS)))

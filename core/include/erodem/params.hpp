@@ -303,7 +303,8 @@ struct Params {
     std::vector<std::string> fields{"bed",        "water_depth", "sediment",
                                     "velocity_x", "velocity_y",  "erosion"};
     std::vector<std::array<double, 2>> gauges;  ///< x, y in the DEM's CRS
-    bool restart_state = true;  ///< store the full state at each snapshot (restartable)
+    bool restart_state = true;  ///< store the full state at the snapshots (restartable)
+    long restart_every = 1;     ///< the state at every N-th snapshot (and the last)
   } output;
 
   struct Numerics {

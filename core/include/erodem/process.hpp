@@ -132,6 +132,10 @@ void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps);
 /// Whether a sweep of the sequence writes the bed (erosion, slope collapse): the gauges must
 /// then read the bed every step.
 bool bed_changes(const Params& params);
+/// Whether a sweep of the sequence (on any domain) writes or updates `field`: a state field
+/// none writes keeps its initial values through the run, unless changed between steps (a
+/// restart, Python's set_field, the terrain-class pass).
+bool step_writes(const Params& params, const std::string& field);
 
 /// The bytes a sweep moves per cell and step: every distinct field it reads, once, plus every
 /// field it writes, once; `real_bytes` (4 or 8) per field, 1 byte for the cell kind. Neighbour

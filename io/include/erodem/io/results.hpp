@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "erodem/grid.hpp"
+#include "erodem/io/paths.hpp"
 #include "erodem/params.hpp"
 #include "erodem/simulation.hpp"
 
@@ -43,9 +44,12 @@ struct Provenance {
   static Provenance of(const Simulation& sim, const std::string& command_line);
 };
 
-/// The temporary name a result file is written under until ResultWriter::finish():
-/// "dir/run.h5" -> "dir/.run.h5.partial".
+/// The temporary name a result file is written under until ResultWriter::finish(), unique
+/// to this process: "dir/run.h5" -> "dir/.run.h5.HOST-PID.partial" (host_name(), getpid()).
 std::string partial_path(const std::string& path);
+/// Removes the partial files of `path` left by processes of this host that have ended
+/// (".run.h5.HOST-PID.partial" whose PID does not exist); those of other hosts stay.
+void remove_stale_partials(const std::string& path);
 /// The XDMF sidecar of a result file: "dir/run.h5" -> "dir/run.xmf".
 std::string xdmf_path(const std::string& path);
 
@@ -75,7 +79,8 @@ class ResultWriter {
   ResultWriter& operator=(const ResultWriter&) = delete;
 
   /// Appends the configured output fields at the simulation's current time (inactive cells
-  /// NaN), writes the buffered diagnostics and gauge rows, and flushes the file.
+  /// NaN), the restart state at every output.restart_every-th snapshot (the first, t = 0,
+  /// included), writes the buffered diagnostics and gauge rows, and flushes the file.
   void snapshot(const Simulation& sim);
   /// Buffers one row of diagnostics (and gauge samples) after a step of `sim`. The gauges
   /// read gauge_fields() at gauge_cells(): the step's probe samples when `sim` has them as
@@ -94,11 +99,21 @@ class ResultWriter {
   bool snapshot_due(const Simulation& sim) const;
   /// record_step(), then snapshot() when due.
   void step_done(const Simulation& sim);
-  /// Takes a final snapshot unless the current step has one, then finish().
+  /// The run's last snapshot: a snapshot of `sim`'s current step unless it has one, and
+  /// with the restart state (output.restart_state) whatever output.restart_every says.
+  void last_snapshot(const Simulation& sim);
+  /// last_snapshot(), then finish().
   void finish(const Simulation& sim);
-  /// Writes what is buffered, closes the file, writes the .xmf sidecar and renames both
-  /// into place. Without `overwrite`, a file created at `path` meanwhile is an error.
+  /// Writes what is buffered, closes the file, renames it into place (publish()) and writes
+  /// the .xmf sidecar.
   void finish();
+  /// Renames the closed partial file to path(), never over a file another process put there
+  /// during the run: without `overwrite` nothing may be at path() (renameat2
+  /// RENAME_NOREPLACE, or link + unlink where the file system refuses it: rename_no_replace;
+  /// `force_link` takes that way, for the tests), with it only the file that was there when
+  /// the writer was made (same device, inode, mtime and size) or nothing. Otherwise
+  /// Error(ExitCode::cant_create) naming path() and partial(), which keeps the results.
+  void publish(bool force_link = false) const;
   /// Writes what is buffered and closes the file without renaming it: it stays at
   /// partial(), a readable result file (as the destructor leaves it). No-op once closed.
   void close();
@@ -109,15 +124,22 @@ class ResultWriter {
   /// Where the file is until finish().
   const std::string& partial() const { return partial_; }
   std::size_t snapshots() const { return times_.size(); }
+  /// The snapshots stored with their restart state (output.restart_every).
+  std::size_t states() const { return states_; }
   /// Step of the last snapshot (-1 before the first).
   long last_snapshot_step() const { return last_snapshot_step_; }
 
  private:
+  void take_snapshot(const Simulation& sim, bool last);
+  void store_state(const Simulation& sim);  // one row of restart/
+
   struct Impl;
   std::string path_, partial_;
   bool overwrite_;
+  FileIdentity seen_;  // the file at path_ when the writer was made
   std::unique_ptr<Impl> impl_;
   std::vector<double> times_;
+  std::size_t states_ = 0;
   long last_snapshot_step_ = -1;
 };
 
@@ -156,11 +178,16 @@ class ResultReader {
   const Grid& grid() const { return grid_; }
   /// The per-step diagnostics.
   std::vector<Diagnostics> diagnostics() const;
-  /// Whether the file holds the full state at its snapshots (output.restart_state).
+  /// Whether the file holds the full state at some snapshots (output.restart_state).
   bool has_restart_state() const;
-  /// The full state at snapshot `index`, to continue the run from (Simulation::restore).
-  /// No restart state -> Error(ExitCode::data) saying how to get one; index out of range
-  /// -> Error(ExitCode::usage).
+  /// The times whose full state the file holds (s; restart/time, every
+  /// output.restart_every-th snapshot and the last; in files before 2026-11-27 every
+  /// snapshot); empty without restart state.
+  std::vector<double> restart_times() const;
+  /// The full state at restart_times()[index], to continue the run from
+  /// (Simulation::restore). No restart state -> Error(ExitCode::data) saying how to get one;
+  /// index out of range -> Error(ExitCode::usage). Reads both layouts: restart/time with
+  /// once-per-value fields (NAME_row), and the older one, a row per snapshot.
   RestartPoint restart_point(std::size_t index) const;
   /// Gauge series (empty when the run had none).
   GaugeSeries gauges() const;
