@@ -272,10 +272,12 @@ void Simulation::describe_grid() {
         "near a pole the cells narrow: row {} (latitude {:.4g} degrees) has dx = {:.4g} m, "
         "{:.3g} times narrower than row {} (latitude {:.4g} degrees, dx = {:.4g} m), and the "
         "time step limit shrinks with it (for 1 m of water, CFL {:.3g}: {:.4g} s there against "
-        "{:.4g} s); set boundary.latitude_cap (degrees, e.g. 85) to make the rows poleward of "
-        "it walls",
+        "{:.4g} s); {} boundary.latitude_cap (degrees{}) to make the rows poleward of it walls",
         narrow, g.cell_center(0, narrow)[1], g.dx[narrow], g.dx[wide] / g.dx[narrow], wide,
-        g.cell_center(0, wide)[1], g.dx[wide], cfl, dt_narrow, dt_wide));
+        g.cell_center(0, wide)[1], g.dx[wide], cfl, dt_narrow, dt_wide,
+        params_.boundary.latitude_cap ? "lower" : "set",
+        params_.boundary.latitude_cap ? fmt::format(", now {:.6g}", *params_.boundary.latitude_cap)
+                                      : std::string(", e.g. 85")));
   }
 }
 
