@@ -45,6 +45,8 @@ void apply_boundary_codes(Terrain& t, const std::string& source) {
 }
 
 BoundaryKind ghost_condition(const Terrain& t, const Params& p, int col, int row, Side side) {
+  // joined edges: the ghost repeats the opposite DEM cell, whatever the codes or edges say
+  if ((side == Side::west || side == Side::east) && periodic_x(t, p)) return BoundaryKind::periodic;
   const auto i = static_cast<std::size_t>(row) * t.grid.nx + col;
   switch (code_at(t, i)) {
     case kBoundaryClosed:
@@ -60,7 +62,7 @@ BoundaryKind ghost_condition(const Terrain& t, const Params& p, int col, int row
     case Side::west:
       return p.boundary.west;
     case Side::east:
-      return p.boundary.east;  // periodic: build_padded_state copies the columns instead
+      return p.boundary.east;
     case Side::north:
       return p.boundary.north;
     case Side::south:

@@ -30,8 +30,9 @@ enum class Side { west, east, north, south };
 /// at the level on its own bed). No-op without codes.
 void apply_boundary_codes(Terrain& t, const std::string& source);
 
-/// The condition of the ghost beyond DEM cell (col, row) on `side`: the raster's code at the
-/// cell where it has one (an edge cell), else the edge's (boundary.west, ...).
+/// The condition of the ghost beyond DEM cell (col, row) on `side`: periodic west and east
+/// where the edges are joined (periodic_x), else the raster's code at the cell where it has one
+/// (an edge cell), else the edge's (boundary.west, ...).
 BoundaryKind ghost_condition(const Terrain& t, const Params& p, int col, int row, Side side);
 
 /// Whether non-active DEM cell `i` is held at the level: coded fixed_level, or a nodata cell
