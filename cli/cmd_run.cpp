@@ -141,6 +141,8 @@ int run(const RunOptions& o) {
                  sim.terrain().source, g.nx, g.ny, g.dx_min(), sim.backend().name(),
                  sim.backend().device());
     spdlog::info("backend chosen by {}", sim.backend().choice_reason());
+    for (const auto& note : sim.setup_notes()) spdlog::info("{}", note);
+    for (const auto& warning : sim.setup_warnings()) spdlog::warn("{}", warning);
     spdlog::info("flow {}, erosion {}, transport {}, thermal {}, {}", scheme_name(p.flow.scheme),
                  p.erosion.enabled ? "on" : "off", scheme_name(p.transport.scheme),
                  p.thermal.enabled ? "on" : "off",

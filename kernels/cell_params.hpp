@@ -163,6 +163,7 @@ CellParams<real> cell_params_of(const Params& params) {
   c.flow.dry_depth = r(params.numerics.dry_depth);
   c.flow.pipe_area = r(f.pipe_area);
   c.flow.pipe_length = r(f.pipe_length);
+  c.flow.periodic_x = 0;  // the backends set it (it depends on the grid: PaddedState)
 
   c.water.velocity_min_depth = r(params.numerics.velocity_min_depth);
 
@@ -277,7 +278,7 @@ extern template ParamBytes cell_params_bytes(const CellParams<double>&, Process)
 // Members of type real or int only: the host's structs have the device's layout (OpenCL
 // passes them by value as kernel arguments).
 static_assert(sizeof(cell_params::BoundaryParams<float>) == 2 * sizeof(float));
-static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float));
+static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
 static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
 static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));

@@ -20,6 +20,7 @@ std::uint8_t cell_kind(BoundaryKind b) {
     case BoundaryKind::fixed_level:
       return ERODEM_CELL_FIXED;
     case BoundaryKind::closed:
+    case BoundaryKind::periodic:  // build_padded_state copies the columns instead
       break;
   }
   return ERODEM_CELL_WALL;
@@ -142,6 +143,18 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
       params.erosion.hardness_noise ? hardness_noise(terrain, params.erosion) : terrain.hardness,
       params.erosion.hardness.value);
   s.rain_factor = raster_or(terrain.rain_factor, 1.0);
+  s.periodic_x = periodic_x(terrain, params);
+  if (s.periodic_x && nx < 2)
+    throw config_error("boundary.periodic_x",
+                       fmt::format("joins the east and west edges of a grid of {} column; it "
+                                   "needs at least 2",
+                                   nx));
+  if (s.periodic_x) {
+    // the ghost columns repeat the opposite DEM columns (the corners the ghost rows' ends)
+    copy_periodic_columns(s.kind.data(), W, H);
+    for (auto* f : {&s.bed, &s.depth, &s.sediment, &s.manning, &s.hardness, &s.rain_factor})
+      copy_periodic_columns(f->data(), W, H);
+  }
   return s;
 }
 

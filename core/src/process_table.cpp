@@ -547,6 +547,18 @@ void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps) {
   }
 }
 
+std::vector<std::string> halo_fields(const SweepInfo& sweep) {
+  std::vector<std::string> out;
+  auto add = [&](const std::string& f) {
+    if (f == "kind" || f == "dx" || f == "dy" || f == "area") return;
+    if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
+  };
+  for (const auto& u : sweep.uses)
+    if (u.access == Access::write || u.access == Access::update) add(u.field);
+  for (const char* f : sweep.leaves) add(f);
+  return out;
+}
+
 namespace {
 
 /// Whether a sweep of the step (on the cells only, or on any domain) writes `field`.

@@ -199,6 +199,22 @@ void check_cross_fields(const Params& p, const std::string& source) {
                  "infiltration.suction, .moisture_deficit or .soil_depth cell by cell: give the "
                  "soil as rasters or by class, not both");
   }
+  const auto& b = p.boundary;
+  for (const auto& [key, kind] :
+       {std::pair{"boundary.north", b.north}, std::pair{"boundary.south", b.south}})
+    if (kind == BoundaryKind::periodic)
+      throw fail(key,
+                 "\"periodic\" joins the east and west edges only (boundary.periodic_x); the "
+                 "north and south edges are closed, open or fixed_level");
+  const bool east = b.east == BoundaryKind::periodic, west = b.west == BoundaryKind::periodic;
+  if (east != west)
+    throw fail(east ? "boundary.west" : "boundary.east",
+               fmt::format("must be \"periodic\" too: boundary.{} is, and a periodic edge is "
+                           "joined to the opposite one (or set boundary.periodic_x = true)",
+                           east ? "east" : "west"));
+  if (east && b.periodic_x && !*b.periodic_x)
+    throw fail("boundary.periodic_x",
+               "is false, but boundary.east and boundary.west are \"periodic\"");
   if (p.flow.order == 2 && p.flow.scheme != FlowScheme::shallow_water)
     throw fail("flow.order",
                "order 2 is the shallow_water scheme's (flow.scheme = \"shallow_water\")");

@@ -89,6 +89,25 @@ Descriptor boolean(const char* key, Access access, const char* doc) {
   return d;
 }
 
+/// true, false, or not set (none: the default the code derives, e.g. from the grid).
+template <class Access>
+Descriptor optional_boolean(const char* key, Access access, const char* doc) {
+  Descriptor d = base(key, access, "optional boolean", Dimension::dimensionless,
+                      "true | false, or \"none\"", doc);
+  d.assign = [=](Params& p, const toml::node& n, const Where& w) {
+    if (n.value_exact<std::string>() == std::optional<std::string>("none"))
+      access(p).reset();
+    else
+      access(p) = read_bool(n, w);
+  };
+  d.check = [](const Params&, const Where&) {};
+  d.format = [=](const Params& p) -> std::optional<std::string> {
+    if (!access(p)) return std::nullopt;
+    return std::string(*access(p) ? "true" : "false");
+  };
+  return d;
+}
+
 template <class Access>
 Descriptor text(const char* key, Access access, const char* doc) {
   Descriptor d = base(key, access, "string", Dimension::dimensionless, "any string", doc);

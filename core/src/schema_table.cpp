@@ -58,7 +58,8 @@ const std::vector<Descriptor>& descriptor_table() {
   using D = Dimension;
   static const Choices<BoundaryKind> boundary{{"closed", BoundaryKind::closed},
                                               {"open", BoundaryKind::open},
-                                              {"fixed_level", BoundaryKind::fixed_level}};
+                                              {"fixed_level", BoundaryKind::fixed_level},
+                                              {"periodic", BoundaryKind::periodic}};
   static const Choices<SedimentClosure> closures{{"non_cohesive", SedimentClosure::non_cohesive},
                                                  {"cohesive", SedimentClosure::cohesive}};
   static const std::vector<Descriptor> table{
@@ -343,10 +344,16 @@ const std::vector<Descriptor>& descriptor_table() {
       ERODEM_CLASS_TABLE(snow),
       ERODEM_CLASS_TABLE(water),
 
-      choice(ERODEM_FIELD(boundary.north), boundary, "north edge: closed, open or fixed_level"),
-      choice(ERODEM_FIELD(boundary.south), boundary, "south edge: closed, open or fixed_level"),
-      choice(ERODEM_FIELD(boundary.east), boundary, "east edge: closed, open or fixed_level"),
-      choice(ERODEM_FIELD(boundary.west), boundary, "west edge: closed, open or fixed_level"),
+      choice(ERODEM_FIELD(boundary.north), boundary,
+             "north edge: closed, open or fixed_level (periodic is for east and west only)"),
+      choice(ERODEM_FIELD(boundary.south), boundary,
+             "south edge: closed, open or fixed_level (periodic is for east and west only)"),
+      choice(ERODEM_FIELD(boundary.east), boundary,
+             "east edge: closed, open, fixed_level, or periodic (with the other of east and west; "
+             "boundary.periodic_x)"),
+      choice(ERODEM_FIELD(boundary.west), boundary,
+             "west edge: closed, open, fixed_level, or periodic (with the other of east and west; "
+             "boundary.periodic_x)"),
       number(ERODEM_FIELD(boundary.sediment_concentration), D::dimensionless, right_open(0, 1),
              "volume concentration of solid sediment in the water fixed_level edges and sea "
              "nodata cells give (1); 0 = clear water"),
@@ -363,6 +370,12 @@ const std::vector<Descriptor>& descriptor_table() {
       choice(ERODEM_FIELD(boundary.nodata),
              Choices<NodataKind>{{"wall", NodataKind::wall}, {"sea", NodataKind::sea}},
              "nodata cells: wall, or sea at boundary.sea_level"),
+      optional_boolean(ERODEM_FIELD(boundary.periodic_x),
+                       "join the east and west edges (water leaving east enters west): true, "
+                       "false, or not set = on where the grid spans 360 degrees of longitude"),
+      optional_number(ERODEM_FIELD(boundary.latitude_cap), D::angle, left_open(0, 90),
+                      "lat/lon grids: the rows poleward of +-cap (degrees) are walls, so their "
+                      "narrow cells do not set the time step; not set = none"),
 
       text(ERODEM_FIELD(output.path), "result file (.h5)"),
       integer(ERODEM_FIELD(output.every), at_least(1),

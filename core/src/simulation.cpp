@@ -127,6 +127,7 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   terrain_.grid.validate();
   // every field a sweep of the step reads is provided before it (process.hpp)
   check_sweeps(step_sweeps(params_));
+  describe_grid();
   const auto& g = terrain_.grid;
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
@@ -215,6 +216,69 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   diag_.material_volume = stats_.material_volume;
   diag_.max_depth = stats_.max_depth;
   diag_.max_speed = stats_.max_speed;
+}
+
+void Simulation::describe_grid() {
+  const Grid& g = terrain_.grid;
+  dx_min_ = g.dx_min();
+  area_min_ = HUGE_VAL;
+  for (double a : g.area) area_min_ = std::min(area_min_, a);
+  // the rows with an active cell: the narrowest and the widest of them
+  int narrow = -1, wide = -1;
+  for (int r = 0; r < g.ny; ++r) {
+    bool any = false;
+    for (int c = 0; c < g.nx && !any; ++c)
+      any = terrain_.active(static_cast<std::size_t>(r) * g.nx + c);
+    if (!any) continue;
+    if (narrow < 0 || g.dx[r] < g.dx[narrow]) narrow = r;
+    if (wide < 0 || g.dx[r] > g.dx[wide]) wide = r;
+  }
+  if (params_.boundary.latitude_cap && narrow >= 0) {
+    dx_min_ = HUGE_VAL;
+    area_min_ = HUGE_VAL;
+    for (int r = 0; r < g.ny; ++r) {
+      bool any = false;
+      for (int c = 0; c < g.nx && !any; ++c)
+        any = terrain_.active(static_cast<std::size_t>(r) * g.nx + c);
+      if (!any) continue;
+      dx_min_ = std::min({dx_min_, g.dx[r], g.dy[r]});
+      area_min_ = std::min(area_min_, g.area[r]);
+    }
+  }
+  notes_ = terrain_.notes;
+  if (periodic_x(terrain_, params_)) {
+    const double span = g.nx * std::fabs(g.georef.transform[1]);
+    const char* why = !params_.boundary.periodic_x && spans_360(g)
+                          ? "the grid spans 360 degrees of longitude; boundary.periodic_x = false "
+                            "keeps them apart"
+                      : spans_360(g)
+                          ? "boundary.periodic_x = true"
+                          : "asked for by boundary.periodic_x or boundary.east and .west "
+                            "= \"periodic\"";
+    notes_.push_back(fmt::format(
+        "the east and west edges are joined (periodic): water leaving east enters west ({}){}", why,
+        spans_360(g) ? std::string()
+        : g.georef.is_geographic
+            ? fmt::format("; the grid spans {:.6g} degrees of longitude, not 360", span)
+            : std::string("; the grid is not a lat/lon grid spanning 360 degrees")));
+  }
+  // The time step's limits scale with the narrowest cells: on a lat/lon grid those of the
+  // rows nearest a pole (dx = R cos(latitude) dlon).
+  if (g.georef.is_geographic && narrow >= 0 && g.dx[narrow] < 0.5 * g.dx[wide]) {
+    const double gravity = params_.flow.gravity, cfl = params_.time.cfl;
+    const double dt_narrow = cfl * g.dx[narrow] / std::sqrt(gravity * 1.0);
+    const double dt_wide = cfl * std::min(g.dx[wide], g.dy[wide]) / std::sqrt(gravity * 1.0);
+    warnings_.push_back(fmt::format(
+        "near a pole the cells narrow: row {} (latitude {:.4g} degrees) has dx = {:.4g} m, "
+        "{:.3g} times narrower than row {} (latitude {:.4g} degrees, dx = {:.4g} m), and the "
+        "time step limit shrinks with it (for 1 m of water, CFL {:.3g}: {:.4g} s there against "
+        "{:.4g} s); {} boundary.latitude_cap (degrees{}) to make the rows poleward of it walls",
+        narrow, g.cell_center(0, narrow)[1], g.dx[narrow], g.dx[wide] / g.dx[narrow], wide,
+        g.cell_center(0, wide)[1], g.dx[wide], cfl, dt_narrow, dt_wide,
+        params_.boundary.latitude_cap ? "lower" : "set",
+        params_.boundary.latitude_cap ? fmt::format(", now {:.6g}", *params_.boundary.latitude_cap)
+                                      : std::string(", e.g. 85")));
+  }
 }
 
 void Simulation::resolve_inflows() {
@@ -354,7 +418,7 @@ double Simulation::next_dt() const {
   double dt = t.dt;
   if (t.adaptive) {
     const double g = params_.flow.gravity;
-    const double dx_min = terrain_.grid.dx_min();
+    const double dx_min = dx_min_;
     const FieldStats& stats = current_stats();
     // The depth the flow kernel sees in this step: the deepest cell's after this step's
     // sources, d_max + s dt (s: source_rise_rate), and at a fixed-level face the sea's depth
@@ -399,8 +463,7 @@ double Simulation::next_dt() const {
     }
     if (params_.flow.scheme == FlowScheme::pipes) {
       // Stability of the pipe oscillator: dt < sqrt(l * area / (2 A g)).
-      double area_min = HUGE_VAL;
-      for (double a : terrain_.grid.area) area_min = std::min(area_min, a);
+      const double area_min = area_min_;
       const double l = params_.flow.pipe_length > 0 ? params_.flow.pipe_length : dx_min;
       dt = std::min(dt, t.cfl * std::sqrt(l * area_min / (2.0 * params_.flow.pipe_area * g)));
     }
@@ -479,8 +542,7 @@ void Simulation::check_stability(double dt) const {
                             steps_, time_, cell_name(stats.bad_cell), d, b, stability_advice()));
   }
   if (params_.flow.scheme != FlowScheme::pipes && stats.max_depth > 0) {
-    const double courant =
-        dt * std::sqrt(params_.flow.gravity * stats.max_depth) / terrain_.grid.dx_min();
+    const double courant = dt * std::sqrt(params_.flow.gravity * stats.max_depth) / dx_min_;
     if (courant > 1.0)
       throw Error(ExitCode::unstable,
                   fmt::format("CFL violated at step {} (t = {:.6g} s): cell {} with depth "

@@ -116,8 +116,23 @@ Terrain load_terrain(const Params& p) {
                      celsius_offset(path, "snow.temperature_grids"), -100.0, 100.0, t, p,
                      t.temperature_grids, t.temperature_grid_times);
   }
+  // a global grid holding both -180 and +180: the column 360 degrees east of the first is the
+  // first again, and the periodic edges join the grid without it
+  if (repeats_first_column(t.grid)) {
+    const Grid& g = t.grid;
+    const double first = g.cell_center(0, 0)[0], last = g.cell_center(g.nx - 1, 0)[0];
+    drop_last_column(t);
+    t.notes.push_back(fmt::format(
+        "{}: its last column (longitude {:.6g}) repeats the first (longitude {:.6g}, 360 "
+        "degrees west of it): dropped, {} columns remain",
+        t.source, last, first, t.grid.nx));
+  }
   const int factor = resample_factor(p.dem, t.grid);
   if (factor > 1) t = coarsen(t, factor);
+  if (const int capped = apply_latitude_cap(t, p))
+    t.notes.push_back(
+        fmt::format("boundary.latitude_cap = {:.6g} degrees: the {} rows poleward of it are walls",
+                    *p.boundary.latitude_cap, capped));
   apply_boundary_codes(t, p.boundary.raster);
   return t;
 }

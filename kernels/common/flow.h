@@ -19,6 +19,8 @@ ERODEM_PARAMS(FlowParams, {
   real dry_depth;   /* local inertial: faces shallower carry no flow (m) */
   real pipe_area;   /* pipes: the pipe cross-section A (m^2) */
   real pipe_length; /* pipes: the pipe length l (m); 0 = the cell size */
+  int periodic_x;   /* boundary.periodic_x: the second-order shallow water's cells two columns
+                       off wrap around the seam (shallow_water_muscl_cell) */
 })
 
 ERODEM_BEGIN_NAMESPACE
@@ -316,6 +318,25 @@ ERODEM_FN real local_inertial_face_x(int x, int y, int W, int H, GLOBAL const er
                                 kind_at(kind, xc + 2, y, W, H) != ERODEM_CELL_WALL, width, width,
                                 width, dx[y], kind, bed, depth, manning, f_right, f_left, dt,
                                 gravity, theta, dry_depth);
+}
+
+/* boundary.periodic_x (the OpenCL seam pass; the CPU's face_x_row evaluates the same): the
+ * discharge (m^3/s) across the seam in padded row y, the face east of the last DEM column
+ * (W - 2), whose east ghost repeats column 1, with its true neighbours, the face before it and
+ * the face between columns 1 and 2 after it. The host writes it to both faces that stand for
+ * it, east of column W - 2 and east of ghost column 0. */
+ERODEM_FN real local_inertial_seam_x(int y, int W, GLOBAL const erodem_kind_t* kind,
+                                     GLOBAL const real* bed, GLOBAL const real* depth,
+                                     GLOBAL const real* manning, GLOBAL const real* dx,
+                                     GLOBAL const real* dy, GLOBAL const real* f_left,
+                                     GLOBAL const real* f_right, real dt, real gravity, real theta,
+                                     real dry_depth) {
+  const int a = W - 2 + y * W, down = 2 + y * W;
+  const real width = dy[y];
+  return local_inertial_face_at(a, a + 1, a - 1, down, kind[a - 1] != ERODEM_CELL_WALL,
+                                kind[down] != ERODEM_CELL_WALL, width, width, width, dx[y], kind,
+                                bed, depth, manning, f_right, f_left, dt, gravity, theta,
+                                dry_depth);
 }
 
 /* Discharge (m^3/s) across the face between padded cells (x, y) and (x, y + 1), positive

@@ -510,9 +510,13 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell(
   const real g = p.gravity, eps = p.dry_depth;
   const ERODEM_S(SwCellState) c = sw_state_at(x, y, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) w1 = sw_state_at(x - 1, y, W, H, kind, bed, depth, q_x, q_y, eps);
-  const ERODEM_S(SwCellState) w2 = sw_state_at(x - 2, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  /* with periodic_x the cells two columns off wrap around the seam (the ghost columns repeat
+   * the opposite DEM columns, the cells beyond them lie inside the grid) */
+  const int x_w2 = p.periodic_x && x - 2 < 1 ? x - 2 + (W - 2) : x - 2;
+  const int x_e2 = p.periodic_x && x + 2 > W - 2 ? x + 2 - (W - 2) : x + 2;
+  const ERODEM_S(SwCellState) w2 = sw_state_at(x_w2, y, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) e1 = sw_state_at(x + 1, y, W, H, kind, bed, depth, q_x, q_y, eps);
-  const ERODEM_S(SwCellState) e2 = sw_state_at(x + 2, y, W, H, kind, bed, depth, q_x, q_y, eps);
+  const ERODEM_S(SwCellState) e2 = sw_state_at(x_e2, y, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) n1 = sw_state_at(x, y - 1, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) n2 = sw_state_at(x, y - 2, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) s1 = sw_state_at(x, y + 1, W, H, kind, bed, depth, q_x, q_y, eps);

@@ -83,17 +83,20 @@ ERODEM_FN real transport_semi_lagrangian_cell(int x, int y, int W, int H,
                                               GLOBAL const real* sediment,
                                               GLOBAL const real* velocity_x,
                                               GLOBAL const real* velocity_y, GLOBAL const real* dx,
-                                              GLOBAL const real* dy, real dt) {
+                                              GLOBAL const real* dy, real dt, int periodic_x) {
   const int i = x + y * W;
   real px = (real)x - velocity_x[i] * dt / dx[y];
   real py = (real)y + velocity_y[i] * dt / dy[y];
-  px = fmin(fmax(px, (real)1), (real)(W - 2));
+  /* with periodic_x the departure point may lie in the ghost columns, which repeat the
+   * opposite DEM columns (it crosses the seam) */
+  const int x_lo = periodic_x ? 0 : 1, x_hi = periodic_x ? W - 1 : W - 2;
+  px = fmin(fmax(px, (real)x_lo), (real)x_hi);
   py = fmin(fmax(py, (real)1), (real)(H - 2));
   int x0 = (int)px;
   int y0 = (int)py;
-  if (x0 > W - 3) x0 = W - 3;
+  if (x0 > x_hi - 1) x0 = x_hi - 1;
   if (y0 > H - 3) y0 = H - 3;
-  if (x0 < 1) x0 = 1;
+  if (x0 < x_lo) x0 = x_lo;
   if (y0 < 1) y0 = 1;
   const real tx = px - (real)x0;
   const real ty = py - (real)y0;

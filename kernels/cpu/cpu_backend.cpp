@@ -30,6 +30,8 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       W_(terrain.grid.nx + 2),
       H_(terrain.grid.ny + 2) {
   const PaddedState s = build_padded_state(terrain, params);
+  periodic_ = s.periodic_x;
+  cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
 #else
@@ -67,6 +69,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   const std::size_t cells = n;
   fields_.bind(*this, [cells] { return Field(cells, Real(0)); });
   run_boundary();
+  exchange_halo({"bed", "water_depth", "sediment"});  // the corners after the ghost rows
 }
 
 template <class Real>
@@ -127,9 +130,26 @@ void CpuBackend<Real>::run(Process p) {
     default:  // the processes whose sweeps are all generic
       break;
   }
-  // the generic sweeps of the process (SweepInfo::generic), after its own loops
-  for (const SweepInfo& s : process_info(p).sweeps(params_))
-    if (s.generic) run_generic(s, p, dt, tally);
+  // the generic sweeps of the process (SweepInfo::generic), after its own loops, and the halo
+  // exchange after every sweep (run_thermal and run_flow exchange between their own passes)
+  run_sweeps_tail(
+      process_info(p).sweeps(params_), periodic_,
+      [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
+      [&](const std::vector<std::string>& names) { exchange_halo(names); });
+}
+
+template <class Real>
+void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
+  if (!periodic_) return;
+  for (const std::string& name : names) {
+    Field* f = name == "depth_flow"      ? &depth_next_
+               : name == "thermal_share" ? &thermal_share_
+                                         : field_storage(field_info(name).id);
+    if (!f)
+      throw Error(ExitCode::internal,
+                  fmt::format("halo exchange: field '{}' has no storage", name));
+    copy_periodic_columns(f->data(), W_, H_);
+  }
 }
 
 template <class Real>
@@ -276,6 +296,11 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
       // a bed keeps what Real cannot hold in its residual (set bed_residual after the bed)
       if (id == FieldId::bed) bed_residual_[p] = static_cast<Real>(value - static_cast<double>(v));
     }
+  if (periodic_) {
+    copy_periodic_columns(dst->data(), W_, H_);
+    if (twin) copy_periodic_columns(twin->data(), W_, H_);
+    if (id == FieldId::bed) copy_periodic_columns(bed_residual_.data(), W_, H_);
+  }
 }
 
 template <class Real>

@@ -17,6 +17,7 @@
 #include "common/erosion.h"
 #include "erodem/backend.hpp"
 #include "erodem/grid.hpp"
+#include "erodem/initial_state.hpp"
 #include "erodem/params.hpp"
 #include "erodem/process.hpp"
 #include "field_registry.hpp"
@@ -74,6 +75,10 @@ class CpuBackend final : public Backend {
   void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
   template <auto Cell>
   void cell_sweep(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
+  /// The halo exchange (process.hpp halo_fields): with boundary.periodic_x, copies the named
+  /// fields (of the field table, or the intermediates "depth_flow", "thermal_share") into the
+  /// ghost columns that repeat the opposite DEM columns; nothing otherwise.
+  void exchange_halo(const std::vector<std::string>& names);
 
  private:
   using Kind = cell::erodem_kind_t;
@@ -157,6 +162,7 @@ class CpuBackend final : public Backend {
   CellParams<Real> cell_;  // the processes' run constants (cell_params.hpp)
   int nx_, ny_, W_, H_;
   int threads_;
+  bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
   std::vector<Kind> kind_;
   std::vector<Real> dx_, dy_, area_;  // per padded row
   // The bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is only

@@ -28,6 +28,7 @@ namespace {
 template <class Real>
 struct InertialParams {
   Real dt, gravity, theta, dry_depth;
+  bool periodic_x = false;  // boundary.periodic_x: the faces across the seam (face_x_row)
 };
 
 /// Unit discharges (m^2/s) of the faces south of padded row j (0 <= j <= H - 2), all x.
@@ -98,6 +99,15 @@ void face_x_row(int y, int W, const int* __restrict k, const Real* __restrict be
         face(x, k[x - 1] != ERODEM_CELL_WALL, k[x + 2] != ERODEM_CELL_WALL, q[x - 1], q[x + 1]);
   out[W - 2] = face(W - 2, k[W - 3] != ERODEM_CELL_WALL, 0, q[W - 3], q[W - 2]);
   out[W - 1] = Real(0);
+  if (p.periodic_x) {
+    // The seam: the face east of the last DEM column is the face west of the first (ghost
+    // columns 0 and W - 1 repeat columns W - 2 and 1), computed once with its true neighbours
+    // on both sides, the face before it (q[W - 3]) and the face after it, between columns 1
+    // and 2 (q[1]), so both cells beside it see the same discharge.
+    out[W - 2] =
+        face(W - 2, k[W - 3] != ERODEM_CELL_WALL, k[2] != ERODEM_CELL_WALL, q[W - 3], q[1]);
+    out[0] = out[W - 2];
+  }
 }
 
 /// Splits the faces around the cells of padded row y into their outflows (m^3/s). face_x:
@@ -382,6 +392,12 @@ void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
       for (int x = 1; x < n - 1; ++x)
         s.store(x, cell::sw_slopes_x(r.state(x - 1), r.state(x), r.state(x + 1), e));
       s.store(n - 1, {});
+      if (st.params.periodic_x) {
+        // the ghost columns' slopes: those of the DEM columns they repeat (the seam's faces
+        // are then the faces inside, shallow_water_muscl_cell's wrap)
+        s.store(0, s.load(n - 2));
+        s.store(n - 1, s.load(1));
+      }
     }
   };
   auto slopes_y = [&](int j) {  // 1 <= j <= H - 2, rows j - 1 .. j + 1 loaded
@@ -460,12 +476,17 @@ void CpuBackend<Real>::run_flow(Real dt) {
                      dt, f, ol,   orr, ot, ob,        qx_next.data(), qy_next.data()};
     if (params_.flow.order == 2) {
       for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true, false>(st, y0, y1); });
+      // the halo of the first stage before the depth and the second stage read it
+      if (periodic_)
+        for (Real* field : {ol, orr, ot, ob, qx_next.data(), qy_next.data()})
+          copy_periodic_columns(field, W, H);
       stage_depth_.resize(depth_.size());
       Real* h1 = stage_depth_.data();
       for_rows(0, H, [=](int y) {
         for (int x = 0; x < W; ++x)
           cell::shallow_water_stage_depth_cell(x, y, W, H, kind, d, ol, orr, ot, ob, area, dt, h1);
       });
+      if (periodic_) copy_periodic_columns(h1, W, H);
       SwStage<Real> st2 = st;
       st2.depth = h1;
       st2.q_x = qx_next.data();
@@ -505,7 +526,7 @@ void CpuBackend<Real>::run_flow(Real dt) {
     std::swap(flux_, flux_next_);
     return;
   }
-  const InertialParams<Real> p{dt, g, f.theta, f.dry_depth};
+  const InertialParams<Real> p{dt, g, f.theta, f.dry_depth, periodic_};
   const Real* manning = manning_.data();
   for_row_blocks(H, [&](int y0, int y1) {
     const std::size_t w = static_cast<std::size_t>(W);

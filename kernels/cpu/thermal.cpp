@@ -27,6 +27,7 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
     for (int x = 1; x < W - 1; ++x)
       cell::thermal_share_sweep_cell(x, y, W, kind, bed, wet, talus, dx, dy, area, share, step, p);
   });
+  exchange_halo({"thermal_share"});  // the apply pass reads the neighbours' shares
   for_rows(1, H_ - 1, [=](int y) {
     const cell_params::ThermalParams<Real> p = params;
     const auto given_row = row_scratch(W);

@@ -34,14 +34,15 @@ void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
     tally.sediment_exchanged += sum_rows(row_sums_b_);
   } else {
     const Real *u = velocity_x_.data(), *v = velocity_y_.data(), *dx = dx_.data(), *dy = dy_.data();
+    const int periodic = periodic_ ? 1 : 0;
     for_rows(1, H - 1, [=](int y) {
       const Real step = dt;
       double change_row = 0.0;
       for (int x = 1; x < W - 1; ++x) {
         const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W;
         if (kind[i] != ERODEM_CELL_ACTIVE) continue;
-        sediment_out[i] =
-            cell::transport_semi_lagrangian_cell(x, y, W, H, sediment, u, v, dx, dy, step);
+        sediment_out[i] = cell::transport_semi_lagrangian_cell(x, y, W, H, sediment, u, v, dx, dy,
+                                                               step, periodic);
         change_row += (static_cast<double>(sediment_out[i]) - sediment[i]) * area[y];
       }
       row_sums_a_[y] = change_row;

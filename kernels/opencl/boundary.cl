@@ -39,3 +39,13 @@ __kernel void boundary_level(int W, int H, __global const uchar* restrict kind,
   ERODEM_UNTALLIED_CELL(x, y);
   boundary_level_sweep_cell(x, y, W, kind, bed, depth, sediment, area, dt, p);
 }
+
+/* The halo exchange of boundary.periodic_x (process.hpp halo_fields; the CPU's
+ * copy_periodic_columns): one work-item per padded row, ghost column 0 takes column W - 2 and
+ * ghost column W - 1 column 1. */
+__kernel void halo_periodic_x(int W, int H, __global real* restrict f) {
+  const int y = (int)get_global_id(0);
+  if (y >= H) return;
+  f[y * W] = f[y * W + W - 2];
+  f[y * W + W - 1] = f[y * W + 1];
+}

@@ -96,6 +96,22 @@ __kernel void flow_local_inertial_faces_y_interior(
                                      dt, p.gravity, p.theta, p.dry_depth);
 }
 
+/* boundary.periodic_x: the faces across the seam after the face pass, one work-item per padded
+ * row (local_inertial_seam_x), into face_x east of column W - 2 and of ghost column 0. */
+__kernel void flow_local_inertial_seam_x(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict f_left, __global const real* restrict f_right,
+    __global real* restrict face_x, real dt, FlowParams p) {
+  const int y = (int)get_global_id(0);
+  if (y >= H) return;
+  const real q = local_inertial_seam_x(y, W, kind, bed, depth, manning, dx, dy, f_left, f_right, dt,
+                                       p.gravity, p.theta, p.dry_depth);
+  face_x[W - 2 + y * W] = q;
+  face_x[y * W] = q;
+}
+
 /* Local inertial, cell pass: the four faces around each padded cell split into its
  * outflows (flow_local_inertial_cell); the host runs flow_local_inertial_split_interior on
  * rows 1 .. H - 2 and this one on rows 0 and H - 1. */

@@ -219,7 +219,10 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
     for (std::size_t i = 0; i < v.size(); ++i)
       lo[i] = static_cast<float>(values[i] - static_cast<double>(v[i]));
     write_interior(queue_.get(), bed_residual_.get(), nx_, ny_, lo);
+    exchange_halo(bed_residual_);
   }
+  exchange_halo(*dst);
+  if (twin) exchange_halo(*twin);
 }
 
 }  // namespace erodem::opencl

@@ -59,6 +59,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                                             "(at most 2^31 padded cells)",
                                             nx_, ny_));
   const PaddedState state = build_padded_state(terrain, params);
+  periodic_ = state.periodic_x;
+  cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
   cl_int err = CL_SUCCESS;
@@ -173,6 +175,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   tally_partials_ = upload(no_partials);
   tally_sums_ = make_buffer(tally_slots() * acc_size_);
   run_boundary();
+  exchange_halo({"bed", "water_depth", "sediment"});  // the corners after the ghost rows
 }
 
 std::string OpenClBackend::device() const {
@@ -223,9 +226,34 @@ void OpenClBackend::run(Process p) {
     default:  // the processes whose sweeps are all generic
       break;
   }
-  // the generic sweeps of the process (SweepInfo::generic), after its own loops
-  for (const SweepInfo& s : process_info(p).sweeps(params_))
-    if (s.generic) run_generic(s, p, dt, tally);
+  // the generic sweeps of the process (SweepInfo::generic), after its own loops, and the halo
+  // exchange after every sweep (run_thermal and run_flow exchange between their own passes)
+  run_sweeps_tail(
+      process_info(p).sweeps(params_), periodic_,
+      [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
+      [&](const std::vector<std::string>& names) { exchange_halo(names); });
+}
+
+void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
+  if (!periodic_) return;
+  for (const std::string& name : names) {
+    const Buffer* b = name == "depth_flow"      ? &depth_next_
+                      : name == "thermal_share" ? &thermal_share_
+                      : name == "rain_factor"   ? &rain_factor_
+                                                : field_buffer(field_info(name).id);
+    if (!b)
+      throw Error(ExitCode::internal, fmt::format("halo exchange: field '{}' has no buffer", name));
+    exchange_halo(*b);
+  }
+}
+
+void OpenClBackend::exchange_halo(const Buffer& b) {
+  if (!periodic_) return;
+  cl_kernel k = kernel("halo_periodic_x");
+  set_args(k, cl_int{W_}, cl_int{H_}, b);
+  const std::size_t global = static_cast<std::size_t>(H_);
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        "clEnqueueNDRangeKernel(halo_periodic_x)");
 }
 
 StepResult OpenClBackend::end_step() {
@@ -342,10 +370,15 @@ void OpenClBackend::run_flow(Real dt) {
                dt, cell_.flow, cl_int{0}, flux_next_[0], flux_next_[1], flux_next_[2],
                flux_next_[3], qx_next, qy_next);
       launch_rows(k, 0, H_);
+      // the halo of the first stage before the depth and the second stage read it
+      for (const Buffer* b :
+           {&flux_next_[0], &flux_next_[1], &flux_next_[2], &flux_next_[3], &qx_next, &qy_next})
+        exchange_halo(*b);
       cl_kernel s = kernel("flow_shallow_water_stage_depth");
       set_args(s, cl_int{W_}, cl_int{H_}, kind_, depth_, flux_next_[0], flux_next_[1],
                flux_next_[2], flux_next_[3], area_, dt, stage_depth_);
       launch_rows(s, 0, H_);
+      exchange_halo(stage_depth_);
       set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, stage_depth_, qx_next, qy_next, manning_,
                dx_, dy_, area_, dt, cell_.flow, cl_int{1}, flux_next_[0], flux_next_[1],
                flux_next_[2], flux_next_[3], qx, qy);
@@ -384,6 +417,15 @@ void OpenClBackend::run_flow(Real dt) {
     launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
     launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
     launch_rows(kernel("flow_local_inertial_faces"), H_ - 2, H_);
+    if (periodic_) {
+      cl_kernel seam = kernel("flow_local_inertial_seam_x");
+      set_args(seam, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_, flux_[0],
+               flux_[1], face_x_, dt, cell_.flow);
+      const std::size_t rows = static_cast<std::size_t>(H_);
+      check(clEnqueueNDRangeKernel(queue_.get(), seam, 1, nullptr, &rows, nullptr, 0, nullptr,
+                                   nullptr),
+            "clEnqueueNDRangeKernel(flow_local_inertial_seam_x)");
+    }
     for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_,
                flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], dt);
@@ -444,7 +486,7 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
   } else {
     cl_kernel k = kernel("transport_semi_lagrangian");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
-             dx_, dy_, dt);
+             dx_, dy_, dt, cl_int{periodic_ ? 1 : 0});
     launch_interior(k);
     cl_kernel r = kernel("reduce_change");
     set_args(r, cl_int{W_}, cl_int{H_}, kind_, sediment_next_, sediment_, area_, partial_b_);
@@ -460,6 +502,7 @@ void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, talus, dx_, dy_, area_,
            thermal_share_, dt, cell_.thermal);
   launch_interior(share);
+  exchange_halo(thermal_share_);  // the apply pass reads the neighbours' shares
   cl_kernel apply = kernel("thermal_apply");
   set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, wetness_, talus,
            thermal_share_, dx_, dy_, area_, bed_next_, cell_.thermal, tally_partials_,

@@ -159,6 +159,10 @@ class OpenClBackend final : public Backend {
   /// the buffers of its uses, the process's parameter struct and the tally partials, over the
   /// DEM rows; the process's tallies deferred (launch.cpp).
   void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
+  /// The halo exchange (process.hpp halo_fields) with boundary.periodic_x: halo_periodic_x
+  /// (boundary.cl) on the buffers of the named fields; nothing otherwise.
+  void exchange_halo(const std::vector<std::string>& names);
+  void exchange_halo(const Buffer& b);
 
   /// A device buffer of `bytes`, filled from `data` where given. A buffer of a field (at
   /// least kStaggerMin bytes) starts at its own offset modulo 4 KiB (stagger_next_): see
@@ -225,6 +229,7 @@ class OpenClBackend final : public Backend {
   Queue queue_;
   std::vector<std::pair<std::string, Kernel>> kernels_;
   int nx_, ny_, W_, H_;
+  bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
   // The cell kernels' groups: (local_x_, 1) work-items, groups_x_ per padded row (the global

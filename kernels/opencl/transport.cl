@@ -31,11 +31,11 @@ __kernel void transport_semi_lagrangian(int W, int H, __global const uchar* rest
                                         __global const real* restrict velocity_x,
                                         __global const real* restrict velocity_y,
                                         __global const real* restrict dx,
-                                        __global const real* restrict dy, real dt) {
+                                        __global const real* restrict dy, real dt, int periodic_x) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   const int i = x + y * W;
-  const real s_new =
-      transport_semi_lagrangian_cell(x, y, W, H, sediment, velocity_x, velocity_y, dx, dy, dt);
+  const real s_new = transport_semi_lagrangian_cell(x, y, W, H, sediment, velocity_x, velocity_y,
+                                                    dx, dy, dt, periodic_x);
   sediment_out[i] = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE) ? s_new : sediment[i];
 }

@@ -71,6 +71,9 @@ struct Terrain {
   std::vector<double> snow_initial;  ///< the initial snow water equivalent S_0 (m)
   std::string source;                ///< DEM path or generator description
   std::string source_sha256;         ///< checksum of the DEM file, when read from one
+  /// What reading it changed, for the log (the repeated column of a global grid dropped, the
+  /// rows of boundary.latitude_cap): one line each.
+  std::vector<std::string> notes;
 
   bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
 };

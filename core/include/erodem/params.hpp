@@ -23,7 +23,8 @@ inline const char* scheme_name(FlowScheme s) {
 inline const char* scheme_name(TransportScheme s) {
   return s == TransportScheme::conservative ? "conservative" : "semi_lagrangian";
 }
-enum class BoundaryKind { closed, open, fixed_level };
+/// periodic: the east and west edges joined (boundary.periodic_x; east and west only).
+enum class BoundaryKind { closed, open, fixed_level, periodic };
 /// erosion.law: the physical closures (docs/model.md 3.5) or Mei et al. (2007)'s capacity law.
 enum class ErosionLaw { physical, mei };
 /// A bed layer's closure: non-cohesive grains (sand, gravel) or cohesive material (silt, clay,
@@ -294,6 +295,13 @@ struct Params {
     /// nodata cells give (1); 0 = clear water.
     double sediment_concentration = 0.0;
     NodataKind nodata = NodataKind::wall;
+    /// The east and west edges joined (water leaving east enters west): true, false, or
+    /// none = on where the grid spans 360 degrees of longitude (or boundary.east and .west
+    /// are both "periodic"), else off (boundary_codes.hpp periodic_x).
+    std::optional<bool> periodic_x;
+    /// Latitude (degrees, (0, 90]) poleward of which the rows of a lat/lon grid are walls:
+    /// their tiny east-west cells would set the time step; none = no cap.
+    std::optional<double> latitude_cap;
   } boundary;
 
   struct Output {

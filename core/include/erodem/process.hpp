@@ -129,6 +129,34 @@ std::vector<std::pair<Process, SweepInfo>> step_sweeps(const Params& params);
 /// step writes or leaves. Throws Error(ExitCode::internal) naming the sweep and the field.
 void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps);
 
+/// The halo exchange (boundary.periodic_x now; bands of rows of an MPI domain decomposition
+/// next): where the halo stands for cells of the grid itself rather than for a boundary, the
+/// backends copy, after every sweep, the fields it writes or leaves into the halo cells that
+/// repeat them, before a later sweep reads them at a neighbour. This is the list: every field
+/// a sweep writes or updates and every intermediate it leaves, but the grid inputs it never
+/// writes ("kind", the per-row sizes). A cells sweep of a process with several (thermal's
+/// share then apply) is exchanged before the next one runs; the backends call it in one place,
+/// Backend::run's loop over the process's sweeps (CpuBackend, OpenClBackend after_sweep).
+std::vector<std::string> halo_fields(const SweepInfo& sweep);
+
+/// The tail of Backend::run(p) in both backends, the one place of the halo exchange: after the
+/// process's own loops (which exchange in between where a pass reads what an earlier one of
+/// theirs wrote), the exchange of their sweeps' fields; then each generic sweep of `sweeps`
+/// (`run_generic(sweep)`) and its exchange (`exchange(halo_fields(sweep))`). `halo`: whether
+/// the halo is shared (boundary.periodic_x); without it only the generic sweeps run.
+template <class RunGeneric, class Exchange>
+void run_sweeps_tail(const std::vector<SweepInfo>& sweeps, bool halo, const RunGeneric& run_generic,
+                     const Exchange& exchange) {
+  if (halo)
+    for (const SweepInfo& s : sweeps)
+      if (!s.generic) exchange(halo_fields(s));
+  for (const SweepInfo& s : sweeps)
+    if (s.generic) {
+      run_generic(s);
+      if (halo) exchange(halo_fields(s));
+    }
+}
+
 /// Whether a sweep of the sequence writes the bed (erosion, slope collapse): the gauges must
 /// then read the bed every step.
 bool bed_changes(const Params& params);

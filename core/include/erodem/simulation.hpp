@@ -87,6 +87,14 @@ class Simulation {
   /// The time step the next step will take (s).
   double next_dt() const;
 
+  /// What the setup decided that the log should say, one line each: the terrain's notes
+  /// (Terrain::notes) and whether the east and west edges are joined (boundary.periodic_x).
+  const std::vector<std::string>& setup_notes() const { return notes_; }
+  /// What the log should warn of: on a lat/lon grid whose narrowest cells (near a pole) are
+  /// under half as wide as its widest, their latitude, width and time step limit against the
+  /// widest's, and boundary.latitude_cap.
+  const std::vector<std::string>& setup_warnings() const { return warnings_; }
+
   /// Tells the simulation that its state was changed outside step(): the statistics the
   /// next time step is chosen from (and the stability check) are taken again before they
   /// are used. backend() (non-const) calls it, since whoever holds the backend may change
@@ -172,6 +180,12 @@ class Simulation {
   Diagnostics diagnostics_now(double dt) const;
 
   Terrain terrain_;
+  /// The smallest cell size and area of the rows the time step looks at: every row, or with
+  /// boundary.latitude_cap the rows with an active cell (the capped rows hold no water).
+  double dx_min_ = 0.0, area_min_ = 0.0;
+  std::vector<std::string> notes_, warnings_;  ///< setup_notes(), setup_warnings()
+  /// Sets dx_min_, area_min_, notes_ and warnings_ (simulation.cpp).
+  void describe_grid();
   Params params_;
   std::unique_ptr<Backend> backend_;
   std::vector<InflowCells> inflows_;

@@ -21,6 +21,11 @@ struct PaddedState {
   /// m of solid: 0, but sea nodata cells hold boundary.sediment_concentration of their depth
   std::vector<double> sediment;
   std::vector<double> manning, hardness, rain_factor;  ///< rasters or the scalar parameter
+  /// boundary.periodic_x (boundary_codes.hpp periodic_x): the west ghost column holds the
+  /// last DEM column and the east ghost column the first, kinds and every field, so the faces
+  /// across the seam are computed as inside the grid (the backends keep the copies up to date,
+  /// Backend halo exchange: process.hpp halo_fields).
+  bool periodic_x = false;
   std::size_t at(int x, int y) const {
     return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
   }
@@ -32,5 +37,16 @@ struct PaddedState {
 /// raster, or a uniform depth), sea ghosts over the lowest active neighbour, and the
 /// parameter rasters with their halo. Throws erodem::Error(data) on rasters of the wrong size.
 PaddedState build_padded_state(const Terrain& terrain, const Params& params);
+
+/// The periodic halo of a padded field of W x H: ghost column 0 takes column W - 2, ghost
+/// column W - 1 takes column 1, on every row (the corners too).
+template <class T>
+void copy_periodic_columns(T* f, int W, int H) {
+  for (int y = 0; y < H; ++y) {
+    T* row = f + static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
+    row[0] = row[W - 2];
+    row[W - 1] = row[1];
+  }
+}
 
 }  // namespace erodem
