@@ -151,6 +151,21 @@ void append_rows(hid_t ds, hid_t mem_type, hsize_t rows, const void* data, const
   checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
 }
 
+void read_row(hid_t ds, hid_t mem_type, hsize_t row, void* data, const std::string& path,
+              const std::string& name) {
+  H5Id space = checked(H5Dget_space(ds), path, name);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  std::vector<hsize_t> start(dims.size(), 0), count = dims;
+  start[0] = row;
+  count[0] = 1;
+  checked(H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+          path, name);
+  H5Id mem_space = checked(H5Screate_simple(rank, count.data(), nullptr), path, name);
+  checked(H5Dread(ds, mem_type, mem_space, space, H5P_DEFAULT, data), path, "(reading) " + name);
+}
+
 bool exists(hid_t loc, const std::string& path) {
   std::size_t pos = 0;
   while (true) {

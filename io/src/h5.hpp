@@ -126,6 +126,10 @@ H5Id create_dataset(hid_t loc, const std::string& name, hid_t type,
 void append_rows(hid_t ds, hid_t mem_type, hsize_t rows, const void* data, const std::string& path,
                  const std::string& name);
 
+/// Reads row `row` (along the first dimension) of dataset `ds` into `data`, as `mem_type`.
+void read_row(hid_t ds, hid_t mem_type, hsize_t row, void* data, const std::string& path,
+              const std::string& name);
+
 /// Whether `path` names an existing object (every link on the way exists).
 bool exists(hid_t loc, const std::string& path);
 

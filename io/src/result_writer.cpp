@@ -163,12 +163,11 @@ struct ResultWriter::Impl {
   // value (`once`): its rows in restart/NAME, and restart/NAME_row says which is whose
   bool restart = false;
   long restart_every = 1;
-  bool restart_f64 = false;          // float64 runs keep their state in float64
-  std::vector<H5Id> restart_fields;  // state_fields(), in order
-  std::vector<bool> once;            // per state field: stored once per value
-  std::vector<H5Id> restart_rows;    // per state field: its NAME_row dataset (once fields)
-  std::vector<std::vector<double>> last_stored;  // per state field: its last row (once)
-  std::vector<std::int32_t> row_count;           // per state field: rows stored (once)
+  bool restart_f64 = false;             // float64 runs keep their state in float64
+  std::vector<H5Id> restart_fields;     // state_fields(), in order
+  std::vector<bool> once;               // per state field: stored once per value
+  std::vector<H5Id> restart_rows;       // per state field: its NAME_row dataset (once fields)
+  std::vector<std::int32_t> row_count;  // per state field: rows stored (once)
   H5Id restart_time, restart_steps;
   std::vector<H5Id> restart_ledger;  // ledger_entries(), in order
   bool last_has_state = false;       // whether the last snapshot stored the state
@@ -485,7 +484,6 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
                                                     " holding the state at each time")
                                     : H5Id());
     }
-    m.last_stored.resize(m.once.size());
     m.row_count.assign(m.once.size(), 0);
     m.restart_steps = per_state("steps", H5T_STD_I64LE, "1", "steps done");
     for (const auto& e : ledger_entries())
@@ -588,32 +586,37 @@ void ResultWriter::close() {
 
 void ResultWriter::store_state(const Simulation& sim) {
   Impl& m = *impl_;
-  const RestartPoint point = sim.restart_point();
-  std::vector<float> state32(m.restart_f64 ? 0 : sim.grid().cells());
-  for (std::size_t k = 0; k < point.fields.size(); ++k) {
-    const auto& v = point.fields[k];
+  // One field at a time (Simulation::restart_point() would hold every state field in double
+  // at once: 8 bytes per cell for each of them, the run's peak at every snapshot).
+  const std::size_t cells = sim.grid().cells();
+  const hid_t mem_type = m.restart_f64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT;
+  const std::size_t row_bytes = cells * (m.restart_f64 ? sizeof(double) : sizeof(float));
+  std::vector<float> state32(m.restart_f64 ? 0 : cells);
+  for (std::size_t k = 0; k < state_fields().size(); ++k) {
+    const std::vector<double> v = sim.field(state_fields()[k]);
     const std::string name = std::string("restart/") + field_info(state_fields()[k]).name;
+    if (!m.restart_f64)
+      for (std::size_t i = 0; i < v.size(); ++i) state32[i] = static_cast<float>(v[i]);
+    const void* row = m.restart_f64 ? static_cast<const void*>(v.data()) : state32.data();
     if (m.once[k]) {  // a new row only when the values differ from the last one stored
-      const bool same =
-          m.row_count[k] > 0 && m.last_stored[k].size() == v.size() &&
-          std::memcmp(m.last_stored[k].data(), v.data(), v.size() * sizeof(double)) == 0;
-      const std::int32_t row = same ? m.row_count[k] - 1 : m.row_count[k];
-      append_rows(m.restart_rows[k], H5T_NATIVE_INT32, 1, &row, partial_, name + "_row");
+      bool same = false;
+      if (m.row_count[k] > 0) {  // compared with that row as the file holds it
+        std::vector<unsigned char> last(row_bytes);
+        read_row(m.restart_fields[k], mem_type, static_cast<hsize_t>(m.row_count[k] - 1),
+                 last.data(), partial_, name);
+        same = std::memcmp(last.data(), row, row_bytes) == 0;
+      }
+      const std::int32_t index = same ? m.row_count[k] - 1 : m.row_count[k];
+      append_rows(m.restart_rows[k], H5T_NATIVE_INT32, 1, &index, partial_, name + "_row");
       if (same) continue;
-      m.last_stored[k] = v;
       ++m.row_count[k];
     }
-    if (m.restart_f64) {
-      append_rows(m.restart_fields[k], H5T_NATIVE_DOUBLE, 1, v.data(), partial_, name);
-    } else {
-      for (std::size_t i = 0; i < v.size(); ++i) state32[i] = static_cast<float>(v[i]);
-      append_rows(m.restart_fields[k], H5T_NATIVE_FLOAT, 1, state32.data(), partial_, name);
-    }
+    append_rows(m.restart_fields[k], mem_type, 1, row, partial_, name);
   }
-  const std::int64_t steps = point.steps;
+  const std::int64_t steps = sim.steps_done();
   append_rows(m.restart_steps, H5T_NATIVE_INT64, 1, &steps, partial_, "restart/steps");
   for (std::size_t k = 0; k < ledger_entries().size(); ++k) {
-    const double v = point.ledger.*ledger_entries()[k].member;
+    const double v = sim.ledger().*ledger_entries()[k].member;
     append_rows(m.restart_ledger[k], H5T_NATIVE_DOUBLE, 1, &v, partial_,
                 std::string("restart/ledger_") + ledger_entries()[k].name);
   }
