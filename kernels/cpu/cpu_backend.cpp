@@ -162,7 +162,7 @@ StepResult CpuBackend<Real>::end_step() {
   // The probes straight from the fields (host memory): no copy of a whole field.
   r.probes.reserve(probe_fields_.size() * probe_cells_.size());
   for (const FieldId id : probe_fields_) {
-    const Field* src = const_cast<CpuBackend*>(this)->field_storage(id);
+    const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
     for (const std::size_t p : probe_cells_) r.probes.push_back(value_at(id, src, p));
   }
   r.face_water = face_water_;
@@ -209,7 +209,7 @@ template <class Real>
 std::vector<double> CpuBackend<Real>::sample(const std::vector<std::int64_t>& cells,
                                              FieldId id) const {
   check_cells(cells, nx_, ny_, "sample");
-  const Field* src = const_cast<CpuBackend*>(this)->field_storage(id);
+  const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
   std::vector<double> out;
   out.reserve(cells.size());
   for (const std::int64_t cell : cells) out.push_back(value_at(id, src, padded(cell)));
@@ -267,8 +267,7 @@ FieldStats CpuBackend<Real>::stats() {
 template <class Real>
 std::vector<double> CpuBackend<Real>::field(FieldId id) const {
   std::vector<double> out(static_cast<std::size_t>(nx_) * ny_);
-  auto* self = const_cast<CpuBackend*>(this);
-  const Field* src = self->field_storage(id);
+  const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
   for (int r = 0; r < ny_; ++r)
     for (int c = 0; c < nx_; ++c)
       out[static_cast<std::size_t>(r) * nx_ + c] = value_at(id, src, at(c + 1, r + 1));
@@ -280,6 +279,7 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
   if (values.size() != static_cast<std::size_t>(nx_) * ny_)
     throw Error(ExitCode::data, fmt::format("field '{}': {} values for a grid of {} x {}",
                                             field_info(id).name, values.size(), nx_, ny_));
+  if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Field* dst = field_storage(id);
   if (!dst)
     throw Error(ExitCode::usage,

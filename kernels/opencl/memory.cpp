@@ -92,7 +92,7 @@ std::vector<const Buffer*> OpenClBackend::field_parts(FieldId id) {
   if (id == FieldId::bed) return {&bed_, &bed_residual_};
   if (id == FieldId::erosion) return {&bed0_, &bed_, &bed_residual_};
   if (id == FieldId::shear_stress) return {&depth_, &velocity_x_, &velocity_y_, &manning_};
-  return {field_buffer(id)};
+  return {fields_.peek(id)};  // a field not made yet reads as zeros
 }
 
 std::size_t OpenClBackend::part_count(const std::vector<FieldId>& fields) const {
@@ -204,6 +204,7 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
   if (values.size() != static_cast<std::size_t>(nx_) * ny_)
     throw Error(ExitCode::data, fmt::format("field '{}': {} values for a grid of {} x {}",
                                             field_info(id).name, values.size(), nx_, ny_));
+  if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Buffer* dst = field_buffer(id);
   if (!dst)
     throw Error(ExitCode::usage,

@@ -105,7 +105,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   manning_ = upload(to_real(state.manning));
   hardness_ = upload(to_real(state.hardness));
   rain_factor_ = upload(to_real(state.rain_factor));
-  fields_.bind(*this, [&] { return upload(zeros); });
+  fields_.bind(*this, [this] { return upload(std::vector<Real>(n_, Real(0))); });
 
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
   // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
