@@ -17,6 +17,7 @@
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/process.hpp"
+#include "erodem/resident.hpp"
 #include "erodem/schema.hpp"
 #include "erodem/simulation.hpp"
 #include "erodem/terrain_synth.hpp"
@@ -80,6 +81,31 @@ int bytes_per_cell(const std::string& process, const Params& p) {
   return 0;
 }
 
+/// The bytes per cell of the full step run in `passes` on `backend`: a pass the backend fuses
+/// counts its fields once (pass_sweep), any other each process's sweeps; plus the statistics.
+int full_step_bytes(const std::vector<std::vector<Process>>& passes, const Backend& backend,
+                    const Params& p) {
+  const int real = p.numerics.precision == Precision::float64 ? 8 : 4;
+  int bytes = sweep_bytes(stats_sweep(), real).total();
+  for (const auto& pass : passes) {
+    if (backend.fuses(pass)) {
+      bytes += sweep_bytes(pass_sweep(pass, p), real).total();
+      continue;
+    }
+    for (const Process q : pass) bytes += process_bytes(q, p, real).total();
+  }
+  return bytes;
+}
+
+/// What one run held: the rise of the peak resident set from before the simulation was built
+/// to the end of its timing (setup included), and its device buffers.
+struct Memory {
+  std::string run;
+  double peak_bytes = 0;    ///< VmHWM rise (bytes); 0 where /proc cannot say
+  double device_bytes = 0;  ///< Backend::device_bytes()
+  double cells = 1;
+};
+
 struct Row {
   std::string backend, device, process;
   int threads = 0;  ///< requested CPU threads (0: all cores); 0 for OpenCL
@@ -90,9 +116,21 @@ struct Row {
 
 constexpr int kRepetitions = 3;
 
+/// A run's short label: "cpu/2" (threads; "all" for 0), "opencl".
+std::string run_label(const std::string& backend, int threads) {
+  return backend == "cpu" ? fmt::format("cpu/{}", threads ? std::to_string(threads) : "all")
+                          : backend;
+}
+std::string run_label(const Row& r) {
+  return run_label(r.backend, r.threads);
+}
+
 /// Times `backend` on `terrain`; a round of `probe` runs before each timed repetition.
 std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::string& backend,
-                           int threads, long steps, BandwidthProbe& probe) {
+                           int threads, long steps, BandwidthProbe& probe, Memory& memory) {
+  // the peak resident set from here: the backend's setup, its state and the steps
+  const bool peak_known = reset_peak_resident();
+  const double resident0 = resident_bytes();
   Simulation sim(terrain, p, make_backend(backend, terrain, p));
   const auto seq = sim.sequence();
   const double cells = static_cast<double>(terrain.grid.cells());
@@ -104,8 +142,9 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
   };
   // Per repetition and process: seconds per step. Slot seq.size() is end_step (the
   // statistics, the tallies' reduction and the step's one read), the last one the full step.
-  const std::size_t n_stats = seq.size(), n_full = seq.size() + 1;
-  std::vector<std::vector<double>> per_step(seq.size() + 2);
+  const std::size_t n_stats = seq.size(), n_full = seq.size() + 1, n_fused = seq.size() + 2,
+                    n_unfused = seq.size() + 3;
+  std::vector<std::vector<double>> per_step(seq.size() + 4);
   const double dt = sim.next_dt();
   for (int rep = 0; rep < kRepetitions; ++rep) {
     probe.round();
@@ -127,25 +166,57 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
         throw Error(ExitCode::unstable, "bench: the benchmark state went unstable");
     }
     for (std::size_t k = 0; k <= n_stats; ++k) per_step[k].push_back(total[k] / steps);
-    // Full steps as the driver runs them (with the ledger's reductions).
-    const auto t0 = Clock::now();
-    sim.step(steps);
-    sim.backend().finish();
-    per_step[n_full].push_back(since(t0) / steps);
+    // Full steps as the driver runs them (with the ledger's reductions): with the config's
+    // numerics.fused_sweeps, then the fused and the unfused passes, alternating which first
+    auto full = [&](int fused) {
+      if (fused >= 0) sim.set_fused_sweeps(fused == 1);
+      const auto t0 = Clock::now();
+      sim.step(steps);
+      sim.backend().finish();
+      return since(t0) / steps;
+    };
+    per_step[n_full].push_back(full(-1));
+    const int first = rep % 2;
+    const double t_first = full(first), t_second = full(1 - first);
+    per_step[n_fused].push_back(first == 1 ? t_first : t_second);
+    per_step[n_unfused].push_back(first == 1 ? t_second : t_first);
+    sim.set_fused_sweeps(p.numerics.fused_sweeps);
   }
+  memory.run = run_label(backend, threads);
+  memory.peak_bytes = peak_known ? peak_resident_bytes() - resident0 : 0;
+  memory.device_bytes = static_cast<double>(sim.backend().device_bytes());
+  memory.cells = cells;
   std::vector<Row> rows;
   const std::string device = sim.backend().device();
-  int full_bytes = 0;
+  const Backend& b = sim.backend();
+  const int fused_bytes = full_step_bytes(step_passes(p, true), b, p),
+            unfused_bytes = full_step_bytes(step_passes(p, false), b, p);
   for (std::size_t k = 0; k < per_step.size(); ++k) {
     const std::string name = k < seq.size() ? process_name(seq[k])
                              : k == n_stats ? "stats"
-                                            : "full_step";
-    const int bytes = k == n_full ? full_bytes : bytes_per_cell(name, p);
-    full_bytes += bytes;
+                             : k == n_full  ? "full_step"
+                             : k == n_fused ? "full_fused"
+                                            : "full_unfused";
+    const int bytes = k == n_full      ? (p.numerics.fused_sweeps ? fused_bytes : unfused_bytes)
+                      : k == n_fused   ? fused_bytes
+                      : k == n_unfused ? unfused_bytes
+                                       : bytes_per_cell(name, p);
     const double sps = median(per_step[k]);
     rows.push_back({backend, device, name, threads, bytes, sps, cells / sps});
   }
   return rows;
+}
+
+/// Per run (its label, as the table's), the unfused full step's time over the fused one's.
+std::vector<std::pair<std::string, double>> fused_speedups(const std::vector<Row>& rows) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& f : rows) {
+    if (f.process != "full_fused") continue;
+    for (const auto& u : rows)
+      if (u.process == "full_unfused" && u.backend == f.backend && u.threads == f.threads)
+        out.emplace_back(run_label(f), u.seconds_per_step / f.seconds_per_step);
+  }
+  return out;
 }
 
 /// The bandwidth a row is measured against: one thread for one CPU thread, else all.
@@ -197,13 +268,15 @@ int bench(const BenchOptions& o) {
   }
   const Params params = bench_params(o);
   std::vector<Row> rows;
+  std::vector<Memory> memory;
   // Rounds of the bandwidth probe interleaved with the timed repetitions, and one at the end:
   // the kernels and the probe see the same machine.
   BandwidthProbe probe(static_cast<std::size_t>(o.stream_floats));
   for (const auto& [backend, threads] : runs) {
     Params p = params;
     p.numerics.threads = threads;
-    auto r = bench_one(terrain, p, backend, threads, o.steps, probe);
+    memory.emplace_back();
+    auto r = bench_one(terrain, p, backend, threads, o.steps, probe, memory.back());
     rows.insert(rows.end(), r.begin(), r.end());
   }
   probe.round();
@@ -243,6 +316,21 @@ int bench(const BenchOptions& o) {
           json_number(r.bytes ? r.gbs() / t : std::nan("")).c_str(),
           k + 1 < rows.size() ? "," : "");
     }
+    std::printf(" ],\n \"fused_speedup\": {");
+    const auto speedups = fused_speedups(rows);
+    for (std::size_t k = 0; k < speedups.size(); ++k)
+      std::printf("%s%s: %s", k ? ", " : "", json_string(speedups[k].first).c_str(),
+                  json_number(speedups[k].second).c_str());
+    std::printf("},\n \"memory\": [\n");
+    for (std::size_t k = 0; k < memory.size(); ++k) {
+      const auto& m = memory[k];
+      std::printf(
+          "  {\"run\": %s, \"peak_resident_rise_bytes\": %s, \"peak_resident_bytes_per_cell\": "
+          "%s, \"device_buffer_bytes\": %s, \"device_buffer_bytes_per_cell\": %s}%s\n",
+          json_string(m.run).c_str(), json_number(m.peak_bytes).c_str(),
+          json_number(m.peak_bytes / m.cells).c_str(), json_number(m.device_bytes).c_str(),
+          json_number(m.device_bytes / m.cells).c_str(), k + 1 < memory.size() ? "," : "");
+    }
     std::printf(" ]}\n");
     return 0;
   }
@@ -260,10 +348,7 @@ int bench(const BenchOptions& o) {
       bw.copy_all_high, bw.triad_all, bw.threads, bw.threads == 1 ? "" : "s", bw.copy_one,
       bw.triad_one);
   // Runs by a short label; their devices listed first.
-  auto label = [](const Row& r) {
-    return r.backend == "cpu" ? fmt::format("cpu/{}", r.threads ? std::to_string(r.threads) : "all")
-                              : r.backend;
-  };
+  auto label = [](const Row& r) { return run_label(r); };
   std::string last;
   for (const auto& r : rows)
     if (label(r) != last) {
@@ -283,6 +368,17 @@ int bench(const BenchOptions& o) {
                   r.process.c_str(), 1e3 * r.seconds_per_step, r.cell_steps_per_second, "-", "-",
                   "-", "-");
   }
+  for (const auto& [run, s] : fused_speedups(rows))
+    std::printf("%s: fused passes %.2fx the unfused full step (full_unfused / full_fused time)\n",
+                run.c_str(), s);
+  for (const auto& m : memory)
+    std::printf("%s: peak resident set +%.1f MiB from before the setup (%.1f B/cell)%s\n",
+                m.run.c_str(), m.peak_bytes / 1048576.0, m.peak_bytes / m.cells,
+                m.device_bytes > 0
+                    ? fmt::format(", device buffers {:.1f} MiB ({:.1f} B/cell)",
+                                  m.device_bytes / 1048576.0, m.device_bytes / m.cells)
+                          .c_str()
+                    : "");
   return 0;
 }
 

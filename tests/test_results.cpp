@@ -15,6 +15,7 @@
 
 #include "erodem/error.hpp"
 #include "erodem/io/results.hpp"
+#include "erodem/resident.hpp"
 #include "erodem/schema.hpp"
 #include "scenarios.hpp"
 #include "temp_dir.hpp"
@@ -255,24 +256,6 @@ TEST(Results, AFieldStoredOncePerValueGetsARowWhenItChanges) {
   std::printf(
       "[once per value] initial_bed edited after step 1: stored times 0, 1 restart with "
       "the original, 2 to 4 with the edit\n");
-}
-
-/// Sets this process's peak resident set (VmHWM) to its resident set now (Linux >= 4.0);
-/// false where it cannot.
-bool reset_peak_resident() {
-  std::ofstream clear("/proc/self/clear_refs");
-  clear << "5";
-  clear.flush();
-  return static_cast<bool>(clear);
-}
-
-/// The peak resident set of this process (VmHWM, bytes); 0 where /proc does not say.
-double peak_resident_bytes() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return 1024.0 * std::stod(line.substr(6));  // kB
-  return 0;
 }
 
 TEST(Results, StoringTheRestartStateHoldsOneFieldAtATime) {

@@ -531,6 +531,54 @@ std::vector<std::pair<Process, SweepInfo>> step_sweeps(const Params& params) {
   return out;
 }
 
+std::vector<std::vector<Process>> fused_passes(const Params& params) {
+  if (params.flow.scheme == FlowScheme::shallow_water) return {};
+  for (const Process p : {Process::flow, Process::sources, Process::water})
+    for (const auto& s : process_info(p).sweeps(params))
+      if (s.generic) return {};
+  return {{Process::flow, Process::sources, Process::water, Process::evaporation},
+          {Process::flow, Process::sources, Process::water}};
+}
+
+std::vector<std::vector<Process>> step_passes(const Params& params, bool fused) {
+  const std::vector<Process> seq = step_sequence(params);
+  const auto runs = fused ? fused_passes(params) : std::vector<std::vector<Process>>{};
+  std::vector<std::vector<Process>> passes;
+  for (std::size_t k = 0; k < seq.size();) {
+    std::size_t taken = 1;
+    for (const auto& run : runs)  // the longest run that starts here
+      if (run.size() > taken && k + run.size() <= seq.size() &&
+          std::equal(run.begin(), run.end(), seq.begin() + static_cast<std::ptrdiff_t>(k)))
+        taken = run.size();
+    passes.emplace_back(seq.begin() + static_cast<std::ptrdiff_t>(k),
+                        seq.begin() + static_cast<std::ptrdiff_t>(k + taken));
+    k += taken;
+  }
+  return passes;
+}
+
+SweepInfo pass_sweep(const std::vector<Process>& pass, const Params& params) {
+  SweepInfo out{"pass", Domain::cells, {}, {}};
+  for (const Process p : pass)
+    for (const auto& s : process_info(p).sweeps(params)) {
+      if (s.domain != Domain::cells) continue;
+      for (const auto& u : s.uses) {
+        auto it = std::find_if(out.uses.begin(), out.uses.end(),
+                               [&](const FieldUse& o) { return std::string(o.field) == u.field; });
+        if (it == out.uses.end()) {
+          out.uses.push_back(u);
+          continue;
+        }
+        // read first, written later: an update; written first: a write (later reads hit the
+        // cache); read twice: one read
+        const bool writes = u.access == Access::write || u.access == Access::update;
+        if (writes && (it->access == Access::read || it->access == Access::read_neighbours))
+          it->access = Access::update;
+      }
+    }
+  return out;
+}
+
 void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps) {
   std::set<std::string> provided(grid_inputs().begin(), grid_inputs().end());
   for (const auto& f : field_table())

@@ -403,6 +403,9 @@ const std::vector<Descriptor>& descriptor_table() {
       number(ERODEM_FIELD(numerics.wetness_time), D::time, above(0),
              "time constant of the wetness running mean (s)"),
       integer(ERODEM_FIELD(numerics.threads), closed(0, 65536), "CPU threads (0 = all cores)"),
+      boolean(ERODEM_FIELD(numerics.fused_sweeps),
+              "run flow, sources and water as one pass over memory where the backend can (the "
+              "same bits); false: each process its own sweep"),
   };
   return table;
 }

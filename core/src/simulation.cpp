@@ -413,6 +413,10 @@ std::vector<Process> Simulation::sequence() const {
   return step_sequence(params_);
 }
 
+std::vector<std::vector<Process>> Simulation::passes() const {
+  return step_passes(params_, params_.numerics.fused_sweeps);
+}
+
 double Simulation::next_dt() const {
   const auto& t = params_.time;
   double dt = t.dt;
@@ -568,8 +572,8 @@ void Simulation::step() {
     if (auto T = temperature_grid_.values_if_changed(time_ + 0.5 * dt))
       backend_->set_field(FieldId::air_temperature, *T);
   backend_->begin_step(in);
-  for (Process p : sequence())
-    if (p != Process::terrain_class || class_pass) backend_->run(p);
+  for (const auto& pass : passes())
+    if (pass.front() != Process::terrain_class || class_pass) backend_->run_pass(pass);
   class_fields_stale_ = false;
   StepResult result = backend_->end_step();  // the step's one wait
   const StepTally& tally = result.tally;

@@ -31,6 +31,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       H_(terrain.grid.ny + 2) {
   const PaddedState s = build_padded_state(terrain, params);
   periodic_ = s.periodic_x;
+  stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
@@ -91,6 +92,7 @@ void CpuBackend<Real>::begin_step(const StepInputs& in) {
   step_inputs_ = in;
   step_cell_params(cell_, in);
   step_tally_ = StepTally{};
+  pass_stats_ = false;
   face_water_.assign(face_codes_.size(), 0.0);
   face_sediment_.assign(face_codes_.size(), 0.0);
   in_step_ = true;
@@ -100,6 +102,7 @@ void CpuBackend<Real>::begin_step(const StepInputs& in) {
 template <class Real>
 void CpuBackend<Real>::run(Process p) {
   if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
+  pass_stats_ = false;  // the state changes after the fused pass's statistics
   const StepInputs& in = step_inputs_;
   StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
@@ -139,6 +142,28 @@ void CpuBackend<Real>::run(Process p) {
 }
 
 template <class Real>
+bool CpuBackend<Real>::fuses(const std::vector<Process>& pass) const {
+  // fused_passes() leaves out shallow water and generic sweeps; a periodic halo is exchanged
+  // between the three, so it runs them one by one
+  const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water},
+      water_only{Process::flow, Process::sources, Process::water, Process::evaporation};
+  return (pass == flow_water || pass == water_only) &&
+         params_.flow.scheme != FlowScheme::shallow_water && !periodic_;
+}
+
+template <class Real>
+void CpuBackend<Real>::run_pass(const std::vector<Process>& pass) {
+  if (!fuses(pass)) {
+    Backend::run_pass(pass);
+    return;
+  }
+  if (!in_step_) throw Error(ExitCode::internal, "backend: run_pass() outside a step (begin_step)");
+  pass_stats_ = false;
+  run_flow_water(static_cast<Real>(step_inputs_.dt), step_tally_,
+                 pass.back() == Process::evaporation);
+}
+
+template <class Real>
 void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
   if (!periodic_) return;
   for (const std::string& name : names) {
@@ -158,7 +183,9 @@ StepResult CpuBackend<Real>::end_step() {
   in_step_ = false;
   StepResult r;
   r.tally = step_tally_;
-  r.stats = stats();
+  // the statistics the fused pass took of each row as it left it, when it ran last
+  r.stats = pass_stats_ ? merge_row_stats(pass_stats_rows_) : stats();
+  pass_stats_ = false;
   // The probes straight from the fields (host memory): no copy of a whole field.
   r.probes.reserve(probe_fields_.size() * probe_cells_.size());
   for (const FieldId id : probe_fields_) {
@@ -219,49 +246,53 @@ std::vector<double> CpuBackend<Real>::sample(const std::vector<std::int64_t>& ce
 template <class Real>
 FieldStats CpuBackend<Real>::stats() {
   std::vector<RowStats> rows(static_cast<std::size_t>(H_ - 2));
-  const Kind* kind = kind_.data();
-  const Real *bed = bed_.data(), *bed_lo = bed_residual_.data(), *depth = depth_.data(),
-             *sediment = sediment_.data(), *vx = velocity_x_.data(), *vy = velocity_y_.data();
-  for_rows(1, H_ - 1, [&](int y) {
-    RowStats row;
-    const double a = area_[y];
-    const std::size_t base = static_cast<std::size_t>(y) * W_;
-    const std::int64_t row_cell = static_cast<std::int64_t>(y - 1) * nx_ - 1;
-    double water = 0, material = 0, sed = 0, max_d = -1, max_v2 = -1;
-    std::size_t fastest = 0;
-    for (int x = 1; x < W_ - 1; ++x) {
-      const std::size_t i = base + static_cast<std::size_t>(x);
-      if (kind[i] != ERODEM_CELL_ACTIVE) continue;
-      const Real d = depth[i], b = bed[i], s = sediment[i];
-      if (row.bad_cell < 0 && !cell::cell_state_ok(b, d, s)) row.bad_cell = row_cell + x;
-      water += static_cast<double>(d) * a;
-      material +=
-          (static_cast<double>(b) + static_cast<double>(bed_lo[i]) + static_cast<double>(s)) * a;
-      sed += static_cast<double>(s) * a;
-      if (d > max_d) {
-        max_d = d;
-        row.max_depth_cell = row_cell + x;
-      }
-      // The squared speed ranks the cells (products of floats are exact in double), as in
-      // stats.cl; the winner's speed is hypot below.
-      const double u = vx[i], v = vy[i];
-      const double v2 = u * u + v * v;
-      if (v2 > max_v2) {
-        max_v2 = v2;
-        row.max_speed_cell = row_cell + x;
-        fastest = i;
-      }
-    }
-    row.water = water;
-    row.material = material;
-    row.sediment = sed;
-    row.max_depth = max_d;
-    row.max_speed2 = max_v2;
-    if (row.max_speed_cell >= 0)
-      row.speed = std::hypot(static_cast<double>(vx[fastest]), static_cast<double>(vy[fastest]));
-    rows[static_cast<std::size_t>(y - 1)] = row;
-  });
+  for_rows(1, H_ - 1,
+           [&](int y) { rows[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_.data()); });
   return merge_row_stats(rows);
+}
+
+template <class Real>
+RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
+  RowStats row;
+  const Kind* kind = kind_.data();
+  const Real *bed = bed_.data(), *bed_lo = bed_residual_.data(), *sediment = sediment_.data(),
+             *vx = velocity_x_.data(), *vy = velocity_y_.data();
+  const double a = area_[y];
+  const std::size_t base = static_cast<std::size_t>(y) * W_;
+  const std::int64_t row_cell = static_cast<std::int64_t>(y - 1) * nx_ - 1;
+  double water = 0, material = 0, sed = 0, max_d = -1, max_v2 = -1;
+  std::size_t fastest = 0;
+  for (int x = 1; x < W_ - 1; ++x) {
+    const std::size_t i = base + static_cast<std::size_t>(x);
+    if (kind[i] != ERODEM_CELL_ACTIVE) continue;
+    const Real d = depth[i], b = bed[i], s = sediment[i];
+    if (row.bad_cell < 0 && !cell::cell_state_ok(b, d, s)) row.bad_cell = row_cell + x;
+    water += static_cast<double>(d) * a;
+    material +=
+        (static_cast<double>(b) + static_cast<double>(bed_lo[i]) + static_cast<double>(s)) * a;
+    sed += static_cast<double>(s) * a;
+    if (d > max_d) {
+      max_d = d;
+      row.max_depth_cell = row_cell + x;
+    }
+    // The squared speed ranks the cells (products of floats are exact in double), as in
+    // stats.cl; the winner's speed is hypot below.
+    const double u = vx[i], v = vy[i];
+    const double v2 = u * u + v * v;
+    if (v2 > max_v2) {
+      max_v2 = v2;
+      row.max_speed_cell = row_cell + x;
+      fastest = i;
+    }
+  }
+  row.water = water;
+  row.material = material;
+  row.sediment = sed;
+  row.max_depth = max_d;
+  row.max_speed2 = max_v2;
+  if (row.max_speed_cell >= 0)
+    row.speed = std::hypot(static_cast<double>(vx[fastest]), static_cast<double>(vy[fastest]));
+  return row;
 }
 
 template <class Real>

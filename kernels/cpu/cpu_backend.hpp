@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "erodem/process.hpp"
 #include "field_registry.hpp"
 #include "stagger.hpp"
+#include "stats_merge.hpp"
 
 /// Before a cell loop whose iterations write only their own cells: tells GCC that the
 /// output arrays do not overlap the inputs, so it vectorises without alias checks.
@@ -51,6 +53,10 @@ class CpuBackend final : public Backend {
   std::string device() const override;
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
+  /// Flow + sources + water (+ evaporation) as one pass (run_flow_water) where it can: local
+  /// inertial or pipes, no periodic halo; any other pass as run() of each process.
+  void run_pass(const std::vector<Process>& pass) override;
+  bool fuses(const std::vector<Process>& pass) const override;
   StepResult end_step() override;
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,
@@ -66,6 +72,15 @@ class CpuBackend final : public Backend {
   void run_sources(const StepInputs& in);
   void run_flow(Real dt);
   void run_water(Real dt, StepTally& tally);
+  /// The fused pass of flow, sources and water (kernels/cpu/flow.cpp): each thread walks its
+  /// block of rows once, the flow's outflows of a row, then the sources one row behind and
+  /// the water update two rows behind (the rows whose depths and outflows are then final);
+  /// the rows beside the next block's, which its flow still reads, after all blocks. The same
+  /// cell functions in the same order per cell as run_flow, run_sources and run_water: the
+  /// same bits, with the state read and written once instead of three times.
+  /// With `evaporation`, the evaporation of each row after its water update, and, where the
+  /// evaporation ends the step, the statistics of the row as it leaves it.
+  void run_flow_water(Real dt, StepTally& tally, bool evaporation);
   void run_erosion(Real dt, StepTally& tally);
   void run_erosion_physical(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
@@ -73,8 +88,19 @@ class CpuBackend final : public Backend {
   /// A generic sweep of the process table (process.hpp SweepInfo::generic), in
   /// kernels/cpu/sweeps.cpp: the cell function the list there names for it, by cell_sweep.
   void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
+  /// A generic sweep made ready to run row by row: row(y) runs its cell function over padded
+  /// row y (1 .. H - 2) and keeps the row's tally sums; book() adds them, in row order, to the
+  /// step's tallies once every row has run.
+  struct GenericRows {
+    std::function<void(int)> row;
+    std::function<void(StepTally&)> book;
+  };
+  /// The generic sweep `sweep` of `process` (its cell function from the list in sweeps.cpp),
+  /// ready to run; `depth`: the array its "water_depth" use reads and writes, where that is
+  /// not the depth field's (the fused pass: the water update's output before the swap).
+  GenericRows generic_rows(const SweepInfo& sweep, Process process, Real dt, Real* depth = nullptr);
   template <auto Cell>
-  void cell_sweep(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
+  GenericRows cell_rows(const SweepInfo& sweep, Process process, Real dt, Real* depth);
   /// The halo exchange (process.hpp halo_fields): with boundary.periodic_x, copies the named
   /// fields (of the field table, or the intermediates "depth_flow", "thermal_share") into the
   /// ghost columns that repeat the opposite DEM columns; nothing otherwise.
@@ -90,6 +116,23 @@ class CpuBackend final : public Backend {
   std::size_t padded(std::int64_t cell) const {
     return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1);
   }
+  /// Local inertial or pipes: the outflows of every padded row into flux_next_ from flux_,
+  /// each thread walking its block [y0, y1) of for_row_blocks top to bottom and calling
+  /// after_row(y, y0, y1) once row y's outflows are stored (kernels/cpu/flow.cpp).
+  template <class AfterRow>
+  void flow_blocks(Real dt, const AfterRow& after_row);
+  /// The rain on padded row y (1 .. H - 2), then the step's inflows at that row in the order
+  /// of the step's list (`point_rows_`: the inflows' rows and indices, sorted by row).
+  void sources_row(int y, Real dt, Real rate);
+  /// Adds inflow `p` of the step to its cell's depth and sediment.
+  void add_inflow(const PointSource& p);
+  /// The water update of padded row y (1 .. H - 2) from the outflows `out` (left, right, top,
+  /// bottom) into depth_next_ and the velocities, its tallies into row_sums_a_/b_/c_[y].
+  void water_row(int y, Real dt, const std::array<const Real*, 4>& out);
+  /// The statistics (stats()) of padded row y (1 .. H - 2) with the depths `depth`.
+  RowStats stats_row(int y, const Real* depth) const;
+  /// Adds the water update's row sums to the step's tallies.
+  void book_water_rows(Real dt, StepTally& tally);
   /// Calls f(y) for the padded rows [y0, y1) on the backend's threads.
   template <class F>
   void for_rows(int y0, int y1, const F& f) const {
@@ -180,6 +223,12 @@ class CpuBackend final : public Backend {
   FieldRegistry<Field> fields_;
   std::vector<double> row_sums_a_, row_sums_b_, row_sums_c_;  // scratch for per-row reductions
   std::vector<std::vector<double>> row_sums_;  // per tally of a generic sweep (sweeps.cpp)
+  std::vector<std::pair<int, std::size_t>> point_rows_;  // run_flow_water: (row, inflow index)
+  // The fused pass with evaporation, when it ends the step (stats_in_pass_), takes the
+  // statistics of each row it leaves (pass_stats_rows_, row y at y - 1); end_step uses them
+  // while pass_stats_ holds (nothing ran after it).
+  bool stats_in_pass_ = false, pass_stats_ = false;
+  std::vector<RowStats> pass_stats_rows_;
   // The step under way (begin_step .. end_step): its inputs and its tallies so far.
   StepInputs step_inputs_;
   StepTally step_tally_;

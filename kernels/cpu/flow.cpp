@@ -14,7 +14,14 @@
 // second order runs it twice a step (Heun), with the depth after the first stage in between.
 #include "common/flow.h"
 
+#include <algorithm>
+#include <array>
+#include <utility>
 #include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "common/shallow_water.h"
 #include "cpu/cpu_backend.hpp"
@@ -454,11 +461,8 @@ void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
 template <class Real>
 void CpuBackend<Real>::run_flow(Real dt) {
   const cell_params::FlowParams<Real> f = cell_.flow;
-  const Real g = f.gravity;
   const Kind* kind = kind_.data();
   const Real *b = bed_.data(), *d = depth_.data();
-  const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
-             *fb = flux_[3].data();
   Real *ol = flux_next_[0].data(), *orr = flux_next_[1].data(), *ot = flux_next_[2].data(),
        *ob = flux_next_[3].data();
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
@@ -502,28 +506,47 @@ void CpuBackend<Real>::run_flow(Real dt) {
     std::swap(flux_, flux_next_);
     return;
   }
+  flow_blocks(dt, [](int, int, int) {});
+  std::swap(flux_, flux_next_);
+}
+
+template <class Real>
+template <class AfterRow>
+void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
+  const cell_params::FlowParams<Real> f = cell_.flow;
+  const Real g = f.gravity;
+  const Kind* kind = kind_.data();
+  const Real *b = bed_.data(), *d = depth_.data();
+  const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
+             *fb = flux_[3].data();
+  Real *ol = flux_next_[0].data(), *orr = flux_next_[1].data(), *ot = flux_next_[2].data(),
+       *ob = flux_next_[3].data();
+  const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
+  const int W = W_, H = H_;
   if (params_.flow.scheme == FlowScheme::pipes) {
     const Real area_pipe = f.pipe_area;
     const Real length = f.pipe_length;
     // Rows 1 .. H - 2 without clamping (the loop vectorises), the first and last row clamped.
-    for_rows(0, H, [=](int y) {
+    for_row_blocks(H, [&](int y0, int y1) {
       // Locals, not closure members: stores to Real arrays could alias those.
       const Real step = dt, gravity = g, a_pipe = area_pipe, l_pipe = length;
-      if (y >= 1 && y <= H - 2) {
-        Real lx, lt, lb;
-        cell::pipe_lengths(y, y - 1, y + 1, dx, dy, l_pipe, &lx, &lt, &lb);
-        const Real cell_area = area[y];
-        ERODEM_IVDEP
-        for (int x = 0; x < W; ++x)
-          cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft, fb,
-                                         ol, orr, ot, ob, step, gravity, a_pipe);
-      } else {
-        for (int x = 0; x < W; ++x)
-          cell::flow_pipes_cell(x, y, W, H, kind, b, d, dx, dy, area, fl, fr, ft, fb, ol, orr, ot,
-                                ob, step, gravity, a_pipe, l_pipe);
+      for (int y = y0; y < y1; ++y) {
+        if (y >= 1 && y <= H - 2) {
+          Real lx, lt, lb;
+          cell::pipe_lengths(y, y - 1, y + 1, dx, dy, l_pipe, &lx, &lt, &lb);
+          const Real cell_area = area[y];
+          ERODEM_IVDEP
+          for (int x = 0; x < W; ++x)
+            cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
+                                           fb, ol, orr, ot, ob, step, gravity, a_pipe);
+        } else {
+          for (int x = 0; x < W; ++x)
+            cell::flow_pipes_cell(x, y, W, H, kind, b, d, dx, dy, area, fl, fr, ft, fb, ol, orr, ot,
+                                  ob, step, gravity, a_pipe, l_pipe);
+        }
+        after_row(y, y0, y1);
       }
     });
-    std::swap(flux_, flux_next_);
     return;
   }
   const InertialParams<Real> p{dt, g, f.theta, f.dry_depth, periodic_};
@@ -574,13 +597,90 @@ void CpuBackend<Real>::run_flow(Real dt) {
       const Real* bottom = y <= H - 2 ? face_row(y) : zeros.data();
       split_row(y, W, kind_row(y), kind_row(y - 1), kind_row(y + 1), d, area, face_x.data(), top,
                 bottom, dt, ol, orr, ot, ob);
+      after_row(y, y0, y1);
     }
   });
+}
+
+template <class Real>
+void CpuBackend<Real>::run_flow_water(Real dt, StepTally& tally, bool evaporation) {
+  // The inflows by row, in list order within a row: each cell receives its rain and then its
+  // inflows in the order run_sources adds them.
+  const StepInputs& in = step_inputs_;
+  point_rows_.clear();
+  for (std::size_t k = 0; k < in.points.size(); ++k)
+    point_rows_.emplace_back(static_cast<int>(padded(in.points[k].cell) / W_), k);
+  std::stable_sort(point_rows_.begin(), point_rows_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  const Real rate = static_cast<Real>(in.rain_rate);
+  const std::array<const Real*, 4> out{flux_next_[0].data(), flux_next_[1].data(),
+                                       flux_next_[2].data(), flux_next_[3].data()};
+  const int H = H_;
+  // evaporation on the water update's output (depth_next_ until the swap), row by row
+  GenericRows evaporate;
+  if (evaporation) {
+    const auto sweeps = process_info(Process::evaporation).sweeps(params_);
+    evaporate = generic_rows(sweeps.at(0), Process::evaporation, dt, depth_next_.data());
+  }
+  const bool stats = evaporation && stats_in_pass_;
+  if (stats) pass_stats_rows_.resize(static_cast<std::size_t>(H - 2));
+  const Real* depth_new = depth_next_.data();
+  const auto water_evaporation_stats = [&](int y) {
+    water_row(y, dt, out);
+    if (!evaporation) return;
+    evaporate.row(y);
+    if (stats) pass_stats_rows_[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_new);
+  };
+  // A block's flow reads the depths of the row above it and the row below it (the faces
+  // between blocks): the sources of a block's first and last rows wait until every block's
+  // flow is done, and so does the water update of the rows beside those. Within a block,
+  // row y - 1 gets its sources once row y's outflows are stored (the flow reads a row's depth
+  // last for the row below it), and row y - 2 its water update (it reads the depths and
+  // outflows of the rows beside it).
+  const auto sources_now = [](int s, int y0, int y1) { return s > y0 && s < y1 - 1; };
+  const auto water_now = [](int w, int y0, int y1) { return w > y0 + 1 && w < y1 - 2; };
+  const auto real_row = [H](int y) { return y >= 1 && y <= H - 2; };
+  std::vector<std::pair<int, int>> blocks(static_cast<std::size_t>(threads_) + 1, {0, 0});
+  flow_blocks(dt, [&](int y, int y0, int y1) {
+    if (y == y0) {
+#ifdef _OPENMP
+      blocks[static_cast<std::size_t>(omp_get_thread_num())] = {y0, y1};
+#else
+      blocks[0] = {y0, y1};
+#endif
+    }
+    if (real_row(y - 1) && sources_now(y - 1, y0, y1)) sources_row(y - 1, dt, rate);
+    if (real_row(y - 2) && water_now(y - 2, y0, y1)) water_evaporation_stats(y - 2);
+  });
+  // the rows left: the sources of each block's first and last rows, then the water update of
+  // the rows their depths reach
+  std::vector<int> source_rows, water_rows;
+  for (const auto& [y0, y1] : blocks)
+    for (int y = y0; y < y1; ++y) {
+      if (real_row(y) && !sources_now(y, y0, y1)) source_rows.push_back(y);
+      if (real_row(y) && !water_now(y, y0, y1)) water_rows.push_back(y);
+    }
+  const int ns = static_cast<int>(source_rows.size()), nw = static_cast<int>(water_rows.size());
+#pragma omp parallel num_threads(threads_)
+  {
+#pragma omp for schedule(static)
+    for (int k = 0; k < ns; ++k) sources_row(source_rows[static_cast<std::size_t>(k)], dt, rate);
+#pragma omp for schedule(static)
+    for (int k = 0; k < nw; ++k) water_evaporation_stats(water_rows[static_cast<std::size_t>(k)]);
+  }
   std::swap(flux_, flux_next_);
+  measure_water_faces();  // the outflows the water update applied, as run(water) measures them
+  book_water_rows(dt, tally);
+  if (evaporation) evaporate.book(tally);
+  // depth_next_ keeps the depth the water update started from (run_water)
+  std::swap(depth_, depth_next_);
+  pass_stats_ = stats;
 }
 
 template void CpuBackend<float>::run_flow(float);
 template void CpuBackend<double>::run_flow(double);
+template void CpuBackend<float>::run_flow_water(float, StepTally&, bool);
+template void CpuBackend<double>::run_flow_water(double, StepTally&, bool);
 
 }  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

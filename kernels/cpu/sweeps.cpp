@@ -66,8 +66,9 @@ inline void cell_row(int y, int W, const std::array<void*, N>& f, const real* ar
 
 template <class Real>
 template <auto Cell>
-void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real dt,
-                                  StepTally& tally) {
+typename CpuBackend<Real>::GenericRows CpuBackend<Real>::cell_rows(const SweepInfo& sweep,
+                                                                   Process process, Real dt,
+                                                                   Real* depth) {
   using Sig = CellSignature<decltype(Cell)>;
   using Args = typename Sig::Args;
   constexpr std::size_t ip = Sig::params_index();
@@ -93,6 +94,10 @@ void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real 
                                  : static_cast<void*>(dy_.data());
       continue;
     }
+    if (depth && name == "water_depth") {
+      fields[k] = static_cast<void*>(depth);
+      continue;
+    }
     Field* f = name == "rain_factor" ? &rain_factor_ : field_storage(field_info(name).id);
     if (!f)
       throw Error(ExitCode::internal,
@@ -114,50 +119,66 @@ void CpuBackend<Real>::cell_sweep(const SweepInfo& sweep, Process process, Real 
   if (row_sums_.size() < nt) row_sums_.resize(nt);
   for (std::size_t t = 0; t < nt; ++t) row_sums_[t].assign(H_, 0.0);
 
-  const Real* area = area_.data();
-  const int W = W_;
-  for_rows(1, H_ - 1, [&](int y) {
+  GenericRows rows;
+  rows.row = [this, fields, params, dt](int y) {
+    const int W = W_;
     std::array<std::unique_ptr<Real[]>, nt> scratch;
     std::array<Real*, nt> t{};
     for (std::size_t k = 0; k < nt; ++k) {
       scratch[k] = row_scratch(W);
       t[k] = scratch[k].get();
     }
-    cell_row<Cell, Args>(y, W, fields, area, dt, params, t, std::make_index_sequence<nf>{},
+    cell_row<Cell, Args>(y, W, fields, area_.data(), dt, params, t, std::make_index_sequence<nf>{},
                          std::make_index_sequence<nt>{});
     for (std::size_t k = 0; k < nt; ++k)
       row_sums_[k][y] = sum_row(t[k], static_cast<std::size_t>(W));
-  });
-  for (std::size_t k = 0; k < nt; ++k) tally.*members[k] += sum_rows(row_sums_[k]);
+  };
+  rows.book = [this, members](StepTally& tally) {
+    for (std::size_t k = 0; k < nt; ++k) tally.*members[k] += sum_rows(row_sums_[k]);
+  };
+  return rows;
 }
 
 template <class Real>
-void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real dt,
-                                   StepTally& tally) {
-  using Run = void (CpuBackend::*)(const SweepInfo&, Process, Real, StepTally&);
+typename CpuBackend<Real>::GenericRows CpuBackend<Real>::generic_rows(const SweepInfo& sweep,
+                                                                      Process process, Real dt,
+                                                                      Real* depth) {
+  using Make = GenericRows (CpuBackend::*)(const SweepInfo&, Process, Real, Real*);
   // Each generic sweep of the process table by its name, with its cell function.
-  static const std::pair<const char*, Run> sweeps[] = {
-      {"evaporation", &CpuBackend::cell_sweep<&cell::evaporation_sweep_cell<Real>>},
-      {"snow", &CpuBackend::cell_sweep<&cell::snow_sweep_cell<Real>>},
-      {"snow_gridded", &CpuBackend::cell_sweep<&cell::snow_gridded_sweep_cell<Real>>},
-      {"snow_slide_share", &CpuBackend::cell_sweep<&cell::snow_slide_share_sweep_cell<Real>>},
-      {"snow_slide", &CpuBackend::cell_sweep<&cell::snow_slide_sweep_cell<Real>>},
-      {"infiltration", &CpuBackend::cell_sweep<&cell::infiltration_sweep_cell<Real>>},
-      {"boundary_level", &CpuBackend::cell_sweep<&cell::boundary_level_sweep_cell<Real>>},
-      {"terrain_class", &CpuBackend::cell_sweep<&cell::terrain_class_sweep_cell<Real>>},
+  static const std::pair<const char*, Make> sweeps[] = {
+      {"evaporation", &CpuBackend::cell_rows<&cell::evaporation_sweep_cell<Real>>},
+      {"snow", &CpuBackend::cell_rows<&cell::snow_sweep_cell<Real>>},
+      {"snow_gridded", &CpuBackend::cell_rows<&cell::snow_gridded_sweep_cell<Real>>},
+      {"snow_slide_share", &CpuBackend::cell_rows<&cell::snow_slide_share_sweep_cell<Real>>},
+      {"snow_slide", &CpuBackend::cell_rows<&cell::snow_slide_sweep_cell<Real>>},
+      {"infiltration", &CpuBackend::cell_rows<&cell::infiltration_sweep_cell<Real>>},
+      {"boundary_level", &CpuBackend::cell_rows<&cell::boundary_level_sweep_cell<Real>>},
+      {"terrain_class", &CpuBackend::cell_rows<&cell::terrain_class_sweep_cell<Real>>},
       {"shallow_water_velocity",
-       &CpuBackend::cell_sweep<&cell::shallow_water_velocity_sweep_cell<Real>>},
+       &CpuBackend::cell_rows<&cell::shallow_water_velocity_sweep_cell<Real>>},
   };
-  for (const auto& [name, run] : sweeps)
-    if (std::string(name) == sweep.name) return (this->*run)(sweep, process, dt, tally);
+  for (const auto& [name, make] : sweeps)
+    if (std::string(name) == sweep.name) return (this->*make)(sweep, process, dt, depth);
   throw Error(ExitCode::internal,
               fmt::format("sweep '{}' is generic but kernels/cpu/sweeps.cpp does not list its "
                           "cell function",
                           sweep.name));
 }
 
+template <class Real>
+void CpuBackend<Real>::run_generic(const SweepInfo& sweep, Process process, Real dt,
+                                   StepTally& tally) {
+  const GenericRows rows = generic_rows(sweep, process, dt);
+  for_rows(1, H_ - 1, [&](int y) { rows.row(y); });
+  rows.book(tally);
+}
+
 template void CpuBackend<float>::run_generic(const SweepInfo&, Process, float, StepTally&);
 template void CpuBackend<double>::run_generic(const SweepInfo&, Process, double, StepTally&);
+template CpuBackend<float>::GenericRows CpuBackend<float>::generic_rows(const SweepInfo&, Process,
+                                                                        float, float*);
+template CpuBackend<double>::GenericRows CpuBackend<double>::generic_rows(const SweepInfo&, Process,
+                                                                          double, double*);
 
 }  // namespace ERODEM_CPU_NAMESPACE
 }  // namespace erodem

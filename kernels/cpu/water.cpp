@@ -9,39 +9,52 @@ namespace erodem {
 namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
-void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
+void CpuBackend<Real>::water_row(int y, Real dt, const std::array<const Real*, 4>& out) {
   const Kind* kind = kind_.data();
-  const Real *bed = bed_.data(), *depth = depth_.data(), *fl = flux_[0].data(),
-             *fr = flux_[1].data(), *ft = flux_[2].data(), *fb = flux_[3].data();
+  const Real *bed = bed_.data(), *depth = depth_.data(), *fl = out[0], *fr = out[1], *ft = out[2],
+             *fb = out[3];
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   Real *depth_out = depth_next_.data(), *u = velocity_x_.data(), *v = velocity_y_.data();
-  const cell_params::WaterParams<Real> params = cell_.water;
+  // Locals, not members: stores to Real arrays could alias those.
+  const Real step = dt;
+  const cell_params::WaterParams<Real> p = cell_.water;
   const int W = W_;
-  for_rows(1, H_ - 1, [=](int y) {
-    // Locals, not closure members: stores to Real arrays could alias those.
-    const Real step = dt;
-    const cell_params::WaterParams<Real> p = params;
-    const auto exchange = row_scratch(W), clipped = row_scratch(W), given = row_scratch(W);
-    Real* ex = exchange.get();
-    Real* cl = clipped.get();
-    Real* gv = given.get();
-    ERODEM_IVDEP
-    for (int x = 1; x < W - 1; ++x)
-      cell::water_update_cell(x, y, W, kind, bed, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u,
-                              v, step, p, ex + x, cl + x, gv + x);
-    row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
-    row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
-    row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));
-  });
+  const auto exchange = row_scratch(W), clipped = row_scratch(W), given = row_scratch(W);
+  Real* ex = exchange.get();
+  Real* cl = clipped.get();
+  Real* gv = given.get();
+  ERODEM_IVDEP
+  for (int x = 1; x < W - 1; ++x)
+    cell::water_update_cell(x, y, W, kind, bed, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u,
+                            v, step, p, ex + x, cl + x, gv + x);
+  row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
+  row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
+  row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));
+}
+
+template <class Real>
+void CpuBackend<Real>::book_water_rows(Real dt, StepTally& tally) {
   tally.boundary_out += static_cast<double>(dt) * sum_rows(row_sums_a_);
   tally.clipped += sum_rows(row_sums_b_);
   tally.water_exchanged += sum_rows(row_sums_c_);
+}
+
+template <class Real>
+void CpuBackend<Real>::run_water(Real dt, StepTally& tally) {
+  const std::array<const Real*, 4> out{flux_[0].data(), flux_[1].data(), flux_[2].data(),
+                                       flux_[3].data()};
+  for_rows(1, H_ - 1, [&](int y) { water_row(y, dt, out); });
+  book_water_rows(dt, tally);
   // depth_next_ keeps the depth the water update started from (after this step's sources):
   // conservative transport needs it.
   std::swap(depth_, depth_next_);
 }
 
 template void CpuBackend<float>::run_water(float, StepTally&);
+template void CpuBackend<float>::water_row(int, float, const std::array<const float*, 4>&);
+template void CpuBackend<double>::water_row(int, double, const std::array<const double*, 4>&);
+template void CpuBackend<float>::book_water_rows(float, StepTally&);
+template void CpuBackend<double>::book_water_rows(double, StepTally&);
 template void CpuBackend<double>::run_water(double, StepTally&);
 
 }  // namespace ERODEM_CPU_NAMESPACE

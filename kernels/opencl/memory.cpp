@@ -42,6 +42,7 @@ Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
           check(clEnqueueWriteBuffer(queue_.get(), b.get(), CL_TRUE, 0, bytes, data, 0, nullptr,
                                      nullptr),
                 "clEnqueueWriteBuffer");
+        device_bytes_ += bytes + kStaggerPeriod;
         return b;
       }
     }
@@ -49,6 +50,7 @@ Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
   const cl_mem_flags flags = CL_MEM_READ_WRITE | (data ? CL_MEM_COPY_HOST_PTR : 0);
   Buffer b(clCreateBuffer(rt_->context.get(), flags, bytes, const_cast<void*>(data), &err));
   check(err, "clCreateBuffer");
+  device_bytes_ += bytes;
   return b;
 }
 

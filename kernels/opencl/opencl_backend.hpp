@@ -133,6 +133,7 @@ class OpenClBackend final : public Backend {
 
   std::string name() const override { return "opencl"; }
   std::string device() const override;
+  std::size_t device_bytes() const override { return device_bytes_; }
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
   StepResult end_step() override;
@@ -241,6 +242,7 @@ class OpenClBackend final : public Backend {
   std::size_t edge_count_ = 0, edge_local_ = 1, edge_groups_ = 1;
   std::size_t tally_stride_ = 1;   // partials per tally slot: >= every tally kernel's groups
   std::size_t stagger_next_ = 0;   // make_buffer: the next field buffer's slot
+  std::size_t device_bytes_ = 0;   // make_buffer: the bytes of every buffer created
   std::vector<double> area_host_;  // per padded row, as the device holds it (rounded to Real)
   Buffer kind_, dx_, dy_, area_;
   // the bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is read and

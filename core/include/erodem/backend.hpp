@@ -128,6 +128,17 @@ class Backend {
   /// stay with the backend (on OpenCL on the device) until end_step(). Outside a step:
   /// Error(ExitCode::internal).
   virtual void run(Process p) = 0;
+  /// Runs a pass of step_passes() (process.hpp): consecutive processes of the sequence that
+  /// the backend may run as one pass over memory. The same bits as run() of each in turn,
+  /// which is what this default does; the CPU reference fuses flow + sources + water.
+  virtual void run_pass(const std::vector<Process>& pass) {
+    for (const Process p : pass) run(p);
+  }
+  /// Whether run_pass(pass) runs it as one pass (else one process after the other).
+  virtual bool fuses(const std::vector<Process>& /*pass*/) const { return false; }
+  /// The bytes of the device buffers the backend has created so far (OpenCL; 0 where the
+  /// state lives in host memory): an upper bound of what it holds on the device at once.
+  virtual std::size_t device_bytes() const { return 0; }
   /// Ends the step: its tallies, the statistics of the state it ends in and the probe
   /// samples, with one wait for the device (OpenCL: one batch of reads). Outside a step:
   /// Error(ExitCode::internal).

@@ -321,6 +321,9 @@ struct Params {
     double velocity_min_depth = 1e-3;  ///< d_min (m): velocity is 0 below this mean depth
     double wetness_time = 3600.0;      ///< s: time constant of the wetness running mean
     int threads = 0;                   ///< CPU threads; 0 = all cores
+    /// Run the passes process.hpp step_passes() fuses as one pass where the backend can (the
+    /// same bits); false: every process its own sweep, the reference the bench compares.
+    bool fused_sweeps = true;
   } numerics;
 };
 

@@ -124,6 +124,25 @@ std::vector<Process> step_sequence(const Params& params);
 /// The sweeps of those processes, in order, each with its process.
 std::vector<std::pair<Process, SweepInfo>> step_sweeps(const Params& params);
 
+/// The passes of a step with `params`: step_sequence() cut into runs of processes that a
+/// backend may run as one pass over memory (Backend::run_pass), each run in step order. With
+/// `fused` false every process is a pass of its own (the readable reference path); with it,
+/// the longest run of fused_passes() that the sequence holds in full at each place is one
+/// pass. Whether a backend fuses a pass is its own choice (the CPU reference does for both
+/// runs, outside a periodic halo); fused or not, the results are the same bits
+/// (tests/test_fused.cpp).
+std::vector<std::vector<Process>> step_passes(const Params& params, bool fused);
+/// The runs of processes the table lets a backend fuse with these parameters, longest first:
+/// flow, sources and water (the water update reads the outflows of the rows around it as the
+/// flow leaves them), and evaporation after them where it follows the water update in the
+/// sequence (erosion, transport and thermal collapse off: the water-only step); with local
+/// inertial or pipes flow and none of the first three running a generic sweep.
+std::vector<std::vector<Process>> fused_passes(const Params& params);
+/// A pass as one sweep for the byte model: the union of its processes' cells sweeps' uses,
+/// each field counted once, as read where its first use reads it and as written where any use
+/// writes it (a field one sweep of the pass writes and a later one reads stays in cache).
+SweepInfo pass_sweep(const std::vector<Process>& pass, const Params& params);
+
 /// Checks that every field a sweep of the sequence reads is provided before it: a grid input,
 /// a state field (fields with `state` in field_table()), or a field an earlier sweep of the
 /// step writes or leaves. Throws Error(ExitCode::internal) naming the sweep and the field.

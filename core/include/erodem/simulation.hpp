@@ -145,6 +145,11 @@ class Simulation {
   std::vector<double> field(FieldId id) const { return backend_->field(id); }
   /// The processes a step runs with these parameters, in order.
   std::vector<Process> sequence() const;
+  /// The passes a step runs them in (process.hpp step_passes, with numerics.fused_sweeps).
+  std::vector<std::vector<Process>> passes() const;
+  /// Switches numerics.fused_sweeps for the next steps (erodem bench times both ways in one
+  /// run); the results do not change.
+  void set_fused_sweeps(bool on) { params_.numerics.fused_sweeps = on; }
   /// Fraction of the configured run done, in [0, 1].
   double progress() const;
   /// Inputs of the next step (rain rate, inflow volumes) for a step of `dt` seconds.

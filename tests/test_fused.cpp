@@ -1,0 +1,224 @@
+// erodem — fused sweeps (process.hpp step_passes, Backend::run_pass): the CPU reference's
+// pass of flow + sources + water (CpuBackend::run_flow_water) gives the bits of the three
+// processes run one after the other, for local inertial and pipes, float32 and float64, with
+// rain, a line inflow, a cross-section, erosion, transport and thermal collapse around it,
+// and thread counts that cut the grid into blocks of every size the pass treats differently
+// (blocks of 2 to 3 rows, where every row waits for the other blocks, up to one block).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "erodem/backends.hpp"
+#include "erodem/process.hpp"
+#include "erodem/simulation.hpp"
+#include "scenarios.hpp"
+
+namespace erodem::test {
+namespace {
+
+constexpr int kNx = 37, kNy = 29;  // odd sizes: blocks of unequal rows
+constexpr double kCell = 5.0;
+
+/// A tilted, wavy valley with a pond: wet and dry cells, flow in every direction.
+Terrain valley() {
+  Terrain t = flat_terrain(kNx, kNy, kCell);
+  t.water_depth.assign(t.grid.cells(), 0.0);
+  for (int r = 0; r < kNy; ++r)
+    for (int c = 0; c < kNx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * kNx + c;
+      const double across = (c - 0.5 * kNx) / kNx;
+      t.bed[i] =
+          2.0 + 0.05 * r + 3.0 * across * across + 0.2 * std::sin(0.7 * c) * std::cos(0.5 * r);
+      const double pond = 2.4 - t.bed[i];
+      if (r > 8 && r < 16 && pond > 0) t.water_depth[i] = pond;
+    }
+  return t;
+}
+
+/// The valley's run: rain, an inflow along three cells, a section across the valley, open
+/// edges, erosion + conservative transport + thermal collapse + evaporation.
+Params valley_params(FlowScheme flow, Precision precision, int threads, bool fused, bool erosion) {
+  Params p;
+  p.flow.scheme = flow;
+  p.flow.manning_n.value = 0.03;
+  p.time.adaptive = false;
+  p.time.dt = flow == FlowScheme::pipes ? 0.05 : 0.2;
+  p.time.duration = 40 * p.time.dt;
+  p.rain.rate = 1e-4;  // m/s
+  InflowSpec in;
+  const double y = (kNy - 5 - 0.5) * kCell;  // row 5
+  in.vertices = {{10.5 * kCell, y}, {12.5 * kCell, y}};
+  in.hydrograph = {{0.0, 0.5}};
+  in.sediment_concentration = 0.01;
+  p.inflow = {in};
+  p.section.push_back(SectionSpec{"across", {{0.0, 14.0 * kCell}, {kNx * kCell, 14.0 * kCell}}});
+  p.erosion.enabled = erosion;
+  p.erosion.law = ErosionLaw::mei;
+  p.thermal.enabled = erosion;
+  p.thermal.talus_angle = 20.0;
+  p.evaporation.rate = 1e-7;
+  p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
+  p.numerics.precision = precision;
+  p.numerics.threads = threads;
+  p.numerics.fused_sweeps = fused;
+  return p;
+}
+
+struct FusedCase {
+  FlowScheme flow;
+  Precision precision;
+  int threads;
+  /// erosion, transport and thermal collapse on: the pass is flow + sources + water; off (the
+  /// water-only step): evaporation joins it and it takes the step's statistics
+  bool erosion = true;
+};
+
+std::string case_name(const testing::TestParamInfo<FusedCase>& info) {
+  const FusedCase& c = info.param;
+  return std::string(c.flow == FlowScheme::pipes ? "pipes" : "local_inertial") +
+         (c.precision == Precision::float64 ? "_float64" : "_float32") + "_threads" +
+         std::to_string(c.threads) + (c.erosion ? "" : "_water_only");
+}
+
+void PrintTo(const FusedCase& c, std::ostream* os) {
+  *os << case_name({c, 0});
+}
+
+class Fused : public testing::TestWithParam<FusedCase> {};
+
+/// The number of values of `a` and `b` whose bits differ.
+std::size_t differing(const std::vector<double>& a, const std::vector<double>& b) {
+  std::size_t n = a.size() == b.size() ? 0 : 1 + a.size() + b.size();
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+    n += std::memcmp(&a[i], &b[i], sizeof(double)) != 0;
+  return n;
+}
+
+TEST_P(Fused, FlowSourcesWaterInOnePassGiveTheSameBits) {
+  const FusedCase c = GetParam();
+  const Target target{"cpu", c.precision};
+  auto fused = make_simulation(
+      valley(), valley_params(c.flow, c.precision, c.threads, true, c.erosion), target);
+  auto apart = make_simulation(
+      valley(), valley_params(c.flow, c.precision, c.threads, false, c.erosion), target);
+  // the fused pass is the one that runs (not the fallback through run())
+  const auto passes = fused.passes();
+  int fused_passes = 0;
+  std::size_t fused_length = 0;
+  for (const auto& pass : passes)
+    if (fused.backend().fuses(pass)) ++fused_passes, fused_length = pass.size();
+  ASSERT_EQ(fused_passes, 1);
+  EXPECT_EQ(fused_length, c.erosion ? 3u : 4u);
+  ASSERT_EQ(apart.passes().size(), apart.sequence().size());
+  fused.run();
+  apart.run();
+  ASSERT_EQ(fused.steps_done(), 40);
+  ASSERT_EQ(apart.steps_done(), 40);
+
+  // Bound: 0 values differ. The fused pass calls the same cell functions on the same inputs;
+  // any row run out of order (its sources before a neighbour block's flow read its depth, its
+  // water update before its neighbours' sources) changes depths there by a step's rain at
+  // least, and the test fails. The state must also have moved (a pass that did nothing would
+  // leave both runs alike only if neither did anything).
+  std::size_t total = 0;
+  for (const auto& f : field_table()) {
+    const auto a = fused.field(f.id), b = apart.field(f.id);
+    const std::size_t n = differing(a, b);
+    total += n;
+    EXPECT_EQ(n, 0u) << "field " << f.name;
+  }
+  const auto depth = fused.field(FieldId::water_depth);
+  const auto start = valley().water_depth;
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < depth.size(); ++i) moved += depth[i] != start[i];
+  EXPECT_GT(moved, depth.size() / 2) << "the run left the depths as they were";
+  std::size_t ledger = 0;
+  for (const auto& e : ledger_entries()) {
+    const double a = fused.ledger().*e.member, b = apart.ledger().*e.member;
+    ledger += std::memcmp(&a, &b, sizeof(double)) != 0;
+    EXPECT_EQ(std::memcmp(&a, &b, sizeof(double)), 0)
+        << "ledger " << e.name << ": " << a << " " << b;
+  }
+  // the statistics of the last step (the fused water-only pass takes them row by row)
+  const FieldStats sa = fused.last_stats(), sb = apart.last_stats();
+  EXPECT_EQ(std::memcmp(&sa.water_volume, &sb.water_volume, sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(&sa.max_depth, &sb.max_depth, sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(&sa.max_speed, &sb.max_speed, sizeof(double)), 0);
+  EXPECT_EQ(sa.max_depth_cell, sb.max_depth_cell);
+  EXPECT_EQ(sa.max_speed_cell, sb.max_speed_cell);
+  EXPECT_EQ(sa.bad_cell, sb.bad_cell);
+  ASSERT_EQ(fused.sections().size(), 1u);
+  const double qa = fused.sections()[0].volume, qb = apart.sections()[0].volume;
+  EXPECT_EQ(std::memcmp(&qa, &qb, sizeof(double)), 0) << qa << " " << qb;
+  EXPECT_NE(qa, 0.0);
+  std::printf(
+      "[fused] %s: %zu of %zu field values differ, %zu ledger entries differ (bound 0); %zu of "
+      "%zu depths moved; section volume %.9g m^3\n",
+      case_name({c, 0}).c_str(), total, field_table().size() * depth.size(), ledger, moved,
+      depth.size(), qa);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cpu, Fused,
+    testing::Values(FusedCase{FlowScheme::local_inertial, Precision::float32, 1},
+                    FusedCase{FlowScheme::local_inertial, Precision::float32, 2},
+                    FusedCase{FlowScheme::local_inertial, Precision::float32, 5},
+                    FusedCase{FlowScheme::local_inertial, Precision::float32, 13},
+                    FusedCase{FlowScheme::local_inertial, Precision::float64, 3},
+                    FusedCase{FlowScheme::pipes, Precision::float32, 2},
+                    FusedCase{FlowScheme::pipes, Precision::float32, 13},
+                    FusedCase{FlowScheme::pipes, Precision::float64, 5},
+                    FusedCase{FlowScheme::local_inertial, Precision::float32, 2, false},
+                    FusedCase{FlowScheme::local_inertial, Precision::float32, 5, false},
+                    FusedCase{FlowScheme::local_inertial, Precision::float64, 13, false},
+                    FusedCase{FlowScheme::pipes, Precision::float32, 3, false}),
+    case_name);
+
+TEST(FusedPasses, TheTableCutsTheSequenceIntoPasses) {
+  Params p;
+  p.erosion.enabled = true;
+  p.thermal.enabled = true;
+  p.rain.rate = 1e-5;
+  const auto seq = step_sequence(p);
+  const auto fused = step_passes(p, true), apart = step_passes(p, false);
+  EXPECT_EQ(apart.size(), seq.size());
+  ASSERT_EQ(fused.size(), seq.size() - 2);  // flow, sources and water in one
+  std::vector<Process> flat;
+  for (const auto& pass : fused) flat.insert(flat.end(), pass.begin(), pass.end());
+  EXPECT_EQ(flat, seq);  // the same processes in the same order
+  const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water};
+  EXPECT_NE(std::find(fused.begin(), fused.end(), flow_water), fused.end());
+  // without erosion and thermal collapse the evaporation follows the water update and joins
+  // the pass
+  Params water_only = p;
+  water_only.erosion.enabled = water_only.thermal.enabled = false;
+  const auto w = step_passes(water_only, true);
+  EXPECT_EQ(w.size(), step_sequence(water_only).size() - 3);
+  EXPECT_NE(std::find(w.begin(), w.end(),
+                      std::vector<Process>{Process::flow, Process::sources, Process::water,
+                                           Process::evaporation}),
+            w.end());
+  // the byte model: the pass reads the state once and writes it once: the kind (1 B), bed,
+  // depth, Manning n, the 4 outflows and the rain factor (8 x 4 B) read, the depth, the 4
+  // outflows and 2 velocities (7 x 4 B) written, 61 B, against 45 + 13 + 37 = 95 B for the
+  // three sweeps
+  int apart_bytes = 0;
+  for (const Process q : flow_water) apart_bytes += process_bytes(q, p, 4).total();
+  const SweepBytes b = sweep_bytes(pass_sweep(flow_water, p), 4);
+  std::printf("[fused] bytes per cell: flow + sources + water %d apart, %d fused (%s / %s)\n",
+              apart_bytes, b.total(), b.reads.c_str(), b.writes.c_str());
+  EXPECT_EQ(apart_bytes, 95);
+  EXPECT_EQ(b.total(), 61);
+  // shallow water is not fused
+  p.flow.scheme = FlowScheme::shallow_water;
+  EXPECT_EQ(step_passes(p, true).size(), step_sequence(p).size());
+}
+
+}  // namespace
+}  // namespace erodem::test
