@@ -2,6 +2,7 @@
 // uninterrupted run bit for bit (same backend and precision), and bad restarts are clear
 // errors.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdint>
@@ -180,7 +181,10 @@ class Restart : public ::testing::TestWithParam<Case> {
     std::string name = std::string(info->name());
     for (char& ch : name)
       if (ch == '/') ch = '_';
-    dir_ = fs::temp_directory_path() / ("erodem_restart_" + name);
+    // the process id too: two test programs running this case at once (two build trees on
+    // one machine) must not remove each other's files
+    dir_ =
+        fs::temp_directory_path() / ("erodem_restart_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     std::ofstream(dir_ / "config.toml") << GetParam().config;

@@ -588,30 +588,36 @@ void ResultWriter::store_state(const Simulation& sim) {
   Impl& m = *impl_;
   // One field at a time (Simulation::restart_point() would hold every state field in double
   // at once: 8 bytes per cell for each of them, the run's peak at every snapshot).
-  const std::size_t cells = sim.grid().cells();
-  const hid_t mem_type = m.restart_f64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT;
-  const std::size_t row_bytes = cells * (m.restart_f64 ? sizeof(double) : sizeof(float));
-  std::vector<float> state32(m.restart_f64 ? 0 : cells);
+  // A float32 state is written from the doubles: HDF5 rounds them to the dataset's floats
+  // (as static_cast<float>) a strip at a time, so no float copy of the field is held.
   for (std::size_t k = 0; k < state_fields().size(); ++k) {
     const std::vector<double> v = sim.field(state_fields()[k]);
     const std::string name = std::string("restart/") + field_info(state_fields()[k]).name;
-    if (!m.restart_f64)
-      for (std::size_t i = 0; i < v.size(); ++i) state32[i] = static_cast<float>(v[i]);
-    const void* row = m.restart_f64 ? static_cast<const void*>(v.data()) : state32.data();
+    const void* row = v.data();
     if (m.once[k]) {  // a new row only when the values differ from the last one stored
       bool same = false;
       if (m.row_count[k] > 0) {  // compared with that row as the file holds it
-        std::vector<unsigned char> last(row_bytes);
-        read_row(m.restart_fields[k], mem_type, static_cast<hsize_t>(m.row_count[k] - 1),
-                 last.data(), partial_, name);
-        same = std::memcmp(last.data(), row, row_bytes) == 0;
+        const hsize_t last_row = static_cast<hsize_t>(m.row_count[k] - 1);
+        if (m.restart_f64) {
+          std::vector<double> last(v.size());
+          read_row(m.restart_fields[k], H5T_NATIVE_DOUBLE, last_row, last.data(), partial_, name);
+          same = std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
+        } else {
+          std::vector<float> last(v.size());
+          read_row(m.restart_fields[k], H5T_NATIVE_FLOAT, last_row, last.data(), partial_, name);
+          same = true;
+          for (std::size_t i = 0; i < v.size() && same; ++i) {
+            const float f = static_cast<float>(v[i]);
+            same = std::memcmp(&last[i], &f, sizeof(float)) == 0;
+          }
+        }
       }
       const std::int32_t index = same ? m.row_count[k] - 1 : m.row_count[k];
       append_rows(m.restart_rows[k], H5T_NATIVE_INT32, 1, &index, partial_, name + "_row");
       if (same) continue;
       ++m.row_count[k];
     }
-    append_rows(m.restart_fields[k], mem_type, 1, row, partial_, name);
+    append_rows(m.restart_fields[k], H5T_NATIVE_DOUBLE, 1, row, partial_, name);
   }
   const std::int64_t steps = sim.steps_done();
   append_rows(m.restart_steps, H5T_NATIVE_INT64, 1, &steps, partial_, "restart/steps");
@@ -649,12 +655,12 @@ void ResultWriter::take_snapshot(const Simulation& sim, bool last) {
   if (g.nx != m.grid.nx || g.ny != m.grid.ny)
     throw Error(ExitCode::internal, path_ + ": snapshot of a simulation on another grid");
   const auto& terrain = sim.terrain();
-  std::vector<float> f32(g.cells());
   for (auto& [info, ds] : m.fields) {
-    const auto values = sim.field(info.id);
-    for (std::size_t i = 0; i < f32.size(); ++i)
-      f32[i] = terrain.active(i) ? static_cast<float>(values[i]) : std::nanf("");
-    append_rows(ds, H5T_NATIVE_FLOAT, 1, f32.data(), partial_, info.name);
+    // NaN on the cells outside the DEM; HDF5 rounds the doubles to the dataset's floats
+    auto values = sim.field(info.id);
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!terrain.active(i)) values[i] = std::nan("");
+    append_rows(ds, H5T_NATIVE_DOUBLE, 1, values.data(), partial_, info.name);
   }
   const bool state = m.restart && (last || times_.size() % m.restart_every == 0);
   if (state) store_state(sim);

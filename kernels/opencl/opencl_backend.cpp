@@ -58,7 +58,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     throw Error(ExitCode::data, fmt::format("backend 'opencl': a grid of {} x {} is too large "
                                             "(at most 2^31 padded cells)",
                                             nx_, ny_));
-  const PaddedState state = build_padded_state(terrain, params);
+  PaddedState state = build_padded_state(terrain, params);
   periodic_ = state.periodic_x;
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
@@ -69,13 +69,24 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
 
   // ---- the host state: the same padded state the CPU reference starts from ----
-  auto to_real = [](const std::vector<double>& v) { return std::vector<Real>(v.begin(), v.end()); };
+  // Each float64 array rounded to Real and freed at once, and each Real copy freed after its
+  // last upload (in the order the buffers are made: their offsets, stagger.hpp): the setup
+  // holds about half the padded state beside the device buffers instead of all of it.
+  auto to_real = [](std::vector<double>& v) {
+    std::vector<Real> r(v.begin(), v.end());
+    std::vector<double>().swap(v);
+    return r;
+  };
+  auto release = [](std::vector<Real>& v) { std::vector<Real>().swap(v); };
   const std::vector<Real> dx = to_real(state.dx), dy = to_real(state.dy),
                           area = to_real(state.area);
   area_host_.assign(area.begin(), area.end());
   const std::vector<cl_uchar> kind(state.kind.begin(), state.kind.end());
-  const std::vector<Real> bed_r = to_real(state.bed), depth_r = to_real(state.depth),
-                          zeros(n_, Real(0));
+  std::vector<std::uint8_t>().swap(state.kind);
+  std::vector<Real> bed_r = to_real(state.bed), depth_r = to_real(state.depth),
+                    sediment_r = to_real(state.sediment), manning_r = to_real(state.manning),
+                    hardness_r = to_real(state.hardness), rain_r = to_real(state.rain_factor);
+  const std::vector<Real> zeros(n_, Real(0));
 
   // ---- the device state ----
   kind_ = upload(kind);
@@ -85,11 +96,13 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   bed_ = upload(bed_r);
   bed_next_ = upload(bed_r);
   bed0_ = upload(bed_r);
-  bed_residual_ = upload(std::vector<Real>(bed_r.size(), Real(0)));
+  release(bed_r);
+  bed_residual_ = upload(zeros);
   depth_ = upload(depth_r);
   depth_next_ = upload(depth_r);
-  sediment_ = upload(to_real(state.sediment));
-  sediment_next_ = upload(to_real(state.sediment));
+  sediment_ = upload(sediment_r);
+  sediment_next_ = upload(sediment_r);
+  release(sediment_r);
   for (int k = 0; k < 4; ++k) {
     flux_[k] = upload(zeros);
     flux_next_[k] = upload(zeros);
@@ -102,9 +115,13 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   if (params_.flow.scheme == FlowScheme::shallow_water && params_.flow.order == 2)
     stage_depth_ = upload(zeros);
   wetness_ = upload(depth_r);
-  manning_ = upload(to_real(state.manning));
-  hardness_ = upload(to_real(state.hardness));
-  rain_factor_ = upload(to_real(state.rain_factor));
+  release(depth_r);
+  manning_ = upload(manning_r);
+  release(manning_r);
+  hardness_ = upload(hardness_r);
+  release(hardness_r);
+  rain_factor_ = upload(rain_r);
+  release(rain_r);
   fields_.bind(*this, [this] { return upload(std::vector<Real>(n_, Real(0))); });
 
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
