@@ -25,6 +25,7 @@ void CpuBackend<Real>::run_sources(const StepInputs& in) {
     });
   }
   for (const auto& p : in.points) {
+    if (!holds(p.cell)) continue;  // another band's (MPI)
     const auto i = padded(p.cell);
     const int y = static_cast<int>(i / static_cast<std::size_t>(W_));
     depth_[i] += static_cast<Real>(p.volume / static_cast<double>(area_[y]));
