@@ -19,8 +19,11 @@
 #    boundary.periodic_x (the periodic columns and the bands' rows together);
 #  - restart: the erosion scenario run to step 20 on 3 ranks, continued from that file to
 #    step 40 on 2 ranks and on 4, and on one process from a file written by 4 ranks, each
-#    against the serial run of 40 steps.
-# Fails too where a run under mpirun exits non-zero.
+#    against the serial run of 40 steps;
+#  - refusals: what N > 1 ranks refuse, each with its exit code and a message naming it:
+#    --backend opencl (2), transport.scheme = "semi_lagrangian" (78), an [[outlet]] (78), and
+#    bands thinner than the halo (4 ranks on 7 rows: 2).
+# Fails too where a run under mpirun exits non-zero (but the refusals).
 # Checked by hand (2026-11-27): with the halo exchange between ranks skipped
 # (CpuBackend::exchange_field returning before parallel::exchange), every scenario fails at
 # N = 2: `erodem compare` reports rel_L2 of 1e-3 .. 1 on water_depth and the others (see
@@ -95,8 +98,9 @@ EOF
   shallow_water)
     sets=(--set flow.scheme=shallow_water --set flow.order=2 --set boundary.periodic_x=true)
     ;;
+  refusals) ;;
   *)
-    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, restart)"
+    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, restart, refusals)"
     exit 2
     ;;
 esac
@@ -136,7 +140,35 @@ run() { # LABEL OUTPUT [mpirun -np N] -- ARGS...
   fi
 }
 
-if [ "$scenario" = restart ]; then
+# refused NAME CODE TEXT ARGS...: a run under mpirun -np 2 (4 where ARGS start with "-np 4")
+# that must exit CODE with TEXT in its message
+refused() {
+  local label=$1 code=$2 text=$3 np=2 rc=0
+  shift 3
+  if [ "$1" = "-np" ]; then
+    np=$2
+    shift 2
+  fi
+  "${mpi[@]}" -np "$np" "$erodem" run scenario.toml --output refused.h5 --overwrite "$@" \
+    >refused.log 2>&1 || rc=$?
+  if [ $rc -ne "$code" ] || ! grep -qF -- "$text" refused.log; then
+    echo "FAIL $label: exit $rc (expected $code), message:"
+    grep "^erodem:" refused.log | head -2
+    failed=1
+  else
+    echo "$label: exit $rc, $(grep -m1 "^erodem:" refused.log)"
+  fi
+}
+
+if [ "$scenario" = refusals ]; then
+  refused "OpenCL" 2 "--backend opencl: not supported under MPI" --backend opencl
+  refused "semi-Lagrangian transport" 78 'transport.scheme = "semi_lagrangian": not supported' \
+    --backend cpu --set transport.scheme=semi_lagrangian
+  printf '[[outlet]]\nname = "east"\nedge = "east"\n' >>scenario.toml
+  refused "an outlet" 78 "[[section]] and [[outlet]]: not supported under MPI" --backend cpu
+  refused "bands thinner than the halo" 2 "each rank needs at least 2" -np 4 --backend cpu \
+    --set dem.size=7
+elif [ "$scenario" = restart ]; then
   run serial serial.h5 "$erodem" run scenario.toml
   run "np 3, 20 steps" first3.h5 "${mpi[@]}" -np 3 "$erodem" run scenario.toml --set time.steps=20
   run "np 4, 20 steps" first4.h5 "${mpi[@]}" -np 4 "$erodem" run scenario.toml --set time.steps=20
