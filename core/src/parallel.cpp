@@ -101,6 +101,25 @@ Band band(int ny, int r, int n) {
   return {static_cast<int>(rows * r / n), static_cast<int>(rows * (r + 1) / n)};
 }
 
+int owner_of_row(int ny, int row, int n) {
+  int r = static_cast<int>(static_cast<long>(row) * n / ny);  // a guess within one of it
+  while (r > 0 && band(ny, r, n).row0 > row) --r;
+  while (r + 1 < n && band(ny, r, n).row1 <= row) ++r;
+  return r;
+}
+
+std::vector<double> gather_owned(const std::vector<int>& owner, const std::vector<double>& mine) {
+  const int n = size();
+  if (n <= 1) return mine;
+  const std::vector<double> all = allgather(mine);  // each rank's items, ranks in order
+  std::vector<double> out(owner.size());
+  std::size_t next = 0;
+  for (int r = 0; r < n; ++r)
+    for (std::size_t j = 0; j < owner.size(); ++j)
+      if (owner[j] == r) out[j] = all.at(next++);
+  return out;
+}
+
 std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) {
   const auto* p = static_cast<const unsigned char*>(data);
 #ifdef ERODEM_HAVE_MPI

@@ -136,19 +136,11 @@ std::vector<double> CpuBackend<Real>::gather_cells(const std::vector<std::int64_
   for (const std::int64_t cell : cells)
     if (owns(cell)) mine.push_back(value(padded(cell)));
   if (!banded_) return mine;
-  // every rank's values in rank order: each rank's cells in the order of `cells`
-  const std::vector<double> all = parallel::allgather(mine);
-  std::vector<double> out(cells.size());
-  std::size_t next = 0;
-  const int ranks = parallel::size();
-  for (int r = 0; r < ranks; ++r) {
-    const parallel::Band b = parallel::band(ny_, r, ranks);
-    for (std::size_t j = 0; j < cells.size(); ++j) {
-      const auto row = cells[j] / nx_;
-      if (row >= b.row0 && row < b.row1) out[j] = all.at(next++);
-    }
-  }
-  return out;
+  std::vector<int> owner;
+  owner.reserve(cells.size());
+  for (const std::int64_t cell : cells)
+    owner.push_back(parallel::owner_of_row(ny_, static_cast<int>(cell / nx_), parallel::size()));
+  return parallel::gather_owned(owner, mine);
 }
 
 template <class Real>
@@ -247,20 +239,34 @@ StepResult CpuBackend<Real>::end_step() {
          gather_cells(probe_cells_, [&](std::size_t p) { return value_at(id, src, p); }))
       r.probes.push_back(v);
   }
-  r.face_water = face_water_;
-  r.face_sediment = face_sediment_;
+  r.face_water = gather_faces(face_water_);
+  r.face_sediment = gather_faces(face_sediment_);
   return r;
 }
 
 template <class Real>
 void CpuBackend<Real>::set_faces(const std::vector<Face>& faces) {
-  if (banded_ && !faces.empty())
-    throw Error(ExitCode::config,
-                "[[section]] and [[outlet]]: not supported under MPI with more than one rank yet "
-                "(their faces may cross the bands); run them on one process");
   face_codes_ = padded_faces(faces, nx_, ny_);
+  // MPI: a face belongs to the band of the cell west or north of it (the north ghost row's
+  // faces to the first band); its far cell is then in the band or its halo. Others': -1.
+  face_owner_.assign(faces.size(), 0);
+  const int ranks = parallel::size(), rank = parallel::rank();
+  if (banded_)
+    for (std::size_t j = 0; j < faces.size(); ++j) {
+      face_owner_[j] = parallel::owner_of_row(ny_, std::max(faces[j].row, 0), ranks);
+      face_codes_[j] = face_owner_[j] == rank ? face_codes_[j] - 2 * row0_ * W_ : -1;
+    }
   face_water_.assign(face_codes_.size(), 0.0);
   face_sediment_.assign(face_codes_.size(), 0.0);
+}
+
+template <class Real>
+std::vector<double> CpuBackend<Real>::gather_faces(const std::vector<double>& values) const {
+  if (!banded_) return values;
+  std::vector<double> mine;
+  for (std::size_t j = 0; j < values.size(); ++j)
+    if (face_codes_[j] >= 0) mine.push_back(values[j]);
+  return parallel::gather_owned(face_owner_, mine);
 }
 
 template <class Real>
@@ -268,7 +274,8 @@ void CpuBackend<Real>::measure_water_faces() {
   const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
              *fb = flux_[3].data();
   for (std::size_t j = 0; j < face_codes_.size(); ++j)
-    face_water_[j] = cell::section_face_water(face_codes_[j], W_, fl, fr, ft, fb);
+    if (face_codes_[j] >= 0)
+      face_water_[j] = cell::section_face_water(face_codes_[j], W_, fl, fr, ft, fb);
 }
 
 template <class Real>
@@ -278,8 +285,9 @@ void CpuBackend<Real>::measure_sediment_faces() {
   const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
              *fb = flux_[3].data();
   for (std::size_t j = 0; j < face_codes_.size(); ++j)
-    face_sediment_[j] = cell::section_face_sediment(face_codes_[j], W_, sediment_.data(),
-                                                    depth_next_.data(), fl, fr, ft, fb);
+    if (face_codes_[j] >= 0)
+      face_sediment_[j] = cell::section_face_sediment(face_codes_[j], W_, sediment_.data(),
+                                                      depth_next_.data(), fl, fr, ft, fb);
 }
 
 template <class Real>

@@ -221,8 +221,12 @@ class CpuBackend final : public Backend {
   // The faces of the sections and outlets (set_faces, common/sections.h): their codes and
   // what the step moved through them, measured before the water update and the transport
   // from the arrays those read.
-  std::vector<int> face_codes_;
+  // In an MPI band: the codes of the band's own faces in its padded raster, -1 for the
+  // others'; face_owner_ the rank of each (all 0 in one process).
+  std::vector<int> face_codes_, face_owner_;
   std::vector<double> face_water_, face_sediment_;
+  /// A value per face, every face's from its owner (the band's own in one process).
+  std::vector<double> gather_faces(const std::vector<double>& values) const;
   void measure_water_faces();
   void measure_sediment_faces();
 };

@@ -38,6 +38,8 @@ struct Band {
   int row0 = 0, row1 = 0;
 };
 Band band(int ny, int r, int n);
+/// The rank of `n` whose band holds DEM row `row` (0 <= row < ny).
+int owner_of_row(int ny, int row, int n);
 
 /// Every rank's `bytes` bytes at `data`, concatenated in rank order (each rank may give a
 /// different count). Collective.
@@ -52,6 +54,11 @@ std::vector<T> allgather(const std::vector<T>& mine) {
   if (!raw.empty()) std::memcpy(out.data(), raw.data(), raw.size());
   return out;
 }
+
+/// Items each owned by one rank (`owner[j]`, of this run's ranks), with `mine` this rank's
+/// values of its items in item order: every item's value in item order, from its owner.
+/// Collective (in one process: `mine`).
+std::vector<double> gather_owned(const std::vector<int>& owner, const std::vector<double>& mine);
 
 /// The halo exchange of a band: sends `bytes` at `send_up` to rank - 1 and at `send_down` to
 /// rank + 1, receiving into `recv_down` from rank + 1 and into `recv_up` from rank - 1 (none
