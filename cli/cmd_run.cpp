@@ -148,6 +148,12 @@ int run(const RunOptions& o) {
     p.output.path = o.output;
   }
   validate(p, o.config);
+  if (!parallel::built_with_mpi() && parallel::launched_size() > 1)
+    throw Error(ExitCode::usage,
+                fmt::format("started by mpirun as one of {} processes, but this erodem was built "
+                            "without MPI (ERODEM_MPI off): each would run the whole grid into the "
+                            "same output; rebuild with MPI (docs/mpi.md) or run one process",
+                            parallel::launched_size()));
   // MPI (docs/mpi.md): rank 0 writes the result and reports; the others run the same session
   // quietly into a scratch file.
   const bool root = parallel::rank() == 0;

@@ -45,6 +45,12 @@ bool built_with_mpi() {
 #endif
 }
 
+int launched_size() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* v = std::getenv(name); v && std::atoi(v) > 0) return std::atoi(v);
+  return 1;
+}
+
 void init(int* argc, char*** argv) {
 #ifdef ERODEM_HAVE_MPI
   // started by a launcher: OpenMPI's mpirun, or a PMI/PMIx one (MPICH's, Slurm's srun)

@@ -16,6 +16,9 @@ namespace erodem::parallel {
 
 /// Whether this build has MPI (ERODEM_MPI).
 bool built_with_mpi();
+/// The number of processes the launcher (mpirun, srun) started, from its environment
+/// (OMPI_COMM_WORLD_SIZE, PMI_SIZE); 1 without one. Known with or without MPI built in.
+int launched_size();
 /// Initialises MPI when this process was started by mpirun (OpenMPI's or a PMI launcher's
 /// environment); nothing otherwise.
 void init(int* argc, char*** argv);
