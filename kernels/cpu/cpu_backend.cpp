@@ -198,6 +198,7 @@ void CpuBackend<Real>::run(Process p) {
 template <class Real>
 void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
   if (!periodic_ && !banded_) return;
+  std::vector<Real*> fields;
   for (const std::string& name : names) {
     Field* f = name == "depth_flow"      ? &depth_next_
                : name == "thermal_share" ? &thermal_share_
@@ -205,23 +206,37 @@ void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
     if (!f)
       throw Error(ExitCode::internal,
                   fmt::format("halo exchange: field '{}' has no storage", name));
-    exchange_field(f->data());
+    fields.push_back(f->data());
   }
+  exchange_fields(fields);
 }
 
 template <class Real>
-void CpuBackend<Real>::exchange_field(Real* f) {
-  if (periodic_) copy_periodic_columns(f, W_, H_);
-  if (!banded_) return;
+void CpuBackend<Real>::exchange_fields(const std::vector<Real*>& fields) {
+  if (periodic_)
+    for (Real* f : fields) copy_periodic_columns(f, W_, H_);
+  if (!banded_ || fields.empty()) return;
   // whole padded rows (the ghost columns and the corners with them): my first halo_rows_ own
-  // rows to the band above, my last to the band below; theirs into my halo rows
+  // rows to the band above, my last to the band below; theirs into my halo rows. Every field's
+  // rows packed into one message each way.
   const int r = parallel::rank(), ranks = parallel::size();
-  auto row = [&](int y) { return f + static_cast<std::size_t>(y) * static_cast<std::size_t>(W_); };
   const bool up = r > 0, down = r + 1 < ranks;
-  parallel::exchange(
-      up ? row(own0_) : nullptr, up ? row(own0_ - halo_rows_) : nullptr,
-      down ? row(own1_ - halo_rows_) : nullptr, down ? row(own1_) : nullptr,
-      static_cast<std::size_t>(halo_rows_) * static_cast<std::size_t>(W_) * sizeof(Real));
+  const std::size_t per = static_cast<std::size_t>(halo_rows_) * static_cast<std::size_t>(W_);
+  const std::size_t n = per * fields.size();
+  halo_buffer_.resize(4 * n);
+  Real *send_up = halo_buffer_.data(), *recv_up = send_up + n, *send_down = recv_up + n,
+       *recv_down = send_down + n;
+  auto row = [&](Real* f, int y) { return f + static_cast<std::size_t>(y) * W_; };
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    std::copy_n(row(fields[k], own0_), per, send_up + k * per);
+    std::copy_n(row(fields[k], own1_ - halo_rows_), per, send_down + k * per);
+  }
+  parallel::exchange(up ? send_up : nullptr, up ? recv_up : nullptr, down ? send_down : nullptr,
+                     down ? recv_down : nullptr, n * sizeof(Real));
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    if (up) std::copy_n(recv_up + k * per, per, row(fields[k], own0_ - halo_rows_));
+    if (down) std::copy_n(recv_down + k * per, per, row(fields[k], own1_));
+  }
 }
 
 template <class Real>

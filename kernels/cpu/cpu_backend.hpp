@@ -78,11 +78,12 @@ class CpuBackend final : public Backend {
   /// The halo exchange (process.hpp halo_fields): with boundary.periodic_x, copies the named
   /// fields (of the field table, or the intermediates "depth_flow", "thermal_share") into the
   /// ghost columns that repeat the opposite DEM columns; in a band of an MPI run, receives
-  /// the halo rows from the neighbouring ranks (exchange_field); nothing otherwise.
+  /// the halo rows from the neighbouring ranks (exchange_fields); nothing otherwise.
   void exchange_halo(const std::vector<std::string>& names);
-  /// The halo exchange of one padded field (W_ x H_): its periodic ghost columns, then (a band
-  /// of an MPI run) its halo_rows rows on either side from the neighbouring ranks.
-  void exchange_field(Real* f);
+  /// The halo exchange of padded fields (W_ x H_ each): their periodic ghost columns, then (a
+  /// band of an MPI run) their halo_rows_ rows on either side from the neighbouring ranks, all
+  /// the fields in one message each way.
+  void exchange_fields(const std::vector<Real*>& fields);
 
  private:
   using Kind = cell::erodem_kind_t;
@@ -192,6 +193,7 @@ class CpuBackend final : public Backend {
   // whose sweeps read the four neighbours only (tests/mpi.sh: a halo of 1 row changes the
   // local-inertial and shallow-water results, and not the pipes').
   int halo_rows_ = 1;
+  std::vector<Real> halo_buffer_;  // exchange_fields: send up, receive up, send/receive down
   int threads_;
   bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
   std::vector<Kind> kind_;
