@@ -3,18 +3,23 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 
 #include "commands.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/config.hpp"
 #include "erodem/io/results.hpp"
 #include "erodem/io/run_session.hpp"
+#include "erodem/parallel.hpp"
 #include "erodem/schema.hpp"
 
 namespace erodem::cli {
@@ -65,6 +70,31 @@ std::string command_line() {
   if (!arg.empty()) flush();
   return line;
 }
+
+/// Where a rank of an MPI run other than 0 writes its result file: a fresh directory in the
+/// temporary directory, removed with this (docs/mpi.md: every rank runs the writer, whose
+/// reads of the fields gather them from all ranks; rank 0's file is the result).
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string name = (std::filesystem::temp_directory_path() / "erodem-rank-XXXXXX").string();
+    if (!mkdtemp(name.data()))
+      throw Error(ExitCode::cant_create,
+                  fmt::format("MPI rank {}: cannot create a scratch directory {}: {}",
+                              parallel::rank(), name, std::strerror(errno)));
+    path_ = name;
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 /// Progress on a terminal (a bar redrawn in place) or in a log (a line every 10 %).
 class Progress {
@@ -118,7 +148,23 @@ int run(const RunOptions& o) {
     p.output.path = o.output;
   }
   validate(p, o.config);
+  if (!parallel::built_with_mpi() && parallel::launched_size() > 1)
+    throw Error(ExitCode::usage,
+                fmt::format("started by mpirun as one of {} processes, but this erodem was built "
+                            "without MPI (ERODEM_MPI off): each would run the whole grid into the "
+                            "same output; rebuild with MPI (docs/mpi.md) or run one process",
+                            parallel::launched_size()));
+  // MPI (docs/mpi.md): rank 0 writes the result and reports; the others run the same session
+  // quietly into a scratch file.
+  const bool root = parallel::rank() == 0;
+  std::optional<ScratchDir> scratch;
+  if (!root) {
+    scratch.emplace();
+    p.output.path = (scratch->path() / std::filesystem::path(p.output.path).filename()).string();
+    spdlog::set_level(spdlog::level::off);
+  }
   if (o.dump_config) {
+    if (!root) return 0;
     std::fputs(dump_toml(p).c_str(), stdout);
     return 0;
   }
@@ -154,7 +200,7 @@ int run(const RunOptions& o) {
   const auto& g = sim.grid();
 
   auto previous = std::signal(SIGINT, on_sigint);
-  Progress progress(stderr_is_terminal());
+  Progress progress(root && stderr_is_terminal());
   io::Stop stop = io::Stop::finished;
   try {
     // To the configured end, or Ctrl-C; an unstable step throws with the partial-file note.
@@ -174,6 +220,7 @@ int run(const RunOptions& o) {
     return 130;
   }
   session.finish();
+  if (!root) return 0;
   const io::ResultWriter& writer = *session.writer();
   const double wall = progress.elapsed();
   const double cells = static_cast<double>(g.cells());

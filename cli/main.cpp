@@ -15,6 +15,7 @@
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/results.hpp"
+#include "erodem/parallel.hpp"
 
 namespace erodem::cli {
 
@@ -29,6 +30,14 @@ int main(int argc, char** argv) {
   // Declared first, destroyed last: every OpenCL object is released before main returns, not
   // in static destruction after the OpenCL implementation may have torn itself down.
   const OpenClRuntimes opencl_runtimes;
+  // MPI, where mpirun started this process (docs/mpi.md): initialised here, finalised when
+  // main returns; an error on one rank ends them all (parallel::abort_all) with its exit code.
+  struct MpiSession {
+    MpiSession(int* c, char*** v) { parallel::init(c, v); }
+    ~MpiSession() { parallel::finalize(); }
+    MpiSession(const MpiSession&) = delete;
+    MpiSession& operator=(const MpiSession&) = delete;
+  } mpi(&argc, &argv);
   io::skip_hdf5_exit_cleanup();  // one error line, not HDF5's page (corrupt result files)
   CLI::App app{"erodem — hydrology and hydraulic erosion on real terrain"};
   app.require_subcommand(1);
@@ -66,9 +75,11 @@ int main(int argc, char** argv) {
     return static_cast<int>(ExitCode::usage);
   } catch (const Error& e) {
     std::fprintf(stderr, "erodem: %s\n", e.what());
+    parallel::abort_all(static_cast<int>(e.code()));
     return static_cast<int>(e.code());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "erodem: internal error: %s\n", e.what());
+    parallel::abort_all(static_cast<int>(ExitCode::internal));
     return static_cast<int>(ExitCode::internal);
   }
 }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <type_traits>
 
 #include "common/compat.h"
 #include "erodem/boundary_codes.hpp"
@@ -156,6 +157,32 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
       copy_periodic_columns(f->data(), W, H);
   }
   return s;
+}
+
+PaddedState padded_rows(const PaddedState& s, int y0, int y1) {
+  PaddedState out;
+  out.nx = s.nx;
+  out.ny = y1 - y0 - 2;
+  out.W = s.W;
+  out.H = y1 - y0;
+  out.periodic_x = s.periodic_x;
+  const auto rows = [&](const auto& v, std::size_t per_row) {
+    using V = std::decay_t<decltype(v)>;
+    return V(v.begin() + static_cast<std::ptrdiff_t>(per_row) * y0,
+             v.begin() + static_cast<std::ptrdiff_t>(per_row) * y1);
+  };
+  const auto W = static_cast<std::size_t>(s.W);
+  out.kind = rows(s.kind, W);
+  out.dx = rows(s.dx, 1);
+  out.dy = rows(s.dy, 1);
+  out.area = rows(s.area, 1);
+  out.bed = rows(s.bed, W);
+  out.depth = rows(s.depth, W);
+  out.sediment = rows(s.sediment, W);
+  out.manning = rows(s.manning, W);
+  out.hardness = rows(s.hardness, W);
+  out.rain_factor = rows(s.rain_factor, W);
+  return out;
 }
 
 }  // namespace erodem

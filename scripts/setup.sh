@@ -13,6 +13,8 @@ DEBIAN_PACKAGES=(
   # Debian's GDAL reads and writes netCDF (gridded forcing, test_gridded_forcing.cpp)
   libgdal-dev gdal-bin libgeographiclib-dev
   libhdf5-dev hdf5-tools
+  # MPI: `mpirun -np N erodem run` (ERODEM_MPI, docs/mpi.md; ctest -L mpi); parallel HDF5
+  openmpi-bin libopenmpi-dev libhdf5-openmpi-dev
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
   # Oclgrind: the OpenCL kernels under its memory and data-race checks (ctest Oclgrind)
   oclgrind

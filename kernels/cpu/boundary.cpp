@@ -9,11 +9,16 @@ namespace ERODEM_CPU_NAMESPACE {
 template <class Real>
 void CpuBackend<Real>::run_boundary() {
   const cell_params::BoundaryParams<Real> sea = cell_.boundary;
+  // the first and last padded rows where they are the grid's ghost rows (in a band of an MPI
+  // run they may be halo rows, which the neighbouring band gives)
+  const bool north = row0_ == 0, south = row0_ + H_ == ny_ + 2;
   for (int x = 1; x < W_ - 1; ++x) {
-    cell::boundary_fill_cell(x, 0, W_, H_, kind_.data(), bed_.data(), depth_.data(),
-                             sediment_.data(), sea);
-    cell::boundary_fill_cell(x, H_ - 1, W_, H_, kind_.data(), bed_.data(), depth_.data(),
-                             sediment_.data(), sea);
+    if (north)
+      cell::boundary_fill_cell(x, 0, W_, H_, kind_.data(), bed_.data(), depth_.data(),
+                               sediment_.data(), sea);
+    if (south)
+      cell::boundary_fill_cell(x, H_ - 1, W_, H_, kind_.data(), bed_.data(), depth_.data(),
+                               sediment_.data(), sea);
   }
   for (int y = 1; y < H_ - 1; ++y) {
     cell::boundary_fill_cell(0, y, W_, H_, kind_.data(), bed_.data(), depth_.data(),

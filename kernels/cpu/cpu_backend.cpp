@@ -16,6 +16,7 @@
 #include "erodem/backends.hpp"
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
+#include "erodem/parallel.hpp"
 #include "stats_merge.hpp"
 
 namespace erodem {
@@ -30,11 +31,43 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       W_(terrain.grid.nx + 2),
       H_(terrain.grid.ny + 2) {
   PaddedState s = build_padded_state(terrain, params);
+  if (const int ranks = parallel::size(); ranks > 1) {
+    // A band of rows of an MPI run (docs/mpi.md): its rows, halo_rows_ rows of each
+    // neighbouring band, and the grid's ghost row where the band meets the edge.
+    halo_rows_ = params.flow.scheme == FlowScheme::pipes ? 1 : 2;
+    if (process_info(Process::transport).enabled(params) &&
+        params.transport.scheme == TransportScheme::semi_lagrangian)
+      throw Error(ExitCode::config,
+                  "transport.scheme = \"semi_lagrangian\": not supported under MPI with more "
+                  "than one rank (its departure points may lie beyond the halo of " +
+                      std::to_string(halo_rows_) +
+                      " rows); use transport.scheme = \"conservative\" or run one process");
+    const int r = parallel::rank();
+    const parallel::Band band = parallel::band(ny_, r, ranks);
+    if (band.row1 - band.row0 < halo_rows_)
+      throw Error(ExitCode::usage,
+                  fmt::format("mpirun -np {}: the grid's {} rows give rank {} {} rows, and each "
+                              "rank needs at least {} (the halo); run fewer ranks",
+                              ranks, ny_, r, band.row1 - band.row0, halo_rows_));
+    const int y0 = r == 0 ? 0 : band.row0 + 1 - halo_rows_;
+    const int y1 = r == ranks - 1 ? ny_ + 2 : band.row1 + 1 + halo_rows_;
+    s = padded_rows(s, y0, y1);
+    banded_ = true;
+    row0_ = y0;
+    H_ = y1 - y0;
+    own0_ = band.row0 + 1 - y0;
+    own1_ = band.row1 + 1 - y0;
+  } else {
+    own1_ = H_ - 1;
+  }
   periodic_ = s.periodic_x;
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
+  // MPI: the ranks on this machine share its cores (unless OMP_NUM_THREADS says otherwise)
+  if (banded_ && params.numerics.threads <= 0 && !std::getenv("OMP_NUM_THREADS"))
+    threads_ = std::max(1, threads_ / parallel::local_size());
 #else
   threads_ = 1;
 #endif
@@ -81,16 +114,40 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
 
 template <class Real>
 std::string CpuBackend<Real>::device() const {
-  return fmt::format("CPU reference, {}, {} thread{}, {}",
-                     sizeof(Real) == 4 ? "float32" : "float64", threads_, threads_ == 1 ? "" : "s",
-                     cpu_isa_label);
+  return fmt::format(
+      "CPU reference, {}, {} thread{}, {}{}", sizeof(Real) == 4 ? "float32" : "float64", threads_,
+      threads_ == 1 ? "" : "s", cpu_isa_label,
+      banded_ ? fmt::format(" (a rank), {} MPI ranks in bands of rows, halo {} row{}",
+                            parallel::size(), halo_rows_, halo_rows_ == 1 ? "" : "s")
+              : "");
 }
 
 template <class Real>
-double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) {
+double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) const {
+  // In a band: the sums of every rank's own rows in global row order. The grid's ghost rows
+  // (0 in every row sum) and the halo rows are left out; adding 0.0 to a sum that starts at
+  // +0.0 changes no bit, so this is the one-process sum.
+  const std::vector<double> all =
+      banded_ ? parallel::allgather(std::vector<double>(rows.begin() + own0_, rows.begin() + own1_))
+              : std::vector<double>();
   double s = 0.0;
-  for (double v : rows) s += v;
+  for (double v : banded_ ? all : rows) s += v;
   return s;
+}
+
+template <class Real>
+template <class F>
+std::vector<double> CpuBackend<Real>::gather_cells(const std::vector<std::int64_t>& cells,
+                                                   const F& value) const {
+  std::vector<double> mine;
+  for (const std::int64_t cell : cells)
+    if (owns(cell)) mine.push_back(value(padded(cell)));
+  if (!banded_) return mine;
+  std::vector<int> owner;
+  owner.reserve(cells.size());
+  for (const std::int64_t cell : cells)
+    owner.push_back(parallel::owner_of_row(ny_, static_cast<int>(cell / nx_), parallel::size()));
+  return parallel::gather_owned(owner, mine);
 }
 
 template <class Real>
@@ -142,19 +199,19 @@ void CpuBackend<Real>::run(Process p) {
   // the generic sweeps of the process (SweepInfo::generic), after its own loops, and the halo
   // exchange after every sweep (run_thermal and run_flow exchange between their own passes)
   run_sweeps_tail(
-      process_info(p).sweeps(params_), periodic_,
+      process_info(p).sweeps(params_), periodic_ || banded_,
       [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
       [&](const std::vector<std::string>& names) { exchange_halo(names); });
 }
 
 template <class Real>
 bool CpuBackend<Real>::fuses(const std::vector<Process>& pass) const {
-  // fused_passes() leaves out shallow water and generic sweeps; a periodic halo is exchanged
-  // between the three, so it runs them one by one
+  // fused_passes() leaves out shallow water and generic sweeps; a periodic halo, or the halo
+  // rows of an MPI band, are exchanged between the three, so it runs them one by one
   const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water},
       water_only{Process::flow, Process::sources, Process::water, Process::evaporation};
   return (pass == flow_water || pass == water_only) &&
-         params_.flow.scheme != FlowScheme::shallow_water && !periodic_;
+         params_.flow.scheme != FlowScheme::shallow_water && !periodic_ && !banded_;
 }
 
 template <class Real>
@@ -171,7 +228,8 @@ void CpuBackend<Real>::run_pass(const std::vector<Process>& pass) {
 
 template <class Real>
 void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
-  if (!periodic_) return;
+  if (!periodic_ && !banded_) return;
+  std::vector<Real*> fields;
   for (const std::string& name : names) {
     Field* f = name == "depth_flow"      ? &depth_next_
                : name == "thermal_share" ? &thermal_share_
@@ -179,7 +237,36 @@ void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
     if (!f)
       throw Error(ExitCode::internal,
                   fmt::format("halo exchange: field '{}' has no storage", name));
-    copy_periodic_columns(f->data(), W_, H_);
+    fields.push_back(f->data());
+  }
+  exchange_fields(fields);
+}
+
+template <class Real>
+void CpuBackend<Real>::exchange_fields(const std::vector<Real*>& fields) {
+  if (periodic_)
+    for (Real* f : fields) copy_periodic_columns(f, W_, H_);
+  if (!banded_ || fields.empty()) return;
+  // whole padded rows (the ghost columns and the corners with them): my first halo_rows_ own
+  // rows to the band above, my last to the band below; theirs into my halo rows. Every field's
+  // rows packed into one message each way.
+  const int r = parallel::rank(), ranks = parallel::size();
+  const bool up = r > 0, down = r + 1 < ranks;
+  const std::size_t per = static_cast<std::size_t>(halo_rows_) * static_cast<std::size_t>(W_);
+  const std::size_t n = per * fields.size();
+  halo_buffer_.resize(4 * n);
+  Real *send_up = halo_buffer_.data(), *recv_up = send_up + n, *send_down = recv_up + n,
+       *recv_down = send_down + n;
+  auto row = [&](Real* f, int y) { return f + static_cast<std::size_t>(y) * W_; };
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    std::copy_n(row(fields[k], own0_), per, send_up + k * per);
+    std::copy_n(row(fields[k], own1_ - halo_rows_), per, send_down + k * per);
+  }
+  parallel::exchange(up ? send_up : nullptr, up ? recv_up : nullptr, down ? send_down : nullptr,
+                     down ? recv_down : nullptr, n * sizeof(Real));
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    if (up) std::copy_n(recv_up + k * per, per, row(fields[k], own0_ - halo_rows_));
+    if (down) std::copy_n(recv_down + k * per, per, row(fields[k], own1_));
   }
 }
 
@@ -196,18 +283,38 @@ StepResult CpuBackend<Real>::end_step() {
   r.probes.reserve(probe_fields_.size() * probe_cells_.size());
   for (const FieldId id : probe_fields_) {
     const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
-    for (const std::size_t p : probe_cells_) r.probes.push_back(value_at(id, src, p));
+    for (const double v :
+         gather_cells(probe_cells_, [&](std::size_t p) { return value_at(id, src, p); }))
+      r.probes.push_back(v);
   }
-  r.face_water = face_water_;
-  r.face_sediment = face_sediment_;
+  r.face_water = gather_faces(face_water_);
+  r.face_sediment = gather_faces(face_sediment_);
   return r;
 }
 
 template <class Real>
 void CpuBackend<Real>::set_faces(const std::vector<Face>& faces) {
   face_codes_ = padded_faces(faces, nx_, ny_);
+  // MPI: a face belongs to the band of the cell west or north of it (the north ghost row's
+  // faces to the first band); its far cell is then in the band or its halo. Others': -1.
+  face_owner_.assign(faces.size(), 0);
+  const int ranks = parallel::size(), rank = parallel::rank();
+  if (banded_)
+    for (std::size_t j = 0; j < faces.size(); ++j) {
+      face_owner_[j] = parallel::owner_of_row(ny_, std::max(faces[j].row, 0), ranks);
+      face_codes_[j] = face_owner_[j] == rank ? face_codes_[j] - 2 * row0_ * W_ : -1;
+    }
   face_water_.assign(face_codes_.size(), 0.0);
   face_sediment_.assign(face_codes_.size(), 0.0);
+}
+
+template <class Real>
+std::vector<double> CpuBackend<Real>::gather_faces(const std::vector<double>& values) const {
+  if (!banded_) return values;
+  std::vector<double> mine;
+  for (std::size_t j = 0; j < values.size(); ++j)
+    if (face_codes_[j] >= 0) mine.push_back(values[j]);
+  return parallel::gather_owned(face_owner_, mine);
 }
 
 template <class Real>
@@ -215,7 +322,8 @@ void CpuBackend<Real>::measure_water_faces() {
   const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
              *fb = flux_[3].data();
   for (std::size_t j = 0; j < face_codes_.size(); ++j)
-    face_water_[j] = cell::section_face_water(face_codes_[j], W_, fl, fr, ft, fb);
+    if (face_codes_[j] >= 0)
+      face_water_[j] = cell::section_face_water(face_codes_[j], W_, fl, fr, ft, fb);
 }
 
 template <class Real>
@@ -225,16 +333,16 @@ void CpuBackend<Real>::measure_sediment_faces() {
   const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
              *fb = flux_[3].data();
   for (std::size_t j = 0; j < face_codes_.size(); ++j)
-    face_sediment_[j] = cell::section_face_sediment(face_codes_[j], W_, sediment_.data(),
-                                                    depth_next_.data(), fl, fr, ft, fb);
+    if (face_codes_[j] >= 0)
+      face_sediment_[j] = cell::section_face_sediment(face_codes_[j], W_, sediment_.data(),
+                                                      depth_next_.data(), fl, fr, ft, fb);
 }
 
 template <class Real>
 void CpuBackend<Real>::set_probes(const std::vector<std::int64_t>& cells,
                                   const std::vector<FieldId>& fields) {
   check_cells(cells, nx_, ny_, "probes");
-  probe_cells_.clear();
-  for (const std::int64_t cell : cells) probe_cells_.push_back(padded(cell));
+  probe_cells_ = cells;
   probe_fields_ = fields;
 }
 
@@ -243,10 +351,7 @@ std::vector<double> CpuBackend<Real>::sample(const std::vector<std::int64_t>& ce
                                              FieldId id) const {
   check_cells(cells, nx_, ny_, "sample");
   const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
-  std::vector<double> out;
-  out.reserve(cells.size());
-  for (const std::int64_t cell : cells) out.push_back(value_at(id, src, padded(cell)));
-  return out;
+  return gather_cells(cells, [&](std::size_t p) { return value_at(id, src, p); });
 }
 
 template <class Real>
@@ -254,6 +359,9 @@ FieldStats CpuBackend<Real>::stats() {
   std::vector<RowStats> rows(static_cast<std::size_t>(H_ - 2));
   for_rows(1, H_ - 1,
            [&](int y) { rows[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_.data()); });
+  if (banded_)  // every rank's own rows, in global row order
+    rows = parallel::allgather(
+        std::vector<RowStats>(rows.begin() + (own0_ - 1), rows.begin() + (own1_ - 1)));
   return merge_row_stats(rows);
 }
 
@@ -265,7 +373,7 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
              *vx = velocity_x_.data(), *vy = velocity_y_.data();
   const double a = area_[y];
   const std::size_t base = static_cast<std::size_t>(y) * W_;
-  const std::int64_t row_cell = static_cast<std::int64_t>(y - 1) * nx_ - 1;
+  const std::int64_t row_cell = static_cast<std::int64_t>(y - 1 + row0_) * nx_ - 1;
   double water = 0, material = 0, sed = 0, max_d = -1, max_v2 = -1;
   std::size_t fastest = 0;
   for (int x = 1; x < W_ - 1; ++x) {
@@ -303,12 +411,13 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
 
 template <class Real>
 std::vector<double> CpuBackend<Real>::field(FieldId id) const {
-  std::vector<double> out(static_cast<std::size_t>(nx_) * ny_);
+  // the rows this rank owns (all of them in one process), then every rank's in row order
+  std::vector<double> out(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(own1_ - own0_));
   const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
-  for (int r = 0; r < ny_; ++r)
+  for (int y = own0_; y < own1_; ++y)
     for (int c = 0; c < nx_; ++c)
-      out[static_cast<std::size_t>(r) * nx_ + c] = value_at(id, src, at(c + 1, r + 1));
-  return out;
+      out[static_cast<std::size_t>(y - own0_) * nx_ + c] = value_at(id, src, at(c + 1, y));
+  return banded_ ? parallel::allgather(out) : out;
 }
 
 template <class Real>
@@ -323,9 +432,12 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
                 fmt::format("field '{}' is derived and cannot be set", field_info(id).name));
   // Fields kept in two buffers get both, so the next step starts from the new values.
   Field* twin = fields_.twin(id);
-  for (int r = 0; r < ny_; ++r)
+  // the DEM rows the padded raster holds (a band's own and halo rows in an MPI run)
+  for (int y = 0; y < H_; ++y) {
+    const int r = y + row0_ - 1;
+    if (r < 0 || r >= ny_) continue;
     for (int c = 0; c < nx_; ++c) {
-      const auto p = at(c + 1, r + 1);
+      const auto p = at(c + 1, y);
       const double value = values[static_cast<std::size_t>(r) * nx_ + c];
       const auto v = static_cast<Real>(value);
       (*dst)[p] = v;
@@ -333,6 +445,7 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
       // a bed keeps what Real cannot hold in its residual (set bed_residual after the bed)
       if (id == FieldId::bed) bed_residual_[p] = static_cast<Real>(value - static_cast<double>(v));
     }
+  }
   if (periodic_) {
     copy_periodic_columns(dst->data(), W_, H_);
     if (twin) copy_periodic_columns(twin->data(), W_, H_);
@@ -342,7 +455,7 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
 
 template <class Real>
 HostView CpuBackend<Real>::host_view(FieldId id) {
-  Field* src = field_storage(id);
+  Field* src = banded_ ? nullptr : field_storage(id);  // a band holds part of the field
   if (!src) return {};
   return {src->data() + at(1, 1), sizeof(Real), static_cast<std::ptrdiff_t>(W_)};
 }

@@ -103,8 +103,13 @@ class CpuBackend final : public Backend {
   GenericRows cell_rows(const SweepInfo& sweep, Process process, Real dt, Real* depth);
   /// The halo exchange (process.hpp halo_fields): with boundary.periodic_x, copies the named
   /// fields (of the field table, or the intermediates "depth_flow", "thermal_share") into the
-  /// ghost columns that repeat the opposite DEM columns; nothing otherwise.
+  /// ghost columns that repeat the opposite DEM columns; in a band of an MPI run, receives
+  /// the halo rows from the neighbouring ranks (exchange_fields); nothing otherwise.
   void exchange_halo(const std::vector<std::string>& names);
+  /// The halo exchange of padded fields (W_ x H_ each): their periodic ghost columns, then (a
+  /// band of an MPI run) their halo_rows_ rows on either side from the neighbouring ranks, all
+  /// the fields in one message each way.
+  void exchange_fields(const std::vector<Real*>& fields);
 
  private:
   using Kind = cell::erodem_kind_t;
@@ -112,9 +117,10 @@ class CpuBackend final : public Backend {
   std::size_t at(int x, int y) const {
     return static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
   }
-  /// Index in the padded raster of DEM cell `cell` (row-major (ny, nx)).
+  /// Index in the padded raster (the band's, in an MPI run) of DEM cell `cell` (row-major
+  /// (ny, nx)), which the raster holds (holds()).
   std::size_t padded(std::int64_t cell) const {
-    return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1);
+    return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1 - row0_);
   }
   /// Local inertial or pipes: the outflows of every padded row into flux_next_ from flux_,
   /// each thread walking its block [y0, y1) of for_row_blocks top to bottom and calling
@@ -133,6 +139,20 @@ class CpuBackend final : public Backend {
   RowStats stats_row(int y, const Real* depth) const;
   /// Adds the water update's row sums to the step's tallies.
   void book_water_rows(Real dt, StepTally& tally);
+  /// Whether the padded raster holds DEM cell `cell` (always, but in a band of an MPI run:
+  /// its rows and its halo rows), and whether this rank owns it (its rows).
+  bool holds(std::int64_t cell) const {
+    const auto y = cell / nx_ + 1 - row0_;
+    return y >= 0 && y < H_;
+  }
+  bool owns(std::int64_t cell) const {
+    const auto y = cell / nx_ + 1 - row0_;
+    return y >= own0_ && y < own1_;
+  }
+  /// value(cell) of the cells this rank owns, gathered from every rank into the order of
+  /// `cells` (in one process: value(cell) of each).
+  template <class F>
+  std::vector<double> gather_cells(const std::vector<std::int64_t>& cells, const F& value) const;
   /// Calls f(y) for the padded rows [y0, y1) on the backend's threads.
   template <class F>
   void for_rows(int y0, int y1, const F& f) const {
@@ -156,8 +176,9 @@ class CpuBackend final : public Backend {
       if (y0 < y1) f(y0, y1);
     }
   }
-  /// Sums per-row partial sums in row order (deterministic for any thread count).
-  static double sum_rows(const std::vector<double>& rows);
+  /// Sums per-row partial sums (one per padded row) in row order (deterministic for any
+  /// thread count): in an MPI run, those of the rows of every rank in global row order.
+  double sum_rows(const std::vector<double>& rows) const;
   /// Sums a row of per-cell values in double in a fixed order: four interleaved partial
   /// sums (cells x = 4k + j into partial j), then (p0 + p1) + (p2 + p3), then the tail.
   /// Four independent chains of adds instead of one; the same order on every run and for
@@ -203,7 +224,19 @@ class CpuBackend final : public Backend {
 
   Params params_;
   CellParams<Real> cell_;  // the processes' run constants (cell_params.hpp)
-  int nx_, ny_, W_, H_;
+  int nx_, ny_, W_, H_;    // the DEM (all of it) and the padded raster (a band's in MPI)
+  // The MPI band (docs/mpi.md): the padded raster holds the global padded rows [row0_,
+  // row0_ + H_); this rank owns its rows [own0_, own1_) (the DEM rows it computes, tallies and
+  // writes); the others are halo rows (received after every sweep) or the grid's ghost rows.
+  // One process: row0_ 0, own0_ 1, own1_ H_ - 1.
+  bool banded_ = false;
+  int row0_ = 0, own0_ = 1, own1_ = 0;
+  // The rows of halo a band holds on either side of its own: 2, as the local-inertial and
+  // shallow-water faces read the cells (and faces) beyond the face's two cells; 1 with pipes,
+  // whose sweeps read the four neighbours only (tests/mpi.sh: a halo of 1 row changes the
+  // local-inertial and shallow-water results, and not the pipes').
+  int halo_rows_ = 1;
+  std::vector<Real> halo_buffer_;  // exchange_fields: send up, receive up, send/receive down
   int threads_;
   bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
   std::vector<Kind> kind_;
@@ -233,14 +266,18 @@ class CpuBackend final : public Backend {
   StepInputs step_inputs_;
   StepTally step_tally_;
   bool in_step_ = false;
-  // The probes (set_probes): padded cells and the fields end_step samples at them.
-  std::vector<std::size_t> probe_cells_;
+  // The probes (set_probes): DEM cells and the fields end_step samples at them.
+  std::vector<std::int64_t> probe_cells_;
   std::vector<FieldId> probe_fields_;
   // The faces of the sections and outlets (set_faces, common/sections.h): their codes and
   // what the step moved through them, measured before the water update and the transport
   // from the arrays those read.
-  std::vector<int> face_codes_;
+  // In an MPI band: the codes of the band's own faces in its padded raster, -1 for the
+  // others'; face_owner_ the rank of each (all 0 in one process).
+  std::vector<int> face_codes_, face_owner_;
   std::vector<double> face_water_, face_sediment_;
+  /// A value per face, every face's from its owner (the band's own in one process).
+  std::vector<double> gather_faces(const std::vector<double>& values) const;
   void measure_water_faces();
   void measure_sediment_faces();
 };

@@ -481,16 +481,14 @@ void CpuBackend<Real>::run_flow(Real dt) {
     if (params_.flow.order == 2) {
       for_row_blocks(H, [&](int y0, int y1) { shallow_water_rows<true, false>(st, y0, y1); });
       // the halo of the first stage before the depth and the second stage read it
-      if (periodic_)
-        for (Real* field : {ol, orr, ot, ob, qx_next.data(), qy_next.data()})
-          copy_periodic_columns(field, W, H);
+      exchange_fields({ol, orr, ot, ob, qx_next.data(), qy_next.data()});
       stage_depth_.resize(depth_.size());
       Real* h1 = stage_depth_.data();
       for_rows(0, H, [=](int y) {
         for (int x = 0; x < W; ++x)
           cell::shallow_water_stage_depth_cell(x, y, W, H, kind, d, ol, orr, ot, ob, area, dt, h1);
       });
-      if (periodic_) copy_periodic_columns(h1, W, H);
+      exchange_fields({h1});
       SwStage<Real> st2 = st;
       st2.depth = h1;
       st2.q_x = qx_next.data();

@@ -30,6 +30,7 @@ void CpuBackend<Real>::sources_row(int y, Real dt, Real rate) {
 
 template <class Real>
 void CpuBackend<Real>::add_inflow(const PointSource& p) {
+  if (!holds(p.cell)) return;  // another band's (MPI)
   const auto i = padded(p.cell);
   const int y = static_cast<int>(i / static_cast<std::size_t>(W_));
   depth_[i] += static_cast<Real>(p.volume / static_cast<double>(area_[y]));

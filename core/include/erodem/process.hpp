@@ -148,8 +148,8 @@ SweepInfo pass_sweep(const std::vector<Process>& pass, const Params& params);
 /// step writes or leaves. Throws Error(ExitCode::internal) naming the sweep and the field.
 void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps);
 
-/// The halo exchange (boundary.periodic_x now; bands of rows of an MPI domain decomposition
-/// next): where the halo stands for cells of the grid itself rather than for a boundary, the
+/// The halo exchange (boundary.periodic_x; the bands of rows of the MPI domain decomposition,
+/// docs/mpi.md): where the halo stands for cells of the grid itself rather than for a boundary, the
 /// backends copy, after every sweep, the fields it writes or leaves into the halo cells that
 /// repeat them, before a later sweep reads them at a neighbour. This is the list: every field
 /// a sweep writes or updates and every intermediate it leaves, but the grid inputs it never
@@ -162,7 +162,7 @@ std::vector<std::string> halo_fields(const SweepInfo& sweep);
 /// process's own loops (which exchange in between where a pass reads what an earlier one of
 /// theirs wrote), the exchange of their sweeps' fields; then each generic sweep of `sweeps`
 /// (`run_generic(sweep)`) and its exchange (`exchange(halo_fields(sweep))`). `halo`: whether
-/// the halo is shared (boundary.periodic_x); without it only the generic sweeps run.
+/// the halo is shared (boundary.periodic_x, MPI bands); without it only the generic sweeps run.
 template <class RunGeneric, class Exchange>
 void run_sweeps_tail(const std::vector<SweepInfo>& sweeps, bool halo, const RunGeneric& run_generic,
                      const Exchange& exchange) {

@@ -38,6 +38,10 @@ struct PaddedState {
 /// parameter rasters with their halo. Throws erodem::Error(data) on rasters of the wrong size.
 PaddedState build_padded_state(const Terrain& terrain, const Params& params);
 
+/// The padded rows [y0, y1) of `s` (a band of the MPI decomposition with its halo rows): the
+/// same fields, H = y1 - y0 rows.
+PaddedState padded_rows(const PaddedState& s, int y0, int y1);
+
 /// The periodic halo of a padded field of W x H: ghost column 0 takes column W - 2, ghost
 /// column W - 1 takes column 1, on every row (the corners too).
 template <class T>

@@ -1,0 +1,73 @@
+// erodem — the MPI domain decomposition's communication (docs/mpi.md): which band of rows a
+// rank holds, the halo exchange between neighbouring ranks, and the gathers that let every
+// rank combine per-row partial results in global row order (so reductions give the bits of a
+// run on one process). Built with MPI where ERODEM_MPI is on; MPI is initialised only when
+// the process was started by mpirun (init), so a plain `erodem run` and `import erodem`
+// never touch it. Without MPI (or outside mpirun) rank() is 0 and size() 1, and every
+// function here is the identity.
+#pragma once
+
+#include <cstddef>
+#include <cstring>
+#include <type_traits>
+#include <vector>
+
+namespace erodem::parallel {
+
+/// Whether this build has MPI (ERODEM_MPI).
+bool built_with_mpi();
+/// The number of processes the launcher (mpirun, srun) started, from its environment
+/// (OMPI_COMM_WORLD_SIZE, PMI_SIZE); 1 without one. Known with or without MPI built in.
+int launched_size();
+/// Initialises MPI when this process was started by mpirun (OpenMPI's or a PMI launcher's
+/// environment); nothing otherwise.
+void init(int* argc, char*** argv);
+/// Finalises MPI where init started it.
+void finalize();
+/// Ends every rank with exit status `code` (MPI_Abort) where MPI runs with more than one
+/// rank: one rank's error must not leave the others waiting in a collective. Returns
+/// otherwise.
+void abort_all(int code);
+/// This process's rank and the number of ranks (0 and 1 without MPI running).
+int rank();
+int size();
+/// The ranks on this machine (the launcher's OMPI_COMM_WORLD_LOCAL_SIZE or MPI_LOCALNRANKS;
+/// 1 where neither says), to share its cores among them.
+int local_size();
+
+/// The DEM rows [row0, row1) rank `r` of `n` holds (bands as equal as the rows allow, in rank
+/// order from the north).
+struct Band {
+  int row0 = 0, row1 = 0;
+};
+Band band(int ny, int r, int n);
+/// The rank of `n` whose band holds DEM row `row` (0 <= row < ny).
+int owner_of_row(int ny, int row, int n);
+
+/// Every rank's `bytes` bytes at `data`, concatenated in rank order (each rank may give a
+/// different count). Collective.
+std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes);
+
+/// Every rank's `mine`, concatenated in rank order. Collective.
+template <class T>
+std::vector<T> allgather(const std::vector<T>& mine) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const std::vector<unsigned char> raw = allgather_bytes(mine.data(), mine.size() * sizeof(T));
+  std::vector<T> out(raw.size() / sizeof(T));
+  if (!raw.empty()) std::memcpy(out.data(), raw.data(), raw.size());
+  return out;
+}
+
+/// Items each owned by one rank (`owner[j]`, of this run's ranks), with `mine` this rank's
+/// values of its items in item order: every item's value in item order, from its owner.
+/// Collective (in one process: `mine`).
+std::vector<double> gather_owned(const std::vector<int>& owner, const std::vector<double>& mine);
+
+/// The halo exchange of a band: sends `bytes` at `send_up` to rank - 1 and at `send_down` to
+/// rank + 1, receiving into `recv_down` from rank + 1 and into `recv_up` from rank - 1 (none
+/// beyond the first and last rank; null buffers where there is none). Collective among
+/// neighbours.
+void exchange(const void* send_up, void* recv_up, const void* send_down, void* recv_down,
+              std::size_t bytes);
+
+}  // namespace erodem::parallel

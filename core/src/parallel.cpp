@@ -1,0 +1,179 @@
+#include "erodem/parallel.hpp"
+
+#include <climits>
+#include <cstdlib>
+
+#include "erodem/error.hpp"
+
+#ifdef ERODEM_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace erodem::parallel {
+
+namespace {
+#ifdef ERODEM_HAVE_MPI
+bool g_started = false;  // init() called MPI_Init
+
+bool running() {
+  int on = 0, off = 0;
+  MPI_Initialized(&on);
+  if (on) MPI_Finalized(&off);
+  return on && !off;
+}
+
+/// MPI_Comm_rank or MPI_Comm_size of MPI_COMM_WORLD.
+int world(int (*query)(MPI_Comm, int*)) {
+  int v = 0;
+  query(MPI_COMM_WORLD, &v);
+  return v;
+}
+
+int count_of(std::size_t bytes) {
+  if (bytes > static_cast<std::size_t>(INT_MAX))
+    throw Error(ExitCode::internal, "MPI: a message of more than 2 GiB");
+  return static_cast<int>(bytes);
+}
+#endif
+}  // namespace
+
+bool built_with_mpi() {
+#ifdef ERODEM_HAVE_MPI
+  return true;
+#else
+  return false;
+#endif
+}
+
+int launched_size() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* v = std::getenv(name); v && std::atoi(v) > 0) return std::atoi(v);
+  return 1;
+}
+
+void init(int* argc, char*** argv) {
+#ifdef ERODEM_HAVE_MPI
+  // started by a launcher: OpenMPI's mpirun, or a PMI/PMIx one (MPICH's, Slurm's srun)
+  const bool launched =
+      std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
+  if (!launched || running()) return;
+  MPI_Init(argc, argv);
+  g_started = true;
+#else
+  (void)argc;
+  (void)argv;
+#endif
+}
+
+void finalize() {
+#ifdef ERODEM_HAVE_MPI
+  if (g_started && running()) MPI_Finalize();
+#endif
+}
+
+void abort_all(int code) {
+#ifdef ERODEM_HAVE_MPI
+  if (size() > 1) MPI_Abort(MPI_COMM_WORLD, code);
+#else
+  (void)code;
+#endif
+}
+
+#ifdef ERODEM_HAVE_MPI
+int rank() {
+  return running() ? world(MPI_Comm_rank) : 0;
+}
+int size() {
+  return running() ? world(MPI_Comm_size) : 1;
+}
+#else
+int rank() {
+  return 0;
+}
+int size() {
+  return 1;
+}
+#endif
+
+int local_size() {
+  if (size() <= 1) return 1;
+  for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"})
+    if (const char* v = std::getenv(name); v && std::atoi(v) > 0) return std::atoi(v);
+  return 1;
+}
+
+Band band(int ny, int r, int n) {
+  const long rows = ny;
+  return {static_cast<int>(rows * r / n), static_cast<int>(rows * (r + 1) / n)};
+}
+
+int owner_of_row(int ny, int row, int n) {
+  int r = static_cast<int>(static_cast<long>(row) * n / ny);  // a guess within one of it
+  while (r > 0 && band(ny, r, n).row0 > row) --r;
+  while (r + 1 < n && band(ny, r, n).row1 <= row) ++r;
+  return r;
+}
+
+std::vector<double> gather_owned(const std::vector<int>& owner, const std::vector<double>& mine) {
+  const int n = size();
+  if (n <= 1) return mine;
+  const std::vector<double> all = allgather(mine);  // each rank's items, ranks in order
+  std::vector<double> out(owner.size());
+  std::size_t next = 0;
+  for (int r = 0; r < n; ++r)
+    for (std::size_t j = 0; j < owner.size(); ++j)
+      if (owner[j] == r) out[j] = all.at(next++);
+  return out;
+}
+
+std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+#ifdef ERODEM_HAVE_MPI
+  const int n = size();
+  if (n > 1) {
+    const int mine = count_of(bytes);
+    std::vector<int> counts(static_cast<std::size_t>(n)), offsets(static_cast<std::size_t>(n));
+    MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    std::size_t total = 0;
+    for (int r = 0; r < n; ++r) {
+      offsets[static_cast<std::size_t>(r)] = count_of(total);
+      total += static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+    }
+    std::vector<unsigned char> out(total);
+    MPI_Allgatherv(p, mine, MPI_BYTE, out.data(), counts.data(), offsets.data(), MPI_BYTE,
+                   MPI_COMM_WORLD);
+    return out;
+  }
+#endif
+  return std::vector<unsigned char>(p, p + bytes);
+}
+
+void exchange(const void* send_up, void* recv_up, const void* send_down, void* recv_down,
+              std::size_t bytes) {
+#ifdef ERODEM_HAVE_MPI
+  const int n = size(), r = rank();
+  if (n > 1) {
+    const int up = r > 0 ? r - 1 : MPI_PROC_NULL, down = r + 1 < n ? r + 1 : MPI_PROC_NULL;
+    const int count = count_of(bytes);
+    // MPI checks the buffers even where the neighbour is MPI_PROC_NULL: none given, a byte
+    unsigned char none[1];
+    if (!send_up) send_up = none;
+    if (!recv_up) recv_up = none;
+    if (!send_down) send_down = none;
+    if (!recv_down) recv_down = none;
+    // northwards first (my first rows to the rank above, its halo below), then southwards
+    MPI_Sendrecv(send_up, count, MPI_BYTE, up, 1, recv_down, count, MPI_BYTE, down, 1,
+                 MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    MPI_Sendrecv(send_down, count, MPI_BYTE, down, 2, recv_up, count, MPI_BYTE, up, 2,
+                 MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    return;
+  }
+#endif
+  (void)send_up;
+  (void)recv_up;
+  (void)send_down;
+  (void)recv_down;
+  (void)bytes;
+}
+
+}  // namespace erodem::parallel
