@@ -127,6 +127,7 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   terrain_.grid.validate();
   // every field a sweep of the step reads is provided before it (process.hpp)
   check_sweeps(step_sweeps(params_));
+  passes_ = step_passes(params_, params_.numerics.fused_sweeps);
   describe_grid();
   const auto& g = terrain_.grid;
   for (int r = 0; r < g.ny; ++r)
@@ -413,8 +414,9 @@ std::vector<Process> Simulation::sequence() const {
   return step_sequence(params_);
 }
 
-std::vector<std::vector<Process>> Simulation::passes() const {
-  return step_passes(params_, params_.numerics.fused_sweeps);
+void Simulation::set_fused_sweeps(bool on) {
+  params_.numerics.fused_sweeps = on;
+  passes_ = step_passes(params_, on);
 }
 
 double Simulation::next_dt() const {

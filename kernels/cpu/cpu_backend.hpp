@@ -86,7 +86,7 @@ class CpuBackend final : public Backend {
   void run_transport(Real dt, StepTally& tally);
   void run_thermal(Real dt, StepTally& tally);
   /// A generic sweep of the process table (process.hpp SweepInfo::generic), in
-  /// kernels/cpu/sweeps.cpp: the cell function the list there names for it, by cell_sweep.
+  /// kernels/cpu/sweeps.cpp: the cell function the list there names for it, through generic_rows.
   void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
   /// A generic sweep made ready to run row by row: row(y) runs its cell function over padded
   /// row y (1 .. H - 2) and keeps the row's tally sums; book() adds them, in row order, to the

@@ -146,10 +146,10 @@ class Simulation {
   /// The processes a step runs with these parameters, in order.
   std::vector<Process> sequence() const;
   /// The passes a step runs them in (process.hpp step_passes, with numerics.fused_sweeps).
-  std::vector<std::vector<Process>> passes() const;
+  const std::vector<std::vector<Process>>& passes() const { return passes_; }
   /// Switches numerics.fused_sweeps for the next steps (erodem bench times both ways in one
   /// run); the results do not change.
-  void set_fused_sweeps(bool on) { params_.numerics.fused_sweeps = on; }
+  void set_fused_sweeps(bool on);
   /// Fraction of the configured run done, in [0, 1].
   double progress() const;
   /// Inputs of the next step (rain rate, inflow volumes) for a step of `dt` seconds.
@@ -234,7 +234,8 @@ class Simulation {
   bool sections_measured_ = false;
   /// Terrain classes: the parameter fields their tables write must be written again from the
   /// classes held before the next step (after restore(), which sets terrain_class only).
-  bool class_fields_stale_ = false;  // a step has set the peaks
+  std::vector<std::vector<Process>> passes_;  // step_passes of params_, taken when they change
+  bool class_fields_stale_ = false;           // a step has set the peaks
   /// Sums a step's face values into section_state_.
   void measure_sections(const StepResult& result, double dt);
 };
