@@ -1,5 +1,5 @@
 // erodem — the one conversion of the parameters into the per-cell dialect: each process's
-// run constants as the parameter struct of its cell functions (ERODEM_PARAMS in
+// run constants as the parameter struct of its cell functions (ERODEM_PARAMS_BEGIN in
 // kernels/common/*.h), converted here once, in the baseline translation unit (not the
 // per-instruction-set CPU builds), and passed as they are by the CPU reference and, as one
 // kernel argument, by the OpenCL backend: both backends compute from the same numbers.

@@ -5,10 +5,10 @@
 #include "compat.h"
 
 /* The run constants of the boundary ghosts (boundary_params, kernels/cell_params.cpp). */
-ERODEM_PARAMS(BoundaryParams, {
+ERODEM_PARAMS_BEGIN(BoundaryParams)
   real sea_level;              /* the level of fixed_level edges and of sea nodata cells (m) */
   real sediment_concentration; /* c_b (1): the solid in the water fixed-level ghosts give */
-})
+ERODEM_PARAMS_END(BoundaryParams)
 
 ERODEM_BEGIN_NAMESPACE
 

@@ -67,36 +67,51 @@ typedef std::uint8_t erodem_kind_t;
  * type `real` or `int` only, so that the host's Name<float> and the device's Name share one
  * layout (kernels/cell_params.hpp checks the size). The host converts the parameters into it
  * once (kernels/cell_params.cpp) and both backends pass it as it is: the CPU loops to the cell
- * functions, the OpenCL host as one kernel argument, by value. ERODEM_PARAMS(Name, {members})
- * declares it, at file scope (outside ERODEM_BEGIN_NAMESPACE); ERODEM_P(Name) names it in a
- * cell function's signature. In C++ the structs live in erodem::cell_params, outside the
- * per-instruction-set namespaces of the CPU builds (cpu/isa_prelude.hpp): they hold no code,
- * and the one conversion (baseline code) fills the type every build uses. */
+ * functions, the OpenCL host as one kernel argument, by value. ERODEM_PARAMS_BEGIN(Name)
+ * members ERODEM_PARAMS_END(Name) declares it, at file scope (outside ERODEM_BEGIN_NAMESPACE);
+ * ERODEM_P(Name) names it in a cell function's signature. In C++ the structs live in
+ * erodem::cell_params, outside the per-instruction-set namespaces of the CPU builds
+ * (cpu/isa_prelude.hpp): they hold no code, and the one conversion (baseline code) fills the
+ * type every build uses. The members sit between two macros, not in a macro argument: that
+ * would need a variadic macro (the members' commas), which OpenCL C compilers may refuse
+ * (NVIDIA's does: "variadic macros not supported in OpenCL"). */
 #ifdef __OPENCL_C_VERSION__
-#define ERODEM_PARAMS(Name, ...) typedef struct __VA_ARGS__ Name;
+#define ERODEM_PARAMS_BEGIN(Name) typedef struct {
+#define ERODEM_PARAMS_END(Name) \
+  }                             \
+  Name;
 #define ERODEM_P(Name) Name
 #else
-#define ERODEM_PARAMS(Name, ...) \
-  namespace erodem {             \
-  namespace cell_params {        \
-  template <class real>          \
-  struct Name __VA_ARGS__;       \
-  }                              \
+#define ERODEM_PARAMS_BEGIN(Name) \
+  namespace erodem {              \
+  namespace cell_params {         \
+  template <class real>           \
+  struct Name {
+#define ERODEM_PARAMS_END(Name) \
+  }                             \
+  ;                             \
+  }                             \
   }
 #define ERODEM_P(Name) ::erodem::cell_params::Name<real>
 #endif
 
 /* A small struct of values that cell functions pass between them (a face's fluxes, a cell's
- * results), members of type `real` or `int`: ERODEM_STRUCT(Name, {members}) declares it inside
- * ERODEM_BEGIN_NAMESPACE, ERODEM_S(Name) names it in a cell function. In C++ it is a template
- * on `real`, as the functions are. */
+ * results), members of type `real` or `int`: ERODEM_STRUCT_BEGIN(Name) members
+ * ERODEM_STRUCT_END(Name) declares it inside ERODEM_BEGIN_NAMESPACE, ERODEM_S(Name) names it in
+ * a cell function. In C++ it is a template on `real`, as the functions are. */
 #ifdef __OPENCL_C_VERSION__
-#define ERODEM_STRUCT(Name, ...) typedef struct __VA_ARGS__ Name;
+#define ERODEM_STRUCT_BEGIN(Name) typedef struct {
+#define ERODEM_STRUCT_END(Name) \
+  }                             \
+  Name;
 #define ERODEM_S(Name) Name
 #else
-#define ERODEM_STRUCT(Name, ...) \
-  template <class real>          \
-  struct Name __VA_ARGS__;
+#define ERODEM_STRUCT_BEGIN(Name) \
+  template <class real>           \
+  struct Name {
+#define ERODEM_STRUCT_END(Name) \
+  }                             \
+  ;
 #define ERODEM_S(Name) Name<real>
 #endif
 

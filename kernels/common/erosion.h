@@ -7,20 +7,20 @@
 
 /* The run constants of the erosion process (erosion_params, kernels/cell_params.cpp, from
  * Params::Erosion). */
-ERODEM_PARAMS(ErosionParams, {
+ERODEM_PARAMS_BEGIN(ErosionParams)
   real capacity_k;      /* K_c (s): capacity per unit speed and tilt */
   real dissolving_rate; /* K_s (1/s) */
   real deposition_rate; /* K_d (1/s) */
   real min_tilt;        /* sin_min (1) */
   real min_depth;       /* depth below which the capacity ramps to 0 (m); 0 = off */
   real bedrock;         /* no erosion below this bed elevation (m); -inf without one */
-})
+ERODEM_PARAMS_END(ErosionParams)
 
 /* The run constants of the physical erosion law (erosion.law = "physical", docs/model.md
  * section 3.5.2; sediment_params_of, kernels/cell_params.hpp, from Params::Erosion): one
  * grain-size class in suspension over a bed of two layers, the loose soil over the bedrock,
  * each with its closure. Derived constants are computed once on the host in double. */
-ERODEM_PARAMS(SedimentParams, {
+ERODEM_PARAMS_BEGIN(SedimentParams)
   real rho;               /* water density (kg/m^3), flow.water_density */
   real gravity;           /* g (m/s^2) */
   real min_depth;         /* h_min (m): numerics.velocity_min_depth, the thin-film depth */
@@ -44,7 +44,7 @@ ERODEM_PARAMS(SedimentParams, {
   real soil_inv_tau_d;    /* cohesive: 1 / tau_c,d (1/Pa) of Krone's deposition; 0 = always */
   real rock_inv_tau_d;    /* the bedrock's */
   real morfac;            /* morphological acceleration factor (1): bed change per exchange */
-})
+ERODEM_PARAMS_END(SedimentParams)
 
 ERODEM_BEGIN_NAMESPACE
 
@@ -211,12 +211,12 @@ ERODEM_FN real soulsby_whitehouse_shields(real grain, real specific_r, real g, r
 }
 
 /* What the flow does to the bed at one cell: the bed shear stress and its Shields numbers. */
-ERODEM_STRUCT(BedLoad, {
+ERODEM_STRUCT_BEGIN(BedLoad)
   real tau;        /* tau_b (Pa), bed_shear_stress */
   real theta;      /* tau_b / ((rho_s - rho) g D) (1) */
   real theta_skin; /* theta' (1): with the grain roughness n' (<= n) in place of n */
   real theta_crit; /* theta_c (1): Soulsby-Whitehouse, raised on slopes (Lamb et al. 2008) */
-})
+ERODEM_STRUCT_END(BedLoad)
 
 /* The bed load of a cell with depth h (m), velocities u, v (m/s), Manning n (s m^-1/3) and
  * squared bed slope tan2 (1). The skin friction (Einstein's partition): the same flow over

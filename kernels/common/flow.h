@@ -13,7 +13,7 @@
 #include "compat.h"
 
 /* The run constants of the flow schemes (flow_params, kernels/cell_params.cpp). */
-ERODEM_PARAMS(FlowParams, {
+ERODEM_PARAMS_BEGIN(FlowParams)
   real gravity;     /* g (m/s^2) */
   real theta;       /* local inertial: de Almeida's weighting (1) */
   real dry_depth;   /* local inertial: faces shallower carry no flow (m) */
@@ -21,7 +21,7 @@ ERODEM_PARAMS(FlowParams, {
   real pipe_length; /* pipes: the pipe length l (m); 0 = the cell size */
   int periodic_x;   /* boundary.periodic_x: the second-order shallow water's cells two columns
                        off wrap around the seam (shallow_water_muscl_cell) */
-})
+ERODEM_PARAMS_END(FlowParams)
 
 ERODEM_BEGIN_NAMESPACE
 

@@ -8,12 +8,12 @@
 
 /* The run constants of infiltration (infiltration_params_of, kernels/cell_params.hpp). The
  * soil's K_sat, suction and store are per-cell fields (infiltration_ksat, _suction, _store). */
-ERODEM_PARAMS(InfiltrationParams, {
+ERODEM_PARAMS_BEGIN(InfiltrationParams)
   real recovery_rate; /* k_r (1/s) where recovery_swmm is 0 */
   real swmm_scale;    /* recovery_swmm: k_r = sqrt(K_sat * swmm_scale) / 270000 (SWMM's rule in
                          K_sat (in/h) and 1/h: swmm_scale = 1 / (0.0254 m / 3600 s)) */
   int recovery_swmm;  /* 1: SWMM's k_r from K_sat; 0: recovery_rate */
-})
+ERODEM_PARAMS_END(InfiltrationParams)
 
 ERODEM_BEGIN_NAMESPACE
 

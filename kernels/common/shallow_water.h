@@ -72,7 +72,7 @@ ERODEM_FN_INLINED real sw_hllc(real h_l, real u_l, real t_l, real h_r, real u_r,
 
 /* What a face gives the two cells beside it (sw_face): a west or north of the face, b east or
  * south of it. */
-ERODEM_STRUCT(SwFace, {
+ERODEM_STRUCT_BEGIN(SwFace)
   real mass;    /* mass flux (m^2/s, positive from a to b) */
   real mom_a;   /* normal momentum flux leaving a (m^3/s^2, positive from a to b) */
   real mom_b;   /* normal momentum flux entering b (equal to mom_a where the water meets) */
@@ -83,7 +83,7 @@ ERODEM_STRUCT(SwFace, {
   real mom_low; /* a step's low side: its normal momentum flux against the step */
   real z_mean;  /* the mean of the two beds (m) */
   int step;     /* a step: 1 where a is the high side, -1 where b is, 0 where the water meets */
-})
+ERODEM_STRUCT_END(SwFace)
 
 /* The face between padded cells a (west or north of it) and b (east or south), the normal
  * from a to b: kinds k_a, k_b; each side's depth h (m), bed z (m), velocity u normal to the
@@ -194,10 +194,10 @@ ERODEM_FN_INLINED ERODEM_S(SwFace)
 }
 
 /* What the shallow-water step gives a cell: its outflows (m^3/s) and unit discharges (m^2/s). */
-ERODEM_STRUCT(SwCell, {
+ERODEM_STRUCT_BEGIN(SwCell)
   real left, right, top, bottom; /* outflows through the west, east, north and south faces */
   real q_x, q_y;                 /* the new unit discharges, eastwards and northwards */
-})
+ERODEM_STRUCT_END(SwCell)
 
 /* The shallow-water step of a padded cell of kind k from its four faces (sw_face: e the face east
  * of it, where it is a; w west, where it is b; s south, where it is a; n north, where it is b;
@@ -365,10 +365,10 @@ ERODEM_FN real sw_minmod(real a, real b) {
 /* A cell's limited slopes in one direction (the change per cell towards its next neighbour)
  * of its surface eta = z + h, depth h, the velocity normal to the faces u and along them t
  * (m/s); `on` 0 where the cell is reconstructed at first order. */
-ERODEM_STRUCT(SwSlopes, {
+ERODEM_STRUCT_BEGIN(SwSlopes)
   real eta, h, u, t;
   int on;
-})
+ERODEM_STRUCT_END(SwSlopes)
 
 /* The slopes of a cell (kind k, depth h, bed z, velocities u, t) from its previous (_m) and next
  * (_p) neighbours in one direction: minmod of the two one-sided differences (Van Leer's MUSCL
@@ -391,9 +391,9 @@ ERODEM_FN ERODEM_S(SwSlopes)
 }
 
 /* A cell's state at one of its faces. */
-ERODEM_STRUCT(SwSide, {
+ERODEM_STRUCT_BEGIN(SwSide)
   real h, z, u, t; /* depth (m), bed (m), velocities normal to and along the face (m/s) */
-})
+ERODEM_STRUCT_END(SwSide)
 
 /* The state of a cell (depth h, bed z, velocities u, t) at its face half a cell along its slopes
  * s (d = 0.5 towards the next neighbour, -0.5 towards the previous): surface and depth
@@ -437,10 +437,10 @@ ERODEM_FN void shallow_water_stage_depth_cell(int x, int y, int W, int H,
 
 /* One cell's state for the second-order faces: kind, depth (m), bed (m), velocities east and
  * north (m/s). */
-ERODEM_STRUCT(SwCellState, {
+ERODEM_STRUCT_BEGIN(SwCellState)
   real h, z, u, v;
   int k;
-})
+ERODEM_STRUCT_END(SwCellState)
 
 /* The state of padded cell (x, y) (sw_velocity with h_eps = eps); outside the raster a wall
  * standing on the nearest cell's state (as shallow_water_cell clamps). */

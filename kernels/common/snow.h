@@ -12,7 +12,7 @@
 
 /* The constants of the snow pack (snow_params, kernels/cell_params.hpp); air_temperature and
  * rain_rate follow the step (step_cell_params: the series' values at the step midpoint). */
-ERODEM_PARAMS(SnowParams, {
+ERODEM_PARAMS_BEGIN(SnowParams)
   real melt_factor;          /* DDF, melt per kelvin above melt_temperature (m/s per K) */
   real melt_temperature;     /* T_melt (degrees C) */
   real air_temperature;      /* T_ref(t) at reference_elevation (degrees C), per step */
@@ -24,7 +24,7 @@ ERODEM_PARAMS(SnowParams, {
   real rain_rate;            /* the step's rain rate (m/s; times the cell's rain factor) */
   real tan_slide;            /* tan of snow.slide_angle (1) */
   real slide_rate;           /* fraction of a sliding pack that moves per second (1/s) */
-})
+ERODEM_PARAMS_END(SnowParams)
 
 ERODEM_BEGIN_NAMESPACE
 

@@ -6,11 +6,11 @@
 
 /* The run constants of evaporation and the wetness (evaporation_params,
  * kernels/cell_params.cpp). */
-ERODEM_PARAMS(EvaporationParams, {
+ERODEM_PARAMS_BEGIN(EvaporationParams)
   real rate;         /* K_e (1/s) */
   real wetness_time; /* tau of the wetness running mean (s) */
   int evaporate;     /* rate > 0: 1, else 0 (then only the wetness runs) */
-})
+ERODEM_PARAMS_END(EvaporationParams)
 
 ERODEM_BEGIN_NAMESPACE
 

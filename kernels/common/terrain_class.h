@@ -21,7 +21,7 @@
 /* The rule's thresholds and the class tables (terrain_class_params_of,
  * kernels/cell_params.hpp). A table row holds, by class code, the value a class's cells take:
  * the class's own where terrain_classes.<class> gives one, else the uniform parameter. */
-ERODEM_PARAMS(TerrainClassParams, {
+ERODEM_PARAMS_BEGIN(TerrainClassParams)
   real snow_depth;     /* a cell whose pack (snow water equivalent) exceeds this is snow (m) */
   real snow_line;      /* ... as is one whose bed lies above this (m; the largest real: none) */
   real water_wetness;  /* a cell whose wetness exceeds this is water (m) */
@@ -41,7 +41,7 @@ ERODEM_PARAMS(TerrainClassParams, {
   int set_soil; /* infiltration_suction_deficit and infiltration_store */
   int set_talus;
   int classify; /* per step: 1 classify, then write; 0 write from the classes the field holds */
-})
+ERODEM_PARAMS_END(TerrainClassParams)
 
 ERODEM_BEGIN_NAMESPACE
 

@@ -6,14 +6,14 @@
 #include "compensated.h"
 
 /* The run constants of slope collapse (thermal_params, kernels/cell_params.cpp). */
-ERODEM_PARAMS(ThermalParams, {
+ERODEM_PARAMS_BEGIN(ThermalParams)
   real rate;          /* K_t (1/s) */
   real tan_talus;     /* tan of the talus angle (1) */
   real tan_wet;       /* tan of the wet talus angle (1); tan_talus where none is given */
   real wet_threshold; /* wetness (m) above which a cell takes tan_wet (+inf: no wet angle) */
   int by_class;       /* 1: the dry talus slope of each cell is its talus_slope field (the
                          terrain classes' table, terrain_class.h); 0: tan_talus everywhere */
-})
+ERODEM_PARAMS_END(ThermalParams)
 
 ERODEM_BEGIN_NAMESPACE
 

@@ -5,9 +5,9 @@
 #include "flow.h"
 
 /* The run constants of the water update (water_params, kernels/cell_params.cpp). */
-ERODEM_PARAMS(WaterParams, {
+ERODEM_PARAMS_BEGIN(WaterParams)
   real velocity_min_depth; /* the velocity is 0 below this mean depth (m) */
-})
+ERODEM_PARAMS_END(WaterParams)
 
 ERODEM_BEGIN_NAMESPACE
 
