@@ -25,6 +25,10 @@ namespace opencl {
 
 namespace {
 
+/// Values per row that stats_rows (stats.cl) writes: water, material, sediment volume, max
+/// depth, max squared speed, and the two velocities of the cell of the max squared speed.
+constexpr std::size_t kStatsRowValues = 7;
+
 /// A size from the environment (the tuning variable ERODEM_OPENCL_WG), else `fallback`. Where
 /// the kernels are built for rounded launches, the cell kernels' work-group is ERODEM_OPENCL_WG
 /// rounded down to a power of two, by default 64 on CPU devices and 128 on others, one row high;
@@ -169,7 +173,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
   partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
   partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
-  row_sums_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 6 * acc_size_);  // stats_rows
+  row_sums_ = make_buffer(static_cast<std::size_t>(H_ - 2) * kStatsRowValues * acc_size_);
   row_cells_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 3 * sizeof(cl_long));
   // The active cells beside a ghost, row-major: the only ones with a water exchange or a
   // sediment outflow through the domain's faces (edges.cl). The kinds never change.
@@ -571,28 +575,34 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
     face_sediment_raw_.resize(face_count_);
     read(face_sediment_out_, face_count_ * sizeof(Real), face_sediment_raw_.data(), false);
   }
-  stats_sums_raw_.resize(static_cast<std::size_t>(rows) * 6 * acc_size_);
+  stats_sums_raw_.resize(static_cast<std::size_t>(rows) * kStatsRowValues * acc_size_);
   read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
   deliver_tallies();
   if (probes)
     *probes =
         gather ? compose_gathered(probe_fields_, probe_raw_, probe_count_) : std::vector<double>();
-  const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * 6);
-  // Rows in order, merged as the CPU's (stats_merge.hpp).
+  constexpr std::size_t n = kStatsRowValues;
+  const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * n);
+  // Rows in order, merged as the CPU's (stats_merge.hpp); the speed of the winning cell after.
   std::vector<RowStats> row_stats(static_cast<std::size_t>(rows));
   for (std::size_t y = 0; y < row_stats.size(); ++y) {
     RowStats& row = row_stats[y];
-    row.water = sums[6 * y + 0];
-    row.material = sums[6 * y + 1];
-    row.sediment = sums[6 * y + 2];
-    row.max_depth = sums[6 * y + 3];
-    row.max_speed2 = sums[6 * y + 4];
-    row.speed = sums[6 * y + 5];
+    row.water = sums[n * y + 0];
+    row.material = sums[n * y + 1];
+    row.sediment = sums[n * y + 2];
+    row.max_depth = sums[n * y + 3];
+    row.max_speed2 = sums[n * y + 4];
     row.max_depth_cell = cells[3 * y + 0];
     row.max_speed_cell = cells[3 * y + 1];
     row.bad_cell = cells[3 * y + 2];
   }
-  return merge_row_stats(row_stats);
+  FieldStats st = merge_row_stats(row_stats);
+  if (st.max_speed_cell >= 0) {
+    // hypot on the host, as the CPU reference takes it (stats_rows gives the velocities)
+    const auto y = static_cast<std::size_t>(st.max_speed_cell / nx_);
+    st.max_speed = std::hypot(sums[n * y + 5], sums[n * y + 6]);
+  }
+  return st;
 }
 
 }  // namespace opencl

@@ -217,8 +217,10 @@ __kernel void field_stats(
  * of field_stats in that row, in column order, as the CPU reference's row scan gives them:
  * sums added; a maximum replaced only by a strictly larger one (a later group holds later
  * cells); the first bad cell. Per row: row_sums[6 r + k] = water, material, sediment volume,
- * max depth, max squared speed (-1: no candidate), the speed (m/s, hypot as on the CPU) of the
- * cell of the max squared speed; row_cells[3 r + k] as cells. One work-item per row, so the
+ * max depth, max squared speed (-1: no candidate), and the two velocities (m/s, 0 without a
+ * candidate) of the cell of the max squared speed, whose speed the host takes with the CPU's
+ * hypot (OpenCL's hypot may differ from the C library's by an ulp: NVIDIA's did, and the speed
+ * sets the local-inertial time step); row_cells[3 r + k] as cells. One work-item per row, so the
  * host reads one result per row, not per group. */
 __kernel void stats_rows(int W, int rows, int groups_x, __global const acc_t* restrict sums,
                          __global const long* restrict cells,
@@ -244,17 +246,19 @@ __kernel void stats_rows(int W, int rows, int groups_x, __global const acc_t* re
     }
     if (bad < 0) bad = cells[3 * g + 2];
   }
-  acc_t speed = -1;
+  acc_t u = 0, v = 0;
   if (arg_v >= 0) {
     const int c = (int)(arg_v % (long)(W - 2)) + 1 + (r + 1) * W;
-    speed = hypot((acc_t)velocity_x[c], (acc_t)velocity_y[c]);
+    u = velocity_x[c];
+    v = velocity_y[c];
   }
-  row_sums[6 * r + 0] = water;
-  row_sums[6 * r + 1] = material;
-  row_sums[6 * r + 2] = sed;
-  row_sums[6 * r + 3] = max_d;
-  row_sums[6 * r + 4] = max_v;
-  row_sums[6 * r + 5] = speed;
+  row_sums[7 * r + 0] = water;
+  row_sums[7 * r + 1] = material;
+  row_sums[7 * r + 2] = sed;
+  row_sums[7 * r + 3] = max_d;
+  row_sums[7 * r + 4] = max_v;
+  row_sums[7 * r + 5] = u;
+  row_sums[7 * r + 6] = v;
   row_cells[3 * r + 0] = arg_d;
   row_cells[3 * r + 1] = arg_v;
   row_cells[3 * r + 2] = bad;
