@@ -219,11 +219,42 @@ std::vector<std::pair<std::string, double>> fused_speedups(const std::vector<Row
   return out;
 }
 
-/// The bandwidth a row is measured against: one thread for one CPU thread, else all.
-double copy_ref(const Row& r, const Bandwidth& bw) {
+/// The copy bandwidth of the device memory of an OpenCL run on a device other than the CPU
+/// (a GPU's), measured after the runs; gbs 0 when no such run was made.
+struct DeviceMemory {
+  std::string device;  ///< as Backend::device() names it: "<platform> / <device>"
+  ClCopyBandwidth copy;
+};
+
+/// Measures the device memory's copy bandwidth when one of `rows` ran on an OpenCL device
+/// that is not the CPU: its kernels are set against that, not against the host's memory.
+DeviceMemory device_memory(const std::vector<Row>& rows, std::size_t bytes) {
+  DeviceMemory out;
+  auto ran_on = [&](const ClDeviceInfo& d) {
+    return std::any_of(rows.begin(), rows.end(), [&](const Row& r) {
+      return r.backend != "cpu" && r.device == d.platform + " / " + d.device;
+    });
+  };
+  // PoCL's device is the host: its runs stay set against the host's probe
+  const auto devices = list_opencl_devices();
+  if (std::none_of(devices.begin(), devices.end(),
+                   [&](const ClDeviceInfo& d) { return d.type != "CPU" && ran_on(d); }))
+    return out;
+  ClCopyBandwidth copy = opencl_copy_bandwidth(bytes);  // the device the runs chose
+  if (copy.device.type == "CPU" || !ran_on(copy.device)) return out;
+  out.device = copy.device.platform + " / " + copy.device.device;
+  out.copy = copy;
+  return out;
+}
+
+/// The bandwidth a row is measured against: the device memory's for a run on a GPU (triad
+/// not measured there: NaN); else the host's, one thread for one CPU thread, else all.
+double copy_ref(const Row& r, const Bandwidth& bw, const DeviceMemory& dm) {
+  if (dm.copy.gbs > 0 && r.device == dm.device) return dm.copy.gbs;
   return r.backend == "cpu" && (r.threads == 1 || bw.threads == 1) ? bw.copy_one : bw.copy_all;
 }
-double triad_ref(const Row& r, const Bandwidth& bw) {
+double triad_ref(const Row& r, const Bandwidth& bw, const DeviceMemory& dm) {
+  if (dm.copy.gbs > 0 && r.device == dm.device) return std::nan("");
   return r.backend == "cpu" && (r.threads == 1 || bw.threads == 1) ? bw.triad_one : bw.triad_all;
 }
 
@@ -281,6 +312,8 @@ int bench(const BenchOptions& o) {
   }
   probe.round();
   const Bandwidth bw = probe.result();
+  const DeviceMemory dm =
+      device_memory(rows, static_cast<std::size_t>(o.stream_floats) * sizeof(float) * 4);
   const bool small = bw.llc_bytes > 0 && o.stream_floats * sizeof(float) < 4 * bw.llc_bytes;
 
   const auto& g = terrain.grid;
@@ -301,10 +334,18 @@ int bench(const BenchOptions& o) {
         json_number(bw.copy_all).c_str(), json_number(bw.copy_all_low).c_str(),
         json_number(bw.copy_all_high).c_str(), json_number(bw.triad_all).c_str(),
         json_number(bw.copy_one).c_str(), json_number(bw.triad_one).c_str());
+    if (dm.copy.gbs > 0)
+      std::printf(
+          " \"device_bandwidth\": {\"device\": %s, \"bytes_per_buffer\": %zu, "
+          "\"repetitions\": %d, \"copy_gbs\": %s, \"copy_gbs_lowest\": %s, "
+          "\"copy_gbs_highest\": %s},\n",
+          json_string(dm.device).c_str(), dm.copy.bytes, dm.copy.repetitions,
+          json_number(dm.copy.gbs).c_str(), json_number(dm.copy.gbs_low).c_str(),
+          json_number(dm.copy.gbs_high).c_str());
     std::printf(" \"results\": [\n");
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const auto& r = rows[k];
-      const double c = copy_ref(r, bw), t = triad_ref(r, bw);
+      const double c = copy_ref(r, bw, dm), t = triad_ref(r, bw, dm);
       std::printf(
           "  {\"backend\": %s, \"device\": %s, \"threads\": %d, \"process\": %s, "
           "\"seconds_per_step\": %s, \"cell_steps_per_second\": %s, \"bytes_per_cell\": %d, "
@@ -347,6 +388,12 @@ int bench(const BenchOptions& o) {
       small ? ", below 4x the last-level cache: cache-resident" : "", bw.copy_all, bw.copy_all_low,
       bw.copy_all_high, bw.triad_all, bw.threads, bw.threads == 1 ? "" : "s", bw.copy_one,
       bw.triad_one);
+  if (dm.copy.gbs > 0)
+    std::printf(
+        "device memory (%s: clEnqueueCopyBuffer, median of %d copies of %.0f MiB): copy %.1f "
+        "GB/s (%.1f to %.1f); that device's runs are set against it (no triad)\n",
+        dm.device.c_str(), dm.copy.repetitions, dm.copy.bytes / 1048576.0, dm.copy.gbs,
+        dm.copy.gbs_low, dm.copy.gbs_high);
   // Runs by a short label; their devices listed first.
   auto label = [](const Row& r) { return run_label(r); };
   std::string last;
@@ -358,11 +405,12 @@ int bench(const BenchOptions& o) {
   std::printf("%-10s %-12s %10s %14s %6s %8s %7s %7s\n", "run", "process", "ms/step",
               "cell-steps/s", "B/cell", "GB/s", "%copy", "%triad");
   for (const auto& r : rows) {
-    const double c = copy_ref(r, bw), t = triad_ref(r, bw);
+    const double c = copy_ref(r, bw, dm), t = triad_ref(r, bw, dm);
     if (r.bytes)
-      std::printf("%-10s %-12s %10.3f %14.4g %6d %8.2f %6.0f%% %6.0f%%\n", label(r).c_str(),
+      std::printf("%-10s %-12s %10.3f %14.4g %6d %8.2f %6.0f%% %7s\n", label(r).c_str(),
                   r.process.c_str(), 1e3 * r.seconds_per_step, r.cell_steps_per_second, r.bytes,
-                  r.gbs(), 100 * r.gbs() / c, 100 * r.gbs() / t);
+                  r.gbs(), 100 * r.gbs() / c,
+                  std::isnan(t) ? "-" : fmt::format("{:.0f}%", 100 * r.gbs() / t).c_str());
     else
       std::printf("%-10s %-12s %10.3f %14.4g %6s %8s %7s %7s\n", label(r).c_str(),
                   r.process.c_str(), 1e3 * r.seconds_per_step, r.cell_steps_per_second, "-", "-",

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,31 @@ TEST_F(CliTools, DevicesListsTheCpuReferenceAndWhatAutoPicks) {
     EXPECT_TRUE(contains(j.output, "\"max_work_group_size\"")) << j.output;
     EXPECT_TRUE(contains(j.output, "\"device\": \"" + devices.front().device + "\"")) << j.output;
   }
+}
+
+TEST(OpenClCopyBandwidth, CopiesOnTheDeviceTheBackendChooses) {
+  // `erodem bench` sets a GPU's kernels against this figure. It must come from the device the
+  // backend runs on, move what it says (two buffers no larger than a quarter of the device's
+  // memory) and be a rate: a probe that timed nothing (0) or an empty event (inf) fails.
+  if (!erodem::opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  const std::size_t want = std::size_t{64} << 20;
+  const auto bw = erodem::opencl_copy_bandwidth(want, 5);
+  const auto devices = erodem::list_opencl_devices();
+  bool gpu = false;
+  for (const auto& d : devices) gpu = gpu || d.gpu();
+  std::printf("[opencl copy] %s / %s (%s): %.1f GB/s (%.1f to %.1f), %zu bytes per buffer\n",
+              bw.device.platform.c_str(), bw.device.device.c_str(), bw.device.type.c_str(), bw.gbs,
+              bw.gbs_low, bw.gbs_high, bw.bytes);
+  EXPECT_EQ(bw.device.type, gpu ? "GPU" : devices.front().type);
+  EXPECT_EQ(bw.repetitions, 5);
+  EXPECT_LE(bw.bytes, want);
+  EXPECT_LE(bw.bytes, bw.device.global_memory / 4);
+  EXPECT_EQ(bw.bytes % 4096, 0u);
+  // Above 0.1 GB/s (64 MiB in 1.3 s: no device of the last twenty years is that slow) and
+  // below 100 TB/s (no memory is that fast: a timer that read zero would give inf).
+  EXPECT_TRUE(bw.gbs_low > 0.1 && bw.gbs_low <= bw.gbs && bw.gbs <= bw.gbs_high &&
+              bw.gbs_high < 1e5)
+      << bw.gbs_low << " " << bw.gbs << " " << bw.gbs_high;
 }
 
 TEST_F(CliTools, CompareIdenticalOutputsPasses) {
@@ -209,6 +235,26 @@ TEST_F(CliTools, BenchReportsRatesAndBandwidth) {
   EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 45,")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"bytes_per_cell\": 245,")) << r.output;
   EXPECT_TRUE(contains(r.output, "\"flow_scheme\": \"local_inertial\"")) << r.output;
+}
+
+TEST_F(CliTools, BenchSetsAGpuAgainstItsOwnMemory) {
+  // An OpenCL run on a GPU is set against the GPU memory's copy bandwidth (the host's says
+  // nothing of it) and has no triad figure; a run on PoCL, whose device is the host, stays set
+  // against the host's probe.
+  if (!erodem::opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  const auto r =
+      run_cli("bench --size 64 --steps 2 --backends opencl --stream-floats 1048576 --json", dir_);
+  ASSERT_EQ(r.code, 0) << r.output;
+  bool gpu = false;
+  for (const auto& d : erodem::list_opencl_devices()) gpu = gpu || d.gpu();
+  std::printf("[bench on %s] device_bandwidth %s\n", gpu ? "a GPU" : "PoCL",
+              contains(r.output, "\"device_bandwidth\"") ? "reported" : "not reported");
+  EXPECT_EQ(contains(r.output, "\"device_bandwidth\""), gpu) << r.output;
+  // a row of the byte model (not the per-step 'stats' rows with no bytes) without a triad
+  const std::regex modelled_without_triad(
+      "\"bytes_per_cell\": [1-9][0-9]*, \"gbs\": [^,]*, \"fraction_of_copy\": [0-9.e+-]+, "
+      "\"fraction_of_triad\": null");
+  EXPECT_EQ(std::regex_search(r.output, modelled_without_triad), gpu) << r.output;
 }
 
 TEST_F(CliTools, BenchRunsTheSchemesSetAndRejectsBadSettings) {

@@ -30,4 +30,10 @@ std::vector<DeviceEntry> enumerate_devices();
 /// The devices as "'<platform>:<device>' (<type>), ...", or "none", for messages.
 std::string describe(const std::vector<DeviceEntry>& devices);
 
+/// The device a backend runs on: the first that `selector` (ERODEM_OPENCL_DEVICE) matches, or
+/// without a selector the first GPU, else the first device. Throws Error (usage) when there is
+/// no device or the selector matches none.
+const DeviceEntry& choose_device(const std::vector<DeviceEntry>& devices,
+                                 const std::string& selector);
+
 }  // namespace erodem::opencl

@@ -44,33 +44,28 @@ RuntimeCache& runtime_cache() {
 
 }  // namespace
 
-std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width) {
-  RuntimeCache& cache = runtime_cache();
-  const auto devices = enumerate_devices();
+const DeviceEntry& choose_device(const std::vector<DeviceEntry>& devices,
+                                 const std::string& selector) {
   if (devices.empty())
     throw Error(ExitCode::usage,
                 "backend 'opencl': no OpenCL platform or device found (install an OpenCL "
                 "driver, e.g. pocl-opencl-icd or the GPU vendor's, or use --backend cpu)");
-  const DeviceEntry* chosen = nullptr;
   if (!selector.empty()) {
     for (const auto& d : devices)
-      if (opencl_selector_matches(d.info, selector)) {
-        chosen = &d;
-        break;
-      }
-    if (!chosen)
-      throw Error(ExitCode::usage,
-                  fmt::format("ERODEM_OPENCL_DEVICE='{}': no OpenCL device matches "
-                              "'<platform>:<device>'; devices: {}",
-                              selector, describe(devices)));
-  } else {
-    for (const auto& d : devices)
-      if (d.info.gpu()) {
-        chosen = &d;
-        break;
-      }
-    if (!chosen) chosen = &devices.front();
+      if (opencl_selector_matches(d.info, selector)) return d;
+    throw Error(ExitCode::usage, fmt::format("ERODEM_OPENCL_DEVICE='{}': no OpenCL device matches "
+                                             "'<platform>:<device>'; devices: {}",
+                                             selector, describe(devices)));
   }
+  for (const auto& d : devices)
+    if (d.info.gpu()) return d;
+  return devices.front();
+}
+
+std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width) {
+  RuntimeCache& cache = runtime_cache();
+  const auto devices = enumerate_devices();
+  const DeviceEntry* chosen = &choose_device(devices, selector);
 
   // Whole rows on CPU devices (PoCL vectorises across a row's work-items only where no
   // per-work-item condition guards the loads), unless a tuning size is set.

@@ -17,6 +17,9 @@ bool opencl_available() {
 std::size_t release_opencl_runtimes() {
   return 0;
 }
+ClCopyBandwidth opencl_copy_bandwidth(std::size_t, int) {
+  throw Error(ExitCode::usage, "the OpenCL copy bandwidth: this build has no OpenCL backend");
+}
 std::unique_ptr<Backend> make_opencl_backend(const Terrain&, const Params&) {
   throw Error(ExitCode::usage,
               "backend 'opencl': this build has no OpenCL backend (configure with "

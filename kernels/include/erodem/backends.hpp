@@ -51,6 +51,22 @@ struct ClDeviceInfo {
 /// built (ERODEM_OPENCL=OFF).
 std::vector<ClDeviceInfo> list_opencl_devices();
 
+/// The copy bandwidth of the OpenCL device a backend would run on (ERODEM_OPENCL_DEVICE, else
+/// the first GPU, else the first device), counted as STREAM's copy counts it: `bytes` read and
+/// `bytes` written by clEnqueueCopyBuffer between two buffers on the device, each copy timed
+/// by its profiling event; the median of `repetitions` copies after one untimed. `erodem
+/// bench` sets a GPU's kernels against this figure, since the host's says nothing of a GPU's
+/// memory. Throws Error (usage) without an OpenCL device.
+struct ClCopyBandwidth {
+  ClDeviceInfo device;
+  std::size_t bytes = 0;  ///< per buffer (the request, capped at a quarter of the device's)
+  int repetitions = 0;
+  double gbs = 0.0;      ///< median, 1e9 bytes/s, read + written
+  double gbs_low = 0.0;  ///< the slowest and fastest copy (GB/s)
+  double gbs_high = 0.0;
+};
+ClCopyBandwidth opencl_copy_bandwidth(std::size_t bytes, int repetitions = 9);
+
 /// Whether the OpenCL backend is built and at least one device is present.
 bool opencl_available();
 
