@@ -35,7 +35,9 @@ if ((${#missing[@]})); then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
-gdalinfo --formats | grep -q '^ *netCDF ' ||
+# (grep without -q: with -q it stops reading, gdalinfo dies of SIGPIPE, and pipefail reported
+# a GDAL with netCDF as one without)
+gdalinfo --formats | grep '^ *netCDF ' > /dev/null ||
   echo "setup: warning: this GDAL has no netCDF driver; netCDF gridded forcing and its tests fail"
 
 # Python readers the tests open result files with (h5py, xarray with h5netcdf).
