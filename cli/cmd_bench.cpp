@@ -101,8 +101,9 @@ int full_step_bytes(const std::vector<std::vector<Process>>& passes, const Backe
 /// to the end of its timing (setup included), and its device buffers.
 struct Memory {
   std::string run;
-  double peak_bytes = 0;    ///< VmHWM rise (bytes); 0 where /proc cannot say
-  double device_bytes = 0;  ///< Backend::device_bytes()
+  std::vector<KernelTime> kernels;  ///< device time per kernel (ERODEM_OPENCL_PROFILE=1)
+  double peak_bytes = 0;            ///< VmHWM rise (bytes); 0 where /proc cannot say
+  double device_bytes = 0;          ///< Backend::device_bytes()
   double cells = 1;
 };
 
@@ -185,6 +186,7 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
   memory.run = run_label(backend, threads);
   memory.peak_bytes = peak_known ? peak_resident_bytes() - resident0 : 0;
   memory.device_bytes = static_cast<double>(sim.backend().device_bytes());
+  memory.kernels = sim.backend().kernel_times();
   memory.cells = cells;
   std::vector<Row> rows;
   const std::string device = sim.backend().device();
@@ -372,7 +374,16 @@ int bench(const BenchOptions& o) {
           json_number(m.peak_bytes / m.cells).c_str(), json_number(m.device_bytes).c_str(),
           json_number(m.device_bytes / m.cells).c_str(), k + 1 < memory.size() ? "," : "");
     }
-    std::printf(" ]}\n");
+    std::printf(" ],\n \"kernel_times\": [");
+    bool first = true;
+    for (const auto& m : memory)
+      for (const auto& k : m.kernels) {
+        std::printf("%s\n  {\"run\": %s, \"kernel\": %s, \"calls\": %ld, \"seconds\": %s}",
+                    first ? "" : ",", json_string(m.run).c_str(), json_string(k.name).c_str(),
+                    k.calls, json_number(k.seconds).c_str());
+        first = false;
+      }
+    std::printf("%s]}\n", first ? "" : "\n ");
     return 0;
   }
   std::printf(
@@ -427,6 +438,23 @@ int bench(const BenchOptions& o) {
                                   m.device_bytes / 1048576.0, m.device_bytes / m.cells)
                           .c_str()
                     : "");
+  // ERODEM_OPENCL_PROFILE=1: the device time of each kernel and of the reads, over the whole
+  // run (warm-up, per-process and full steps), from the profiling events
+  for (const auto& m : memory) {
+    if (m.kernels.empty()) continue;
+    double total = 0;
+    for (const auto& k : m.kernels) total += k.seconds;
+    auto kernels = m.kernels;
+    std::sort(kernels.begin(), kernels.end(),
+              [](const KernelTime& a, const KernelTime& b) { return a.seconds > b.seconds; });
+    std::printf("%s: device time per kernel over the run (%.1f ms in all):\n", m.run.c_str(),
+                1e3 * total);
+    std::printf("  %-36s %8s %10s %12s %7s\n", "kernel", "calls", "ms", "us per call", "share");
+    for (const auto& k : kernels)
+      std::printf("  %-36s %8ld %10.3f %12.2f %6.1f%%\n", k.name.c_str(), k.calls, 1e3 * k.seconds,
+                  k.calls ? 1e6 * k.seconds / static_cast<double>(k.calls) : 0.0,
+                  total > 0 ? 100 * k.seconds / total : 0.0);
+  }
   return 0;
 }
 

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -255,6 +256,35 @@ TEST_F(CliTools, BenchSetsAGpuAgainstItsOwnMemory) {
       "\"bytes_per_cell\": [1-9][0-9]*, \"gbs\": [^,]*, \"fraction_of_copy\": [0-9.e+-]+, "
       "\"fraction_of_triad\": null");
   EXPECT_EQ(std::regex_search(r.output, modelled_without_triad), gpu) << r.output;
+}
+
+TEST_F(CliTools, BenchGivesTheDeviceTimePerKernelWhenProfiling) {
+  // ERODEM_OPENCL_PROFILE=1 puts a profiling event on every launch and read and books them per
+  // kernel name. The bench runs 3 warm-up steps and, in each of its 3 repetitions, --steps steps
+  // process by process and 3 x --steps full steps: 27 steps at --steps 2, so every kernel of
+  // the step ran at least 27 times, each for a time above 0. Without the variable: no list.
+  if (!erodem::opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  const std::string args =
+      "bench --size 64 --steps 2 --backends opencl --stream-floats 1048576 --json";
+  const auto plain = run_cli(args, dir_);
+  ASSERT_EQ(plain.code, 0) << plain.output;
+  EXPECT_TRUE(contains(plain.output, "\"kernel_times\": []")) << plain.output;
+  setenv("ERODEM_OPENCL_PROFILE", "1", 1);
+  const auto r = run_cli(args, dir_);
+  unsetenv("ERODEM_OPENCL_PROFILE");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* k : {"flow_local_inertial_split_interior", "sources_rain", "water_update",
+                        "erosion", "thermal_share", "field_stats", "stats_rows", "read"}) {
+    std::smatch m;
+    const std::regex entry(std::string("\"kernel\": \"") + k +
+                           "\", \"calls\": ([0-9]+), \"seconds\": ([0-9.e+-]+)");
+    ASSERT_TRUE(std::regex_search(r.output, m, entry)) << k << "\n" << r.output;
+    const long calls = std::stol(m[1].str());
+    const double seconds = std::stod(m[2].str());
+    std::printf("[kernel times] %-36s %5ld calls, %.3f ms\n", k, calls, 1e3 * seconds);
+    EXPECT_GE(calls, 27) << k;
+    EXPECT_GT(seconds, 0.0) << k;
+  }
 }
 
 TEST_F(CliTools, BenchRunsTheSchemesSetAndRejectsBadSettings) {

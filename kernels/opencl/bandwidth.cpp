@@ -50,13 +50,8 @@ ClCopyBandwidth opencl_copy_bandwidth(std::size_t bytes, int repetitions) {
     check(clEnqueueCopyBuffer(queue.get(), src, dst, 0, 0, out.bytes, 0, nullptr, &ev),
           "clEnqueueCopyBuffer");
     check(clWaitForEvents(1, &ev), "clWaitForEvents");
-    cl_ulong start = 0, end = 0;
-    check(clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr),
-          "clGetEventProfilingInfo");
-    check(clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr),
-          "clGetEventProfilingInfo");
-    clReleaseEvent(ev);
-    if (k > 0 && end > start) gbs.push_back(2.0 * out.bytes / static_cast<double>(end - start));
+    const double seconds = take_event_seconds(ev);
+    if (k > 0 && seconds > 0) gbs.push_back(2e-9 * out.bytes / seconds);
   }
   if (gbs.empty()) return out;
   std::sort(gbs.begin(), gbs.end());

@@ -96,7 +96,8 @@ void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1) {
   const std::size_t offset[2] = {0, static_cast<std::size_t>(y0)};
   const std::size_t global[2] = {groups_x_ * local_x_, static_cast<std::size_t>(y1 - y0)};
   const std::size_t local[2] = {local_x_, 1};
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel");
 }
 
@@ -107,13 +108,15 @@ void OpenClBackend::launch_edge_tallies(int slot, Real dt) {
            flux_[2], flux_[3], sediment_, depth_next_, dt, cl_int{slot}, tally_partials_,
            static_cast<cl_int>(tally_stride_));
   const std::size_t global = edge_groups_ * edge_local_, local = edge_local_;
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel(edge_tallies)");
 }
 
 void OpenClBackend::launch_reduction(cl_kernel k, std::size_t groups) {
   const std::size_t global = groups * reduce_local_, local = reduce_local_;
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel");
 }
 

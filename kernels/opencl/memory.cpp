@@ -56,7 +56,7 @@ Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
 
 void OpenClBackend::read(const Buffer& b, std::size_t bytes, void* dst, bool blocking) {
   check(clEnqueueReadBuffer(queue_.get(), b.get(), blocking ? CL_TRUE : CL_FALSE, 0, bytes, dst, 0,
-                            nullptr, nullptr),
+                            nullptr, profile_event("read")),
         "clEnqueueReadBuffer");
 }
 
@@ -147,9 +147,9 @@ void OpenClBackend::enqueue_gather(const Buffer& cells, std::size_t n,
     for (std::size_t j = 0; j < kGatherParts; ++j)  // unused parameters: any buffer
       set_arg(k, static_cast<cl_uint>(5 + j), *parts[first + std::min(j, count - 1)]);
     const std::size_t global = n;
-    check(
-        clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
-        "clEnqueueNDRangeKernel(gather_cells)");
+    check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
+                                 profile_event(k)),
+          "clEnqueueNDRangeKernel(gather_cells)");
   }
 }
 

@@ -68,7 +68,10 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
   cl_int err = CL_SUCCESS;
-  queue_ = Queue(clCreateCommandQueue(rt_->context.get(), rt_->device, 0, &err));
+  const char* profile_env = std::getenv("ERODEM_OPENCL_PROFILE");
+  profiling_ = profile_env && *profile_env && std::string(profile_env) != "0";
+  queue_ = Queue(clCreateCommandQueue(rt_->context.get(), rt_->device,
+                                      profiling_ ? CL_QUEUE_PROFILING_ENABLE : 0, &err));
   check(err, "clCreateCommandQueue");
   acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
 
@@ -273,7 +276,8 @@ void OpenClBackend::exchange_halo(const Buffer& b) {
   cl_kernel k = kernel("halo_periodic_x");
   set_args(k, cl_int{W_}, cl_int{H_}, b);
   const std::size_t global = static_cast<std::size_t>(H_);
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel(halo_periodic_x)");
 }
 
@@ -310,7 +314,8 @@ void OpenClBackend::measure_faces(bool sediment) {
            sediment_, depth_next_, flux_[0], flux_[1], flux_[2], flux_[3],
            sediment ? face_sediment_out_ : face_water_out_);
   const std::size_t global = face_count_;
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel(section_faces)");
   (sediment ? face_sediment_done_ : face_water_done_) = true;
 }
@@ -319,7 +324,8 @@ void OpenClBackend::run_boundary() {
   cl_kernel k = kernel("boundary_fill");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, cell_.boundary);
   const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel(boundary_fill)");
 }
 
@@ -373,7 +379,8 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   set_args(k, depth_, sediment_, point_cells_, point_amounts_, static_cast<cl_int>(cells_h.size()),
            cl_int{sediment ? 1 : 0});
   const std::size_t one = 1;
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &one, nullptr, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &one, nullptr, 0, nullptr,
+                               profile_event(k)),
         "clEnqueueNDRangeKernel(sources_points)");
 }
 
@@ -444,7 +451,7 @@ void OpenClBackend::run_flow(Real dt) {
                flux_[1], face_x_, dt, cell_.flow);
       const std::size_t rows = static_cast<std::size_t>(H_);
       check(clEnqueueNDRangeKernel(queue_.get(), seam, 1, nullptr, &rows, nullptr, 0, nullptr,
-                                   nullptr),
+                                   profile_event(seam)),
             "clEnqueueNDRangeKernel(flow_local_inertial_seam_x)");
     }
     for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
@@ -536,6 +543,55 @@ void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
 void OpenClBackend::finish() {
   // (the step's tallies stay on the device: end_step reads them with the statistics)
   check(clFinish(queue_.get()), "clFinish");
+  resolve_profile(false);
+}
+
+OpenClBackend::~OpenClBackend() {
+  if (profile_pending_.empty()) return;
+  clFinish(queue_.get());
+  for (auto& [name, ev] : profile_pending_)
+    if (ev) clReleaseEvent(ev);
+}
+
+cl_event* OpenClBackend::profile_event(const std::string& name) {
+  if (!profiling_) return nullptr;
+  // a long run without finish(): book what is pending (waiting for it) to bound the list
+  if (profile_pending_.size() >= 4096) resolve_profile(true);
+  profile_pending_.emplace_back(name, nullptr);
+  return &profile_pending_.back().second;
+}
+
+cl_event* OpenClBackend::profile_event(cl_kernel k) {
+  if (!profiling_) return nullptr;
+  auto it = kernel_names_.find(k);
+  if (it == kernel_names_.end()) {
+    std::size_t size = 0;
+    check(clGetKernelInfo(k, CL_KERNEL_FUNCTION_NAME, 0, nullptr, &size), "clGetKernelInfo");
+    std::string name(size, '\0');
+    check(clGetKernelInfo(k, CL_KERNEL_FUNCTION_NAME, size, name.data(), nullptr),
+          "clGetKernelInfo");
+    while (!name.empty() && name.back() == '\0') name.pop_back();
+    it = kernel_names_.emplace(k, name).first;
+  }
+  return profile_event(it->second);
+}
+
+void OpenClBackend::resolve_profile(bool wait) {
+  for (auto& [name, ev] : profile_pending_) {
+    if (!ev) continue;
+    if (wait) check(clWaitForEvents(1, &ev), "clWaitForEvents");
+    KernelTime& t = profile_[name];
+    t.name = name;
+    t.calls += 1;
+    t.seconds += take_event_seconds(ev);
+  }
+  profile_pending_.clear();
+}
+
+std::vector<KernelTime> OpenClBackend::kernel_times() const {
+  std::vector<KernelTime> out;
+  for (const auto& [name, t] : profile_) out.push_back(t);
+  return out;
 }
 
 FieldStats OpenClBackend::stats() {
@@ -577,6 +633,7 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   }
   stats_sums_raw_.resize(static_cast<std::size_t>(rows) * kStatsRowValues * acc_size_);
   read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
+  resolve_profile(false);  // the blocking read: every command before it has completed
   deliver_tallies();
   if (probes)
     *probes =

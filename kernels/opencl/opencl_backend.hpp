@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -31,6 +32,18 @@ namespace erodem::opencl {
 const char* error_name(cl_int code);
 /// Throws Error(ExitCode::internal) naming `what` and the error when code != CL_SUCCESS.
 void check(cl_int code, const char* what);
+
+/// The device time of a completed command (s), from its profiling event (end - start; 0 when
+/// the device reports none), and the event released.
+inline double take_event_seconds(cl_event ev) {
+  cl_ulong start = 0, end = 0;
+  check(clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr),
+        "clGetEventProfilingInfo");
+  check(clGetEventProfilingInfo(ev, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr),
+        "clGetEventProfilingInfo");
+  clReleaseEvent(ev);
+  return end > start ? 1e-9 * static_cast<double>(end - start) : 0.0;
+}
 
 /// Owns one OpenCL object and releases it once (move-only).
 template <class T, cl_int(CL_API_CALL* Release)(T)>
@@ -130,6 +143,7 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
 class OpenClBackend final : public Backend {
  public:
   OpenClBackend(const Terrain& terrain, const Params& params, const std::string& selector = "");
+  ~OpenClBackend() override;  // releases the profiling events still pending
 
   std::string name() const override { return "opencl"; }
   std::string device() const override;
@@ -143,6 +157,7 @@ class OpenClBackend final : public Backend {
   void set_faces(const std::vector<Face>& faces) override;
   std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   void finish() override;
+  std::vector<KernelTime> kernel_times() const override;
   std::vector<double> field(FieldId id) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
 
@@ -187,6 +202,12 @@ class OpenClBackend final : public Backend {
   void launch_reduction(cl_kernel k, std::size_t groups);
   /// Enqueues a read of `bytes` of `b` into `dst`; blocking or not.
   void read(const Buffer& b, std::size_t bytes, void* dst, bool blocking);
+  /// Where profiling (ERODEM_OPENCL_PROFILE=1): an event slot for the command about to be
+  /// enqueued, booked under `name` once resolved; else nullptr (no event).
+  cl_event* profile_event(const std::string& name);
+  cl_event* profile_event(cl_kernel k);
+  /// Books the device time of the completed commands' events (all of them after a wait).
+  void resolve_profile(bool wait);
   /// `count` accumulator values (double or float on the device, as read) as doubles.
   std::vector<double> acc_values(const std::vector<unsigned char>& raw, std::size_t count) const;
 
@@ -223,6 +244,13 @@ class OpenClBackend final : public Backend {
   /// The statistics of the current state with one wait, the pending tallies read and
   /// delivered with them (and, with `probes`, the probe samples into it).
   FieldStats collect(std::vector<double>* probes);
+
+  // ERODEM_OPENCL_PROFILE=1: the queue profiles, every launch and read takes an event, and
+  // finish() and end_step() book their device time per kernel name (kernel_times()).
+  bool profiling_ = false;
+  std::vector<std::pair<std::string, cl_event>> profile_pending_;
+  std::map<std::string, KernelTime> profile_;
+  std::map<cl_kernel, std::string> kernel_names_;
 
   Params params_;
   CellParams<float> cell_;  // the processes' run constants (cell_params.hpp)

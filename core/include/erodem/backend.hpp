@@ -110,6 +110,13 @@ void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const c
 /// Error(ExitCode::usage) for a face off the grid.
 std::vector<int> padded_faces(const std::vector<Face>& faces, int nx, int ny);
 
+/// Device time of one kernel (or of the reads: "read"), summed since the backend was built.
+struct KernelTime {
+  std::string name;
+  long calls = 0;
+  double seconds = 0;  ///< device time, from the profiling events (end - start)
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -160,6 +167,10 @@ class Backend {
   virtual std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const = 0;
   /// Waits until every process run so far has finished (for timing; a no-op on the CPU).
   virtual void finish() {}
+  /// Device time per kernel and for the reads, where the backend measures it (OpenCL with
+  /// ERODEM_OPENCL_PROFILE=1: a profiling event on every launch and read; `erodem bench`
+  /// prints them), by name; empty elsewhere. Complete after finish().
+  virtual std::vector<KernelTime> kernel_times() const { return {}; }
   /// A field of the DEM grid, row-major (ny, nx), converted to double.
   virtual std::vector<double> field(FieldId id) const = 0;
   /// Replaces a field of the DEM grid (row-major (ny, nx)).
