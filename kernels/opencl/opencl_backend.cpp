@@ -174,6 +174,16 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   }
   groups_x_ = (static_cast<std::size_t>(W_) + local_x_ - 1) / local_x_;
   interior_groups_ = groups_x_ * static_cast<std::size_t>(H_ - 2);
+  if (!rt_->whole_rows) {
+    // field_stats in row launches (stats.cl): a power of two of at most
+    // ERODEM_STATS_GROUP_MAX work-items per row, no more than the row's interior cells
+    std::size_t wg = 0;
+    check(clGetKernelWorkGroupInfo(kernel("field_stats"), rt_->device, CL_KERNEL_WORK_GROUP_SIZE,
+                                   sizeof(wg), &wg, nullptr),
+          "clGetKernelWorkGroupInfo");
+    stats_local_ = pow2_at_most(std::min(
+        {kStatsGroupMax, rt_->max_work_group, wg, static_cast<std::size_t>(std::max(W_ - 2, 1))}));
+  }
   partial_a_ = make_buffer(interior_groups_ * 5 * acc_size_);  // field_stats, per group
   partial_cells_ = make_buffer(interior_groups_ * 3 * sizeof(cl_long));
   row_sums_ = make_buffer(static_cast<std::size_t>(H_ - 2) * kStatsRowValues * acc_size_);
@@ -602,11 +612,21 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   cl_kernel k = kernel("field_stats");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, depth_, sediment_, velocity_x_,
            velocity_y_, area_, partial_a_, partial_cells_);
-  launch_interior(k);
   const int rows = H_ - 2;
+  if (stats_local_ == 0) {
+    launch_interior(k);  // whole rows: a cell kernel, groups_x_ partials per row
+  } else {               // one group of stats_local_ work-items per row: one partial per row
+    const std::size_t offset[2] = {0, 1};
+    const std::size_t global[2] = {stats_local_, static_cast<std::size_t>(rows)};
+    const std::size_t local[2] = {stats_local_, 1};
+    check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr,
+                                 profile_event(k)),
+          "clEnqueueNDRangeKernel(field_stats)");
+  }
+  const std::size_t partials_per_row = stats_local_ == 0 ? groups_x_ : 1;
   cl_kernel r = kernel("stats_rows");
-  set_args(r, cl_int{W_}, cl_int{rows}, static_cast<cl_int>(groups_x_), partial_a_, partial_cells_,
-           velocity_x_, velocity_y_, row_sums_, row_cells_);
+  set_args(r, cl_int{W_}, cl_int{rows}, static_cast<cl_int>(partials_per_row), partial_a_,
+           partial_cells_, velocity_x_, velocity_y_, row_sums_, row_cells_);
   launch_reduction(r, (static_cast<std::size_t>(rows) + reduce_local_ - 1) / reduce_local_);
   // The step's tallies with the statistics: one wait per step (the queue is in order).
   enqueue_tally_reduction();

@@ -265,6 +265,9 @@ class OpenClBackend final : public Backend {
   // size rounded up to whole groups where local_x_ does not divide the row), interior_groups_
   // over rows 1 .. H - 2 (launch_interior; the tally kernels: one partial per group).
   std::size_t local_x_ = 1, groups_x_ = 1, interior_groups_ = 1;
+  // field_stats' work-items per row where it runs in row launches (rounded launches, GPUs;
+  // stats.cl); 0: a cell kernel like the others (whole rows, CPU devices)
+  std::size_t stats_local_ = 0;
   // The active cells beside a ghost (edge_tallies): padded indices, in groups of edge_local_.
   Buffer edge_cells_;
   std::size_t edge_count_ = 0, edge_local_ = 1, edge_groups_ = 1;

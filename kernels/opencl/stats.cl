@@ -167,20 +167,30 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
   cells[3 * g + 2] = bad;
 }
 
-/* The field statistics over the active cells: a cell kernel over rows 1 .. H - 2 (the host's
- * launch), one work-item per padded cell, work-groups of (L, 1) inside one row (L <=
- * ERODEM_CELL_GROUP_MAX), g = group x + (y - 1) * groups per row. Per group: sums[5 g + k] =
- * water, material, sediment volume, max depth, max squared speed (-1 where the group has no
- * candidate); cells[3 g + k] = the DEM cell (row * nx + col) of the max depth, of the max
- * speed, and the first cell whose state is not physical (-1: none). stats_rows combines them
- * per row. Two ways, the same maxima and cells, the sums in another order:
- *  - whole rows (ERODEM_WHOLE_ROWS, CPU devices): each work-item stores its cell's values in
- *    local memory as they are (floats); one work-item then sums them in acc_t, in eight lanes
- *    (see cell_tallies_sum), and multiplies by the row's cell area: the area is one number per
- *    row (field_stats_group). PoCL runs that walk as vector loops;
- *  - rounded launches (GPUs: work-groups of a power of two): a tree in local memory, every
- *    work-item at work. On a GPU the one work-item's walk left the group's others waiting: the
- *    statistics took half of an H200's step (2.3 of 4.7 ms at 4096^2, 2026-11-27). */
+/* The largest work-group of field_stats in the row launches (the host's stats_local_). */
+#define ERODEM_STATS_GROUP_MAX 256
+
+/* The field statistics over the active cells of padded rows 1 .. H - 2. Per work-group g:
+ * sums[5 g + k] = water, material, sediment volume, max depth, max squared speed (-1 where
+ * the group has no candidate); cells[3 g + k] = the DEM cell (row * nx + col) of the max
+ * depth, of the max speed, and the first cell whose state is not physical (-1: none).
+ * stats_rows combines them per row. Two launches, the same maxima and cells, the sums in
+ * another order:
+ *  - whole rows (ERODEM_WHOLE_ROWS, CPU devices): a cell kernel (launch_interior), one
+ *    work-item per padded cell in groups of (L, 1) inside one row (L <= ERODEM_CELL_GROUP_MAX),
+ *    g = group x + (y - 1) * groups per row. Each work-item stores its cell's values in local
+ *    memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
+ *    cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row
+ *    (field_stats_group). PoCL runs that walk as vector loops;
+ *  - row launches (GPUs): one work-group of L <= ERODEM_STATS_GROUP_MAX work-items per row,
+ *    g = y - 1 (stats_rows sees one group per row). Work-item l walks the row's columns
+ *    1 + l, 1 + l + L, ... (neighbouring work-items read neighbouring cells), keeping its own
+ *    sums and its first largest values; a tree in local memory then merges the L work-items',
+ *    every work-item at work. On an H200 (2026-11-27) a cell kernel with one work-item per
+ *    group walking the group's values took half of the step (2.3 of 4.7 ms at 4096^2), and a
+ *    tree over every cell (eight trees of 128 values per 128 cells, each level behind a
+ *    barrier, 32 KiB of local memory per group) still 0.88 ms, 11 % of the device's copy
+ *    bandwidth for its 25 bytes per cell. */
 __kernel void field_stats(
     int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
     __global const real* restrict bed_residual, __global const real* restrict depth,
@@ -191,19 +201,10 @@ __kernel void field_stats(
   __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_r[ERODEM_CELL_GROUP_MAX],
       s_s[ERODEM_CELL_GROUP_MAX], s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
   __local int s_state[ERODEM_CELL_GROUP_MAX];
-#else
-  __local acc_t s_sum[ERODEM_CELL_GROUP_MAX], s_v2[ERODEM_CELL_GROUP_MAX];
-  __local real s_d[ERODEM_CELL_GROUP_MAX];
-  __local int s_at_d[ERODEM_CELL_GROUP_MAX], s_at_v[ERODEM_CELL_GROUP_MAX],
-      s_bad[ERODEM_CELL_GROUP_MAX];
-#endif
   const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
-  /* work-items past the row (rounded global sizes only) read the row's first cell */
-  const int i = ERODEM_PAST_ROW(x, W) ? y * W : x + y * W;
-  const int active =
-      !ERODEM_PAST_ROW(x, W) & (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
+  const int i = x + y * W;
+  const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   const real d = depth[i], b = bed[i], sd = sediment[i];
-#ifdef ERODEM_WHOLE_ROWS
   /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
   s_d[l] = active ? d : (real)0;
   s_b[l] = active ? b : (real)0;
@@ -224,25 +225,62 @@ __kernel void field_stats(
                       (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0), s_d,
                       s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
 #else
-  /* The rounded launch's tree: the group's maxima as (value, local id) pairs, the larger value
-   * or, between equal ones, the smaller id (the first of equals, as the row scan takes it: the
-   * pairwise rule is associative, so the tree gives the scan's cell and its own value, -0
-   * included); a candidate is an active cell whose value is above -1 (the scan's start: no NaN,
-   * no depth of -1 or below); the first bad cell the smallest id. The four sums by
-   * reduce_local_sum, one after another through one array (a fixed tree: the same bits from
-   * run to run, not the whole-rows walk's). Local memory: 32 bytes per work-item (32 KiB at
-   * ERODEM_CELL_GROUP_MAX), within every device's 32 KiB minimum. */
-  const acc_t u = active ? (acc_t)velocity_x[i] : 0, v = active ? (acc_t)velocity_y[i] : 0;
-  const acc_t v2 = u * u + v * v; /* exact in double for float velocities */
-  s_d[l] = d;
-  s_at_d[l] = active && d > (real)(-1) ? l : INT_MAX;
-  s_v2[l] = v2;
-  s_at_v[l] = active && v2 > (acc_t)(-1) ? l : INT_MAX;
-  s_bad[l] = active && !cell_state_ok(b, d, sd) ? l : INT_MAX;
-  for (int stride = (int)get_local_size(0) / 2; stride > 0; stride >>= 1) {
+  /* The row launch. The maxima as (value, column) pairs: a work-item's columns come in
+   * increasing order and only a strictly larger value replaces, so it keeps its first largest;
+   * the tree takes the larger value or, between equal ones, the smaller column. That rule is
+   * associative, so the result is the row scan's cell with its own value (-0 included). A
+   * candidate is an active cell whose value is above -1 (the scan's start: no NaN, no depth of
+   * -1 or below); the first bad cell the smallest column. The four sums: each work-item's in
+   * column order, then the tree's fixed order (the same bits from run to run for one L, not
+   * the whole-rows walk's). Local memory: 56 bytes per work-item (14 KiB at L = 256). */
+  __local acc_t s_water[ERODEM_STATS_GROUP_MAX], s_bed[ERODEM_STATS_GROUP_MAX],
+      s_res[ERODEM_STATS_GROUP_MAX], s_sed[ERODEM_STATS_GROUP_MAX], s_v2[ERODEM_STATS_GROUP_MAX];
+  __local real s_d[ERODEM_STATS_GROUP_MAX];
+  __local int s_at_d[ERODEM_STATS_GROUP_MAX], s_at_v[ERODEM_STATS_GROUP_MAX],
+      s_bad[ERODEM_STATS_GROUP_MAX];
+  const int l = (int)get_local_id(0), L = (int)get_local_size(0);
+  const int y = (int)get_global_id(1); /* the padded row */
+  (void)H;
+  acc_t water = 0, bed_sum = 0, res = 0, sed = 0, best_v2 = -1;
+  real best_d = -1;
+  int at_d = INT_MAX, at_v = INT_MAX, bad = INT_MAX;
+  for (int x = 1 + l; x <= W - 2; x += L) {
+    const int i = x + y * W;
+    if (kind[i] != ERODEM_CELL_ACTIVE) continue;
+    const real d = depth[i], b = bed[i], sd = sediment[i];
+    water += (acc_t)d;
+    bed_sum += (acc_t)b;
+    res += (acc_t)bed_residual[i];
+    sed += (acc_t)sd;
+    if (d > best_d) { /* best_d starts at -1: the scan's start */
+      best_d = d;
+      at_d = x;
+    }
+    const acc_t u = (acc_t)velocity_x[i], v = (acc_t)velocity_y[i];
+    const acc_t v2 = u * u + v * v; /* exact in double for float velocities */
+    if (v2 > best_v2) {
+      best_v2 = v2;
+      at_v = x;
+    }
+    if (bad == INT_MAX && !cell_state_ok(b, d, sd)) bad = x;
+  }
+  s_water[l] = water;
+  s_bed[l] = bed_sum;
+  s_res[l] = res;
+  s_sed[l] = sed;
+  s_d[l] = best_d;
+  s_at_d[l] = at_d;
+  s_v2[l] = best_v2;
+  s_at_v[l] = at_v;
+  s_bad[l] = bad;
+  for (int stride = L / 2; stride > 0; stride >>= 1) {
     barrier(CLK_LOCAL_MEM_FENCE);
     if (l < stride) {
       const int o = l + stride;
+      s_water[l] += s_water[o];
+      s_bed[l] += s_bed[o];
+      s_res[l] += s_res[o];
+      s_sed[l] += s_sed[o];
       if (s_at_d[o] != INT_MAX && (s_at_d[l] == INT_MAX || s_d[o] > s_d[l] ||
                                    (s_d[o] == s_d[l] && s_at_d[o] < s_at_d[l]))) {
         s_d[l] = s_d[o];
@@ -256,25 +294,13 @@ __kernel void field_stats(
       s_bad[l] = min(s_bad[l], s_bad[o]);
     }
   }
-  /* the sums: water, bed, its residual, sediment (inactive cells add +0) */
-  acc_t total[4];
-  const acc_t mine[4] = {active ? (acc_t)d : 0, active ? (acc_t)b : 0,
-                         active ? (acc_t)bed_residual[i] : 0, active ? (acc_t)sd : 0};
-  for (int k = 0; k < 4; ++k) {
-    s_sum[l] = mine[k];
-    reduce_local_sum(s_sum); /* opens and closes with a barrier */
-    total[k] = s_sum[0];
-    barrier(CLK_LOCAL_MEM_FENCE); /* every work-item has read s_sum[0] before the next */
-  }
   if (l == 0) {
-    const int row = (int)(get_group_id(1) + get_global_offset(1));
-    const int x0 = (int)(get_group_id(0) * get_local_size(0) + get_global_offset(0));
-    const int g = (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
-    const long row_cell = (long)(row - 1) * (long)(W - 2) - 1 + (long)x0; /* cell of local id 0 */
-    const acc_t a = (acc_t)area[row];
-    sums[5 * g + 0] = total[0] * a;
-    sums[5 * g + 1] = ((total[1] + total[2]) + total[3]) * a; /* the bed pair (compensated.h) */
-    sums[5 * g + 2] = total[3] * a;
+    const int g = y - 1;
+    const long row_cell = (long)(y - 1) * (long)(W - 2) - 1; /* the DEM cell of column 0 */
+    const acc_t a = (acc_t)area[y];
+    sums[5 * g + 0] = s_water[0] * a;
+    sums[5 * g + 1] = ((s_bed[0] + s_res[0]) + s_sed[0]) * a; /* the bed pair (compensated.h) */
+    sums[5 * g + 2] = s_sed[0] * a;
     sums[5 * g + 3] = s_at_d[0] == INT_MAX ? (acc_t)(-1) : (acc_t)s_d[0];
     sums[5 * g + 4] = s_at_v[0] == INT_MAX ? (acc_t)(-1) : s_v2[0];
     cells[3 * g + 0] = s_at_d[0] == INT_MAX ? -1 : row_cell + s_at_d[0];
