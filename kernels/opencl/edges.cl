@@ -21,6 +21,7 @@ __kernel void edge_tallies(
     __global const real* restrict sediment, __global const real* restrict depth_flow, real dt,
     int slot, __global acc_t* restrict partials, int stride) {
   __local real s[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int e = (int)get_global_id(0);
   real v = 0;
   if (e < count) {
@@ -30,5 +31,5 @@ __kernel void edge_tallies(
             : transport_boundary_out_cell(i, W, kind, sediment, depth_flow, f_left, f_right, f_top,
                                           f_bottom, dt);
   }
-  cell_group_sum(s, v, partials + slot * stride + (int)get_group_id(0));
+  cell_group_sum(s, s_lanes, v, partials + slot * stride + (int)get_group_id(0));
 }

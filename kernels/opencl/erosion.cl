@@ -15,13 +15,14 @@ __kernel void erosion(int W, int H, __global const uchar* restrict kind,
                       __global const real* restrict dy, __global const real* restrict area, real dt,
                       ErosionParams p, __global acc_t* restrict partials, int stride) {
   __local real s_eroded[ERODEM_CELL_GROUP_MAX], s_deposited[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real eroded = 0, deposited = 0;
   if (!ERODEM_PAST_ROW(x, W))
     erosion_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, sediment, depth, velocity_x,
                        velocity_y, hardness, dx, dy, area, dt, p, &eroded, &deposited);
   const int g = cell_group_index();
-  cell_group_sum2(s_eroded, s_deposited, eroded, deposited,
+  cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
                   partials + ERODEM_TALLY_ERODED * stride + g,
                   partials + ERODEM_TALLY_DEPOSITED * stride + g);
 }
@@ -41,6 +42,7 @@ __kernel void erosion_physical(
     __global acc_t* restrict partials, int stride) {
   __local real s_eroded[ERODEM_CELL_GROUP_MAX], s_deposited[ERODEM_CELL_GROUP_MAX],
       s_rock[ERODEM_CELL_GROUP_MAX], s_bulking[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real eroded = 0, deposited = 0, rock = 0, bulking = 0;
   if (!ERODEM_PAST_ROW(x, W))
@@ -48,10 +50,10 @@ __kernel void erosion_physical(
                         velocity_x, velocity_y, manning, hardness, dx, dy, area, dt, p, &eroded,
                         &deposited, &rock, &bulking);
   const int g = cell_group_index();
-  cell_group_sum2(s_eroded, s_deposited, eroded, deposited,
+  cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
                   partials + ERODEM_TALLY_ERODED * stride + g,
                   partials + ERODEM_TALLY_DEPOSITED * stride + g);
-  cell_group_sum2(s_rock, s_bulking, rock, bulking,
+  cell_group_sum2(s_rock, s_bulking, s_lanes, rock, bulking,
                   partials + ERODEM_TALLY_ERODED_BEDROCK * stride + g,
                   partials + ERODEM_TALLY_BED_BULKING * stride + g);
 }

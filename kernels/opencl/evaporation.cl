@@ -11,9 +11,11 @@ __kernel void evaporation(int W, int H, __global const uchar* kind, __global rea
                           __global real* wetness, __global const real* area, real dt,
                           EvaporationParams p, __global acc_t* partials, int stride) {
   __local real s[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real lost = 0;
   if (!ERODEM_PAST_ROW(x, W))
     evaporation_sweep_cell(x, y, W, kind, depth, wetness, area, dt, p, &lost);
-  cell_group_sum(s, lost, partials + ERODEM_TALLY_EVAPORATED * stride + cell_group_index());
+  cell_group_sum(s, s_lanes, lost,
+                 partials + ERODEM_TALLY_EVAPORATED * stride + cell_group_index());
 }

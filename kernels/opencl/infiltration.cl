@@ -14,12 +14,14 @@ __kernel void infiltration(int W, int H, __global const uchar* restrict kind,
                            real dt, InfiltrationParams p, __global acc_t* restrict partials,
                            int stride) {
   __local real s_in[ERODEM_CELL_GROUP_MAX], s_drained[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real taken = 0, drained = 0;
   if (!ERODEM_PAST_ROW(x, W))
     infiltration_sweep_cell(x, y, W, kind, depth, infiltrated, ksat, suction, store, area, dt, p,
                             &taken, &drained);
   const int g = cell_group_index();
-  cell_group_sum2(s_in, s_drained, taken, drained, partials + ERODEM_TALLY_INFILTRATED * stride + g,
+  cell_group_sum2(s_in, s_drained, s_lanes, taken, drained,
+                  partials + ERODEM_TALLY_INFILTRATED * stride + g,
                   partials + ERODEM_TALLY_SOIL_DRAINED * stride + g);
 }

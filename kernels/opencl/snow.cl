@@ -9,25 +9,28 @@
  * every work-item still reaches the group sums): CELL(x, y, W, kind, TEMPERATURE, ...), its
  * four volumes summed per work-group into the tally slots. The two snow kernels differ only in
  * the cell function and its temperature input (the bed, or the air_temperature field). */
-#define ERODEM_SNOW_KERNEL(NAME, CELL, TEMPERATURE)                                               \
-  __kernel void NAME(int W, int H, __global const uchar* restrict kind,                           \
-                     __global const real* restrict TEMPERATURE,                                   \
-                     __global const real* restrict rain_factor, __global real* restrict snow,     \
-                     __global real* restrict liquid, __global real* restrict depth,               \
-                     __global const real* restrict area, real dt, SnowParams p,                   \
-                     __global acc_t* restrict partials, int stride) {                             \
-    __local real s_fall[ERODEM_CELL_GROUP_MAX], s_rain[ERODEM_CELL_GROUP_MAX];                    \
-    __local real s_melt[ERODEM_CELL_GROUP_MAX], s_out[ERODEM_CELL_GROUP_MAX];                     \
-    const int x = (int)get_global_id(0), y = (int)get_global_id(1);                               \
-    real fall = 0, rain = 0, melted = 0, out = 0;                                                 \
-    if (!ERODEM_PAST_ROW(x, W))                                                                   \
-      CELL(x, y, W, kind, TEMPERATURE, rain_factor, snow, liquid, depth, area, dt, p, &fall,      \
-           &rain, &melted, &out);                                                                 \
-    const int g = cell_group_index();                                                             \
-    cell_group_sum2(s_fall, s_rain, fall, rain, partials + ERODEM_TALLY_SNOWFALL * stride + g,    \
-                    partials + ERODEM_TALLY_RAIN_ON_SNOW * stride + g);                           \
-    cell_group_sum2(s_melt, s_out, melted, out, partials + ERODEM_TALLY_SNOW_MELTED * stride + g, \
-                    partials + ERODEM_TALLY_SNOW_RUNOFF * stride + g);                            \
+#define ERODEM_SNOW_KERNEL(NAME, CELL, TEMPERATURE)                                           \
+  __kernel void NAME(int W, int H, __global const uchar* restrict kind,                       \
+                     __global const real* restrict TEMPERATURE,                               \
+                     __global const real* restrict rain_factor, __global real* restrict snow, \
+                     __global real* restrict liquid, __global real* restrict depth,           \
+                     __global const real* restrict area, real dt, SnowParams p,               \
+                     __global acc_t* restrict partials, int stride) {                         \
+    __local real s_fall[ERODEM_CELL_GROUP_MAX], s_rain[ERODEM_CELL_GROUP_MAX];                \
+    __local real s_melt[ERODEM_CELL_GROUP_MAX], s_out[ERODEM_CELL_GROUP_MAX];                 \
+    __local acc_t s_lanes[ERODEM_TALLY_LANES];                                                \
+    const int x = (int)get_global_id(0), y = (int)get_global_id(1);                           \
+    real fall = 0, rain = 0, melted = 0, out = 0;                                             \
+    if (!ERODEM_PAST_ROW(x, W))                                                               \
+      CELL(x, y, W, kind, TEMPERATURE, rain_factor, snow, liquid, depth, area, dt, p, &fall,  \
+           &rain, &melted, &out);                                                             \
+    const int g = cell_group_index();                                                         \
+    cell_group_sum2(s_fall, s_rain, s_lanes, fall, rain,                                      \
+                    partials + ERODEM_TALLY_SNOWFALL * stride + g,                            \
+                    partials + ERODEM_TALLY_RAIN_ON_SNOW * stride + g);                       \
+    cell_group_sum2(s_melt, s_out, s_lanes, melted, out,                                      \
+                    partials + ERODEM_TALLY_SNOW_MELTED * stride + g,                         \
+                    partials + ERODEM_TALLY_SNOW_RUNOFF * stride + g);                        \
   }
 
 /* T_ref + lapse (bed - z_ref) (snow_sweep_cell) */

@@ -29,10 +29,12 @@ __kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
                             __global real* restrict bed_out, ThermalParams p,
                             __global acc_t* restrict partials, int stride) {
   __local real s_sum[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real moved = 0;
   if (!ERODEM_PAST_ROW(x, W))
     thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, wetness, talus, share, dx,
                              dy, area, p, &moved);
-  cell_group_sum(s_sum, moved, partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index());
+  cell_group_sum(s_sum, s_lanes, moved,
+                 partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index());
 }

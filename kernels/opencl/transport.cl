@@ -14,13 +14,14 @@ __kernel void transport_conservative(
     __global const real* restrict f_top, __global const real* restrict f_bottom,
     __global const real* restrict area, real dt, __global acc_t* restrict partials, int stride) {
   __local real s_sum[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real given = 0;
   real carried; /* edge_tallies sums it over the cells beside ghosts (unused here) */
   if (!ERODEM_PAST_ROW(x, W))
     transport_conservative_sweep_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left,
                                       f_right, f_top, f_bottom, area, dt, &carried, &given);
-  cell_group_sum(s_sum, given,
+  cell_group_sum(s_sum, s_lanes, given,
                  partials + ERODEM_TALLY_SEDIMENT_EXCHANGED * stride + cell_group_index());
 }
 

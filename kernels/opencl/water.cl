@@ -21,13 +21,15 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
                            __global real* restrict velocity_x, __global real* restrict velocity_y,
                            real dt, WaterParams p, __global acc_t* restrict partials, int stride) {
   __local real s_clipped[ERODEM_CELL_GROUP_MAX], s_given[ERODEM_CELL_GROUP_MAX];
+  __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real exchange, clipped = 0, given = 0; /* exchange: edge_tallies (unused here) */
   if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, bed, depth, depth_out, f_left, f_right, f_top, f_bottom, dx,
                       dy, area, velocity_x, velocity_y, dt, p, &exchange, &clipped, &given);
   const int g = cell_group_index();
-  cell_group_sum2(s_clipped, s_given, clipped, given, partials + ERODEM_TALLY_CLIPPED * stride + g,
+  cell_group_sum2(s_clipped, s_given, s_lanes, clipped, given,
+                  partials + ERODEM_TALLY_CLIPPED * stride + g,
                   partials + ERODEM_TALLY_WATER_EXCHANGED * stride + g);
 }
 
