@@ -233,9 +233,8 @@ struct DeviceMemory {
 DeviceMemory device_memory(const std::vector<Row>& rows, std::size_t bytes) {
   DeviceMemory out;
   auto ran_on = [&](const ClDeviceInfo& d) {
-    return std::any_of(rows.begin(), rows.end(), [&](const Row& r) {
-      return r.backend != "cpu" && r.device == d.platform + " / " + d.device;
-    });
+    return std::any_of(rows.begin(), rows.end(),
+                       [&](const Row& r) { return r.backend != "cpu" && r.device == d.label(); });
   };
   // PoCL's device is the host: its runs stay set against the host's probe
   const auto devices = list_opencl_devices();
@@ -244,7 +243,7 @@ DeviceMemory device_memory(const std::vector<Row>& rows, std::size_t bytes) {
     return out;
   ClCopyBandwidth copy = opencl_copy_bandwidth(bytes);  // the device the runs chose
   if (copy.device.type == "CPU" || !ran_on(copy.device)) return out;
-  out.device = copy.device.platform + " / " + copy.device.device;
+  out.device = copy.device.label();
   out.copy = copy;
   return out;
 }

@@ -69,9 +69,7 @@ int devices(const DevicesOptions& o) {
   const bool built = false;
 #endif
   auto chosen_name = [&] {
-    if (choice.backend == "opencl")
-      return list[static_cast<std::size_t>(choice.device)].platform + " / " +
-             list[static_cast<std::size_t>(choice.device)].device;
+    if (choice.backend == "opencl") return list[static_cast<std::size_t>(choice.device)].label();
     if (choice.backend == "cpu") return std::string("CPU reference");
     return std::string("none");
   };

@@ -213,7 +213,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 }
 
 std::string OpenClBackend::device() const {
-  return rt_->info.platform + " / " + rt_->info.device;
+  return rt_->info.label();
 }
 
 void OpenClBackend::begin_step(const StepInputs& in) {

@@ -45,6 +45,8 @@ struct ClDeviceInfo {
   std::string version;             ///< CL_DEVICE_VERSION
   std::string driver;              ///< CL_DRIVER_VERSION
   bool gpu() const { return type == "GPU"; }
+  /// "<platform> / <device>": how Backend::device() names an OpenCL backend's device
+  std::string label() const { return platform + " / " + device; }
 };
 
 /// Every OpenCL device of every platform; empty when there is none or the backend is not
