@@ -18,6 +18,11 @@
 #  - pipes: the pipe model with erosion and thermal;
 #  - shallow_water: second-order shallow water (two stages a step, 2-row halo) with
 #    boundary.periodic_x (the periodic columns and the bands' rows together);
+#  - water_cycle: every other process that reads or writes across cells, each of whose halo
+#    fields must be exchanged or may not be (process.hpp neighbour_read_fields): local
+#    inertial, Mei's erosion law with hardness noise, a snow pack that melts and slides,
+#    Green-Ampt infiltration, evaporation, wet thermal collapse, and terrain classes every 5
+#    steps whose tables set the Manning n and the talus angle;
 #  - restart: the erosion scenario run to step 20 on 3 ranks, continued from that file to
 #    step 40 on 2 ranks and on 4, and on one process from a file written by 4 ranks, each
 #    against the serial run of 40 steps;
@@ -112,12 +117,21 @@ edge = "south"
 EOF
     ;;
   pipes) sets=(--set flow.scheme=pipes --set boundary.east=open) ;;
+  water_cycle)
+    sets=(--set erosion.law=mei --set erosion.hardness=noise --set erosion.noise_scale=100
+      --set snow.enabled=true --set snow.initial=0.05 --set snow.air_temperature=3
+      --set snow.slide_angle=20 --set snow.slide_rate=0.01 --set infiltration.enabled=true
+      --set evaporation.rate=1e-4 --set thermal.wet_talus_angle=20
+      --set terrain_classes.enabled=true --set terrain_classes.interval=5
+      --set terrain_classes.grass.manning_n=0.04 --set terrain_classes.rock.talus_angle=40
+      --set terrain_classes.mud.manning_n=0.05)
+    ;;
   shallow_water)
     sets=(--set flow.scheme=shallow_water --set flow.order=2 --set boundary.periodic_x=true)
     ;;
   refusals) ;;
   *)
-    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, restart, refusals)"
+    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, water_cycle, restart, refusals)"
     exit 2
     ;;
 esac

@@ -320,6 +320,53 @@ TEST(Periodic, HaloFieldsAreWhatASweepWrites) {
   }
 }
 
+// What the halo exchanges (process.hpp neighbour_read_fields, halo_fields(sweep, needed)): the
+// fields a sweep reads at a neighbour, and no other. The lists follow from the process table's
+// accesses; a field missing here that a sweep reads at a neighbour would make the MPI bands
+// and the periodic seam differ from the whole grid (tests/mpi.sh, this file's agreement tests),
+// a field present that none reads only costs bytes.
+TEST(Periodic, HaloExchangesOnlyWhatIsReadAtANeighbour) {
+  auto has = [](const std::vector<std::string>& v, const char* f) {
+    return std::find(v.begin(), v.end(), f) != v.end();
+  };
+  Params p;
+  p.flow.scheme = FlowScheme::local_inertial;
+  p.erosion.enabled = true;
+  p.thermal.enabled = true;
+  const auto needed = neighbour_read_fields(p);
+  for (const char* f : {"bed", "water_depth", "flux_left", "flux_right", "flux_top", "flux_bottom",
+                        "manning_n", "sediment", "depth_flow", "thermal_share", "wetness"})
+    EXPECT_TRUE(has(needed, f)) << f;
+  for (const char* f :
+       {"kind", "velocity_x", "velocity_y", "bed_residual", "soil_thickness", "hardness"})
+    EXPECT_FALSE(has(needed, f)) << f;
+  for (const auto& [process, sweep] : step_sweeps(p)) {
+    const auto fields = halo_fields(sweep, needed);
+    if (std::string(sweep.name) == "water_update") {
+      EXPECT_EQ(fields, (std::vector<std::string>{"water_depth", "depth_flow"}));
+    }
+    if (std::string(sweep.name) == "erosion_physical") {
+      EXPECT_EQ(fields, (std::vector<std::string>{"bed", "sediment"}));
+    }
+    if (std::string(sweep.name) == "thermal_apply") {
+      EXPECT_EQ(fields, std::vector<std::string>{"bed"});
+    }
+  }
+  // water only, pipes: no sediment moves, no Manning n at the faces
+  Params w;
+  w.flow.scheme = FlowScheme::pipes;
+  const auto water = neighbour_read_fields(w);
+  EXPECT_FALSE(has(water, "sediment"));
+  EXPECT_FALSE(has(water, "manning_n"));
+  EXPECT_FALSE(has(water, "depth_flow"));
+  EXPECT_TRUE(has(water, "flux_left"));
+  // a section's faces read the far cell's outflows, sediment and flow depth
+  w.section.push_back({"across", {{{0.0, 5.0}}, {{100.0, 5.0}}}});
+  const auto with_section = neighbour_read_fields(w);
+  EXPECT_TRUE(has(with_section, "sediment"));
+  EXPECT_TRUE(has(with_section, "depth_flow"));
+}
+
 // ---- lat/lon grids ----------------------------------------------------------------------
 
 const char* kWgs84 =

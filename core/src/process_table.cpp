@@ -18,7 +18,7 @@ namespace erodem {
 namespace {
 
 constexpr Access R = Access::read, N = Access::read_neighbours, Wr = Access::write,
-                 U = Access::update;
+                 U = Access::update, UN = Access::update_neighbours;
 
 bool always(const Params&) {
   return true;
@@ -56,9 +56,10 @@ SweepInfo generic_sweep(const char* name, std::vector<FieldUse> uses,
 
 std::vector<SweepInfo> boundary_sweeps(const Params& p) {
   // boundary_fill_cell (boundary.h): the ghosts take the bed and depth their edge gives them
+  // (the edge cell's and the one inside it: neighbours of the ghost)
   std::vector<SweepInfo> s{{"boundary_fill",
                             Domain::halo,
-                            {{"kind", R}, {"bed", U}, {"water_depth", U}, {"sediment", U}},
+                            {{"kind", N}, {"bed", UN}, {"water_depth", UN}, {"sediment", U}},
                             {"boundary_fill"}}};
   if (!p.boundary.stage.empty())
     // boundary_level_sweep_cell (boundary.h): the cells held at the level inside the grid
@@ -85,8 +86,11 @@ std::vector<SweepInfo> sources_sweeps(const Params& p) {
 }
 
 std::vector<SweepInfo> flow_sweeps(const Params& p) {
+  // the outflows: the pipes update each cell's own; a local-inertial face reads the discharges
+  // of the faces beside it (two cells along its axis)
+  const Access fa = p.flow.scheme == FlowScheme::local_inertial ? UN : U;
   const std::vector<FieldUse> fluxes{
-      {"flux_left", U}, {"flux_right", U}, {"flux_top", U}, {"flux_bottom", U}};
+      {"flux_left", fa}, {"flux_right", fa}, {"flux_top", fa}, {"flux_bottom", fa}};
   if (p.flow.scheme == FlowScheme::shallow_water) {
     // shallow_water_cell (shallow_water.h): the four faces of each cell (Chen & Noelle
     // reconstruction, HLLC) give its outflows and its new unit discharges
@@ -95,8 +99,8 @@ std::vector<SweepInfo> flow_sweeps(const Params& p) {
              {{"kind", N},
               {"bed", N},
               {"water_depth", N},
-              {"momentum_x", U},
-              {"momentum_y", U},
+              {"momentum_x", UN},  // the faces' states from the neighbours' unit discharges
+              {"momentum_y", UN},
               {"manning_n", R},
               {"flux_left", Wr},
               {"flux_right", Wr},
@@ -130,7 +134,7 @@ std::vector<SweepInfo> water_sweeps(const Params& p) {
                             Domain::cells,
                             {{"kind", N},
                              {"bed", N},
-                             {"water_depth", U},
+                             {"water_depth", UN},  // the faces' flow depths
                              {"flux_left", N},
                              {"flux_right", N},
                              {"flux_top", N},
@@ -154,13 +158,14 @@ std::vector<SweepInfo> water_sweeps(const Params& p) {
 }
 
 std::vector<SweepInfo> erosion_sweeps(const Params& p) {
+  // both read the bed (and the kinds) of the four neighbours for the bed's slope
   if (p.erosion.law == ErosionLaw::physical)
     // sediment_cell (erosion.h): the bed shear stress and the bed's slope, the surface layer's
     // closure, the exact exchange over the step, Exner with the layer's porosity
     return {{"erosion_physical",
              Domain::cells,
-             {{"kind", R},
-              {"bed", U},
+             {{"kind", N},
+              {"bed", UN},  // the bed's slope
               {"bed_residual", U},
               {"sediment", U},
               {"soil_thickness", U},
@@ -174,8 +179,8 @@ std::vector<SweepInfo> erosion_sweeps(const Params& p) {
   // between the bed pair and the sediment
   return {{"erosion",
            Domain::cells,
-           {{"kind", R},
-            {"bed", U},
+           {{"kind", N},
+            {"bed", UN},  // the bed's slope
             {"bed_residual", U},
             {"sediment", U},
             {"water_depth", R},
@@ -192,7 +197,7 @@ std::vector<SweepInfo> transport_sweeps(const Params& p) {
     return {{"transport_conservative",
              Domain::cells,
              {{"kind", N},
-              {"sediment", U},
+              {"sediment", UN},
               {"depth_flow", N},
               {"flux_left", N},
               {"flux_right", N},
@@ -202,7 +207,7 @@ std::vector<SweepInfo> transport_sweeps(const Params& p) {
   // transport_semi_lagrangian_cell (transport.h): back-traced along the velocity
   return {{"transport_semi_lagrangian",
            Domain::cells,
-           {{"kind", N}, {"sediment", U}, {"velocity_x", R}, {"velocity_y", R}},
+           {{"kind", N}, {"sediment", UN}, {"velocity_x", R}, {"velocity_y", R}},
            {"transport_semi_lagrangian"}}};
 }
 
@@ -217,7 +222,7 @@ std::vector<SweepInfo> thermal_sweeps(const Params& p) {
        {"thermal_share"}},
       {"thermal_apply",
        Domain::cells,
-       {{"kind", N}, {"bed", U}, {"bed_residual", U}, {"wetness", N}, {"thermal_share", N}},
+       {{"kind", N}, {"bed", UN}, {"bed_residual", U}, {"wetness", N}, {"thermal_share", N}},
        {"thermal_apply"}}};
   if (class_tables(p).talus) {
     s[0].uses.push_back({"talus_slope", R});
@@ -571,9 +576,10 @@ SweepInfo pass_sweep(const std::vector<Process>& pass, const Params& params) {
         }
         // read first, written later: an update; written first: a write (later reads hit the
         // cache); read twice: one read
-        const bool writes = u.access == Access::write || u.access == Access::update;
-        if (writes && (it->access == Access::read || it->access == Access::read_neighbours))
-          it->access = Access::update;
+        if (writes(u.access) && !writes(it->access))
+          it->access = reads_neighbours(it->access) || reads_neighbours(u.access)
+                           ? Access::update_neighbours
+                           : Access::update;
       }
     }
   return out;
@@ -602,8 +608,33 @@ std::vector<std::string> halo_fields(const SweepInfo& sweep) {
     if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
   };
   for (const auto& u : sweep.uses)
-    if (u.access == Access::write || u.access == Access::update) add(u.field);
+    if (writes(u.access)) add(u.field);
   for (const char* f : sweep.leaves) add(f);
+  return out;
+}
+
+std::vector<std::string> neighbour_read_fields(const Params& params) {
+  std::vector<std::string> out;
+  auto add = [&](const std::string& f) {
+    if (f == "kind" || f == "dx" || f == "dy" || f == "area") return;
+    if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
+  };
+  for (const auto& [p, s] : step_sweeps(params))
+    for (const auto& u : s.uses)
+      if (reads_neighbours(u.access)) add(u.field);
+  // the faces of sections and outlets (Backend::end_step, sections.h) read the far cell
+  if (!params.section.empty() || !params.outlet.empty())
+    for (const char* f :
+         {"flux_left", "flux_right", "flux_top", "flux_bottom", "sediment", "depth_flow"})
+      add(f);
+  return out;
+}
+
+std::vector<std::string> halo_fields(const SweepInfo& sweep,
+                                     const std::vector<std::string>& needed) {
+  std::vector<std::string> out;
+  for (const std::string& f : halo_fields(sweep))
+    if (std::find(needed.begin(), needed.end(), f) != needed.end()) out.push_back(f);
   return out;
 }
 
@@ -614,8 +645,7 @@ bool sweeps_write(const Params& params, const std::string& field, bool cells_onl
   for (const auto& [p, s] : step_sweeps(params))
     if (s.domain == Domain::cells || !cells_only)
       for (const auto& u : s.uses)
-        if (field == u.field && (u.access == Access::write || u.access == Access::update))
-          return true;
+        if (field == u.field && writes(u.access)) return true;
   return false;
 }
 
@@ -638,7 +668,7 @@ SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes) {
       b.read += size;
       b.reads += (b.reads.empty() ? "" : " ") + std::string(u.field);
     }
-    if (u.access == Access::write || u.access == Access::update) {
+    if (writes(u.access)) {
       b.write += size;
       b.writes += (b.writes.empty() ? "" : " ") + std::string(u.field);
     }

@@ -64,6 +64,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                                             nx_, ny_));
   PaddedState state = build_padded_state(terrain, params);
   periodic_ = state.periodic_x;
+  halo_needed_ = neighbour_read_fields(params);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
@@ -263,7 +264,7 @@ void OpenClBackend::run(Process p) {
   // the generic sweeps of the process (SweepInfo::generic), after its own loops, and the halo
   // exchange after every sweep (run_thermal and run_flow exchange between their own passes)
   run_sweeps_tail(
-      process_info(p).sweeps(params_), periodic_,
+      process_info(p).sweeps(params_), periodic_, halo_needed_,
       [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
       [&](const std::vector<std::string>& names) { exchange_halo(names); });
 }

@@ -259,6 +259,8 @@ class OpenClBackend final : public Backend {
   std::vector<std::pair<std::string, Kernel>> kernels_;
   int nx_, ny_, W_, H_;
   bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
+  // What the halo exchanges after a sweep may hold (process.hpp neighbour_read_fields)
+  std::vector<std::string> halo_needed_;
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
   // The cell kernels' groups: (local_x_, 1) work-items, groups_x_ per padded row (the global

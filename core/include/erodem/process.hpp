@@ -8,6 +8,7 @@
 // added.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -22,11 +23,23 @@ namespace erodem {
 
 /// How a sweep touches a field.
 enum class Access : std::uint8_t {
-  read,             ///< its own cell
-  read_neighbours,  ///< its own cell and its four neighbours
-  write,            ///< writes its own cell, without reading the old value
-  update,           ///< reads the old value (and possibly the neighbours') and writes the new one
+  read,               ///< its own cell
+  read_neighbours,    ///< its own cell and its neighbours (the four, or further: a halo)
+  write,              ///< writes its own cell, without reading the old value
+  update,             ///< reads its own cell's old value and writes the new one
+  update_neighbours,  ///< reads the old values of its own cell and its neighbours (a second
+                      ///< buffer, or rows behind) and writes its own cell's new one
 };
+
+/// Whether a sweep that touches a field this way writes it.
+constexpr bool writes(Access a) {
+  return a == Access::write || a == Access::update || a == Access::update_neighbours;
+}
+/// Whether a sweep that touches a field this way reads it at a neighbouring cell: the halo
+/// cells of that field must then hold the neighbours' current values (halo_fields).
+constexpr bool reads_neighbours(Access a) {
+  return a == Access::read_neighbours || a == Access::update_neighbours;
+}
 
 /// Which cells a sweep visits: the cells of the DEM (every interior row), the ghost cells
 /// around them, a list of point cells (inflows), or none per cell (bookkeeping only).
@@ -158,21 +171,51 @@ void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps);
 /// Backend::run's loop over the process's sweeps (CpuBackend, OpenClBackend after_sweep).
 std::vector<std::string> halo_fields(const SweepInfo& sweep);
 
+/// The fields that something reads at a neighbouring cell in a step of `params`: those that a
+/// sweep of the step (any domain) reads with read_neighbours or update_neighbours, and, with
+/// sections or outlets, what their faces read at the far cell (sections.h: the four outflows,
+/// the sediment, depth_flow); never the grid inputs. Only these need their halo cells current:
+/// a field no one reads at a neighbour is read in the halo by nothing that reaches an owned
+/// cell, so its halo may hold what the rank computed there itself (docs/mpi.md).
+std::vector<std::string> neighbour_read_fields(const Params& params);
+
+/// halo_fields(sweep) less what `needed` (neighbour_read_fields) does not hold: what the
+/// backends exchange after the sweep.
+std::vector<std::string> halo_fields(const SweepInfo& sweep,
+                                     const std::vector<std::string>& needed);
+
 /// The tail of Backend::run(p) in both backends, the one place of the halo exchange: after the
 /// process's own loops (which exchange in between where a pass reads what an earlier one of
 /// theirs wrote), the exchange of their sweeps' fields; then each generic sweep of `sweeps`
-/// (`run_generic(sweep)`) and its exchange (`exchange(halo_fields(sweep))`). `halo`: whether
-/// the halo is shared (boundary.periodic_x, MPI bands); without it only the generic sweeps run.
+/// (`run_generic(sweep)`) and its exchange (`exchange(halo_fields(sweep, needed))`). `halo`:
+/// whether the halo is shared (boundary.periodic_x, MPI bands); without it only the generic
+/// sweeps run. `needed`: neighbour_read_fields of the run's parameters.
 template <class RunGeneric, class Exchange>
-void run_sweeps_tail(const std::vector<SweepInfo>& sweeps, bool halo, const RunGeneric& run_generic,
+void run_sweeps_tail(const std::vector<SweepInfo>& sweeps, bool halo,
+                     const std::vector<std::string>& needed, const RunGeneric& run_generic,
                      const Exchange& exchange) {
+  auto exchange_written = [&](const SweepInfo& s, const std::vector<std::string>& done) {
+    std::vector<std::string> fields;
+    for (const std::string& f : halo_fields(s, needed))
+      if (std::find(done.begin(), done.end(), f) == done.end()) fields.push_back(f);
+    if (!fields.empty()) exchange(fields);
+  };
   if (halo)
-    for (const SweepInfo& s : sweeps)
-      if (!s.generic) exchange(halo_fields(s));
+    for (std::size_t k = 0; k < sweeps.size(); ++k) {
+      if (sweeps[k].generic) continue;
+      // what a later sweep of the process reads at a neighbour and leaves as it is, the
+      // process's own loop has exchanged already (thermal's shares before it applies them)
+      std::vector<std::string> done;
+      for (std::size_t j = k + 1; j < sweeps.size(); ++j)
+        if (!sweeps[j].generic)
+          for (const FieldUse& u : sweeps[j].uses)
+            if (reads_neighbours(u.access) && !writes(u.access)) done.emplace_back(u.field);
+      exchange_written(sweeps[k], done);
+    }
   for (const SweepInfo& s : sweeps)
     if (s.generic) {
       run_generic(s);
-      if (halo) exchange(halo_fields(s));
+      if (halo) exchange_written(s, {});
     }
 }
 
