@@ -31,9 +31,10 @@ void set_args(cl_kernel k, const Args&... args) {
   (set_arg(k, index++, args), ...);
 }
 
-constexpr std::size_t kReduceMax = 256;      // ERODEM_REDUCE_MAX of stats.cl
-constexpr std::size_t kCellGroupMax = 1024;  // ERODEM_CELL_GROUP_MAX of reduce.cl
-constexpr std::size_t kStatsGroupMax = 256;  // ERODEM_STATS_GROUP_MAX of stats.cl
+constexpr std::size_t kReduceMax = 256;        // ERODEM_REDUCE_MAX of stats.cl
+constexpr std::size_t kCellGroupMax = 1024;    // ERODEM_CELL_GROUP_MAX of reduce.cl: whole rows
+constexpr std::size_t kRoundedGroupMax = 256;  // and in rounded launches
+constexpr std::size_t kStatsGroupMax = 256;    // ERODEM_STATS_GROUP_MAX of stats.cl
 constexpr std::size_t kReduceGroupsMax = 1024;
 constexpr std::size_t kGatherParts = 6;  // the parts gather_cells (stats.cl) takes a launch
 

@@ -153,7 +153,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // grid (the tallies' partials, summed in a fixed order). Where a kernel accepts less than the
   // device's maximum, the whole-row divisor may be small: still correct, slower.
   const bool cpu = rt_->info.type == "CPU";
-  std::size_t cell_limit = std::min(kCellGroupMax, rt_->max_work_group);
+  std::size_t cell_limit =
+      std::min(rt_->whole_rows ? kCellGroupMax : kRoundedGroupMax, rt_->max_work_group);
   for (const std::string& name : opencl_cell_kernels()) {  // from the process table
     std::size_t wg = 0;
     check(clGetKernelWorkGroupInfo(kernel(name.c_str()), rt_->device, CL_KERNEL_WORK_GROUP_SIZE,

@@ -57,8 +57,17 @@ typedef int8 acc8_mask_t;
   (void)stride;                                                   \
   if (ERODEM_PAST_ROW(x, W)) return
 
-/* The largest work-group of the cell kernels (the host's local size is at most this). */
+/* The largest work-group of the cell kernels (the host's local size is at most this, and
+ * their local arrays hold this many values): a whole-row divisor on CPU devices; in the rounded
+ * launches (GPUs: 128 unless ERODEM_OPENCL_WG says otherwise; 256 and 512 were no faster on an
+ * H200) 256, so a kernel's local arrays take a quarter of the memory (the snow kernels' four
+ * tally arrays and their lanes: 4.1 KiB instead of 16.1; Oclgrind, counting the two snow
+ * kernels together, refused 33 KiB against its 32). */
+#ifdef ERODEM_WHOLE_ROWS
 #define ERODEM_CELL_GROUP_MAX 1024
+#else
+#define ERODEM_CELL_GROUP_MAX 256
+#endif
 
 /* The tally slots of the partials buffer: ERODEM_TALLY_<NAME> for each tally of ERODEM_TALLIES
  * (core/include/erodem/ledger.hpp), its index there, and ERODEM_TALLY_SLOTS, their number, are
