@@ -217,6 +217,9 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   diag_.material_volume = stats_.material_volume;
   diag_.max_depth = stats_.max_depth;
   diag_.max_speed = stats_.max_speed;
+  // the backend holds the state, the rain and temperature series their bands: from here on
+  // the terrain is its grid and mask
+  terrain_.release_cell_inputs();
 }
 
 void Simulation::describe_grid() {

@@ -76,6 +76,18 @@ struct Terrain {
   std::vector<std::string> notes;
 
   bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
+
+  /// Frees the per-cell inputs (the bed, the parameter rasters, the rain and temperature
+  /// bands, the initial snow) once a backend holds them: the grid, the mask, the band times,
+  /// the source and the notes stay. Simulation calls it at the end of its constructor (8 B
+  /// per cell of the bed in double, and 8 B per cell of each raster and band).
+  void release_cell_inputs() {
+    for (auto* v : {&bed, &water_depth, &manning_n, &hardness, &rain_factor, &soil_thickness, &ksat,
+                    &suction, &moisture_deficit, &soil_depth, &boundary_code, &snow_initial})
+      std::vector<double>().swap(*v);
+    std::vector<std::vector<double>>().swap(rain_grids);
+    std::vector<std::vector<double>>().swap(temperature_grids);
+  }
 };
 
 }  // namespace erodem

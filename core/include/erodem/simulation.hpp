@@ -132,6 +132,9 @@ class Simulation {
   const Diagnostics& diagnostics() const { return diag_; }
   const FieldStats& last_stats() const { return current_stats(); }
   const Params& params() const { return params_; }
+  /// The grid, mask, source and notes of the terrain it was made from; its per-cell inputs
+  /// (the bed, the rasters, the bands) are freed once the backend holds them
+  /// (Terrain::release_cell_inputs): read the state through field().
   const Terrain& terrain() const { return terrain_; }
   const Grid& grid() const { return terrain_.grid; }
   /// The backend, to change the state with: the statistics are taken again before the next
