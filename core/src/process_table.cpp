@@ -601,12 +601,20 @@ void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps) {
   }
 }
 
+namespace {
+
+/// Adds `field` to `out` once, but not the grid inputs that no sweep writes (the kinds and
+/// the per-row sizes): the lists of the halo exchange.
+void add_halo_field(std::vector<std::string>& out, const std::string& field) {
+  if (field == "kind" || field == "dx" || field == "dy" || field == "area") return;
+  if (std::find(out.begin(), out.end(), field) == out.end()) out.push_back(field);
+}
+
+}  // namespace
+
 std::vector<std::string> halo_fields(const SweepInfo& sweep) {
   std::vector<std::string> out;
-  auto add = [&](const std::string& f) {
-    if (f == "kind" || f == "dx" || f == "dy" || f == "area") return;
-    if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
-  };
+  auto add = [&](const std::string& f) { add_halo_field(out, f); };
   for (const auto& u : sweep.uses)
     if (writes(u.access)) add(u.field);
   for (const char* f : sweep.leaves) add(f);
@@ -615,10 +623,7 @@ std::vector<std::string> halo_fields(const SweepInfo& sweep) {
 
 std::vector<std::string> neighbour_read_fields(const Params& params) {
   std::vector<std::string> out;
-  auto add = [&](const std::string& f) {
-    if (f == "kind" || f == "dx" || f == "dy" || f == "area") return;
-    if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
-  };
+  auto add = [&](const std::string& f) { add_halo_field(out, f); };
   for (const auto& [p, s] : step_sweeps(params))
     for (const auto& u : s.uses)
       if (reads_neighbours(u.access)) add(u.field);
