@@ -45,6 +45,12 @@ class FieldRegistry {
   }
   /// Whether field `id` has storage of its own now (a member, or made on first use).
   bool made(FieldId id) const { return storage_[static_cast<std::size_t>(id)] != nullptr; }
+  /// Whether field `id` reads as zeros because it is not made yet: a reader that can supply
+  /// the zeros itself (field()) then needs no array of them (peek makes one, 4 B per cell).
+  bool reads_zeros(FieldId id) const {
+    const auto k = static_cast<std::size_t>(id);
+    return !storage_[k] && lazy_[k];
+  }
   /// Whether setting field `id` to `values` can leave it unmade: it is not made yet and every
   /// value is +0, what its reads give already (a restart of a run without snow writes the
   /// snow pack's zeros, which then need no array).

@@ -180,6 +180,35 @@ INSTANTIATE_TEST_SUITE_P(
                     FusedCase{FlowScheme::pipes, Precision::float32, 3, false}),
     case_name);
 
+// Local inertial and pipes write the new outflows over the old ones (flow.cpp): a block of
+// rows takes the unit discharges it needs of its neighbours' rows before a barrier. Blocks
+// of every size, down to one row (31 threads for the 31 padded rows) and empty ones (40),
+// give the bits of one thread, fused or not. Bound: 0 differing values; a unit discharge
+// read after the neighbouring block wrote its row changes that face's discharge, and the
+// depths and outflows beside it, from the next step on.
+TEST(InPlaceFlow, EveryBlockSizeGivesTheBitsOfOneThread) {
+  const Target target{"cpu", Precision::float32};
+  for (const FlowScheme flow : {FlowScheme::local_inertial, FlowScheme::pipes})
+    for (const bool fused : {false, true}) {
+      auto one = make_simulation(valley(), valley_params(flow, Precision::float32, 1, fused, true),
+                                 target);
+      one.run();
+      for (const int threads : {2, 5, 13, 31, 40}) {
+        auto many = make_simulation(
+            valley(), valley_params(flow, Precision::float32, threads, fused, true), target);
+        many.run();
+        std::size_t total = 0;
+        for (const auto& f : field_table()) total += differing(many.field(f.id), one.field(f.id));
+        std::printf(
+            "[in-place flow] %s%s, %d threads against 1: %zu field values differ (bound "
+            "0)\n",
+            flow == FlowScheme::pipes ? "pipes" : "local inertial", fused ? ", fused" : "", threads,
+            total);
+        EXPECT_EQ(total, 0u) << threads << " threads";
+      }
+    }
+}
+
 TEST(FusedPasses, TheTableCutsTheSequenceIntoPasses) {
   Params p;
   p.erosion.enabled = true;

@@ -325,20 +325,17 @@ double snow_line_share(double z, const Params::Snow& sn) {
 
 /// The initial pack: snow.initial (uniform or its raster) on the active cells, times
 /// snow_line_share of their bed, where the bed's slope is below snow.max_slope (when given).
-std::vector<std::pair<FieldId, std::vector<double>>> snow_initial(const Terrain& t,
-                                                                  const Params& p) {
+std::vector<InitialField> snow_initial(const Terrain& t, const Params& p) {
   const auto& sn = p.snow;
-  std::vector<double> snow(t.bed.size(), 0.0);
-  for (int r = 0; r < t.grid.ny; ++r)
-    for (int c = 0; c < t.grid.nx; ++c) {
-      const std::size_t i = static_cast<std::size_t>(r) * t.grid.nx + c;
-      if (!t.active(i)) continue;
-      if (sn.max_slope && !(bed_slope_degrees(t, c, r) < *sn.max_slope)) continue;
-      const double share = snow_line_share(t.bed[i], sn);
-      const double s0 = t.snow_initial.empty() ? sn.initial.value : t.snow_initial[i];
-      if (share > 0) snow[i] = share == 1.0 ? s0 : s0 * share;
-    }
-  return {{FieldId::snow, std::move(snow)}};
+  return {{FieldId::snow, [&t, &sn](std::size_t i) {
+             if (!t.active(i)) return 0.0;
+             const int c = static_cast<int>(i % static_cast<std::size_t>(t.grid.nx)),
+                       r = static_cast<int>(i / static_cast<std::size_t>(t.grid.nx));
+             if (sn.max_slope && !(bed_slope_degrees(t, c, r) < *sn.max_slope)) return 0.0;
+             const double share = snow_line_share(t.bed[i], sn);
+             const double s0 = t.snow_initial.empty() ? sn.initial.value : t.snow_initial[i];
+             return share > 0 ? (share == 1.0 ? s0 : s0 * share) : 0.0;
+           }}};
 }
 
 std::vector<SweepInfo> infiltration_sweeps(const Params&) {
@@ -356,40 +353,36 @@ std::vector<SweepInfo> infiltration_sweeps(const Params&) {
 
 /// The soil of infiltration on the DEM cells: K_sat, psi delta theta and the store
 /// L delta theta (unlimited: the largest float), each from its uniform value or raster.
-std::vector<std::pair<FieldId, std::vector<double>>> infiltration_initial(const Terrain& t,
-                                                                          const Params& p) {
+std::vector<InitialField> infiltration_initial(const Terrain& t, const Params& p) {
   const auto& in = p.infiltration;
-  const std::size_t n = t.bed.size();
   const auto value = [](const std::vector<double>& raster, const ScalarOrRaster& s, std::size_t i) {
     return raster.empty() ? s.value : raster[i];
   };
-  std::vector<double> ksat(n), suction(n), store(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double deficit = value(t.moisture_deficit, in.moisture_deficit, i);
-    ksat[i] = value(t.ksat, in.ksat, i);
-    suction[i] = value(t.suction, in.suction, i) * deficit;
-    store[i] = in.soil_depth ? value(t.soil_depth, *in.soil_depth, i) * deficit
-                             : static_cast<double>(std::numeric_limits<float>::max());
-  }
-  return {{FieldId::infiltration_ksat, std::move(ksat)},
-          {FieldId::infiltration_suction_deficit, std::move(suction)},
-          {FieldId::infiltration_store, std::move(store)}};
+  const auto deficit = [&t, &in, value](std::size_t i) {
+    return value(t.moisture_deficit, in.moisture_deficit, i);
+  };
+  return {{FieldId::infiltration_ksat,
+           [&t, &in, value](std::size_t i) { return value(t.ksat, in.ksat, i); }},
+          {FieldId::infiltration_suction_deficit,
+           [&t, &in, value, deficit](std::size_t i) {
+             return value(t.suction, in.suction, i) * deficit(i);
+           }},
+          {FieldId::infiltration_store, [&t, &in, value, deficit](std::size_t i) {
+             return in.soil_depth ? value(t.soil_depth, *in.soil_depth, i) * deficit(i)
+                                  : static_cast<double>(std::numeric_limits<float>::max());
+           }}};
 }
 
 /// The initial soil (physical law): erosion.soil_thickness (uniform or its raster), or bed -
 /// bedrock_level (at least 0) where a bedrock level is given, on the active cells.
-std::vector<std::pair<FieldId, std::vector<double>>> erosion_initial(const Terrain& t,
-                                                                     const Params& p) {
+std::vector<InitialField> erosion_initial(const Terrain& t, const Params& p) {
   if (p.erosion.law != ErosionLaw::physical) return {};
-  std::vector<double> soil(t.bed.size(), 0.0);
-  for (std::size_t i = 0; i < soil.size(); ++i) {
-    if (!t.active(i)) continue;
-    if (p.erosion.bedrock_level)
-      soil[i] = std::max(t.bed[i] - *p.erosion.bedrock_level, 0.0);
-    else
-      soil[i] = t.soil_thickness.empty() ? p.erosion.soil_thickness.value : t.soil_thickness[i];
-  }
-  return {{FieldId::soil_thickness, std::move(soil)}};
+  const auto& e = p.erosion;
+  return {{FieldId::soil_thickness, [&t, &e](std::size_t i) {
+             if (!t.active(i)) return 0.0;
+             if (e.bedrock_level) return std::max(t.bed[i] - *e.bedrock_level, 0.0);
+             return t.soil_thickness.empty() ? e.soil_thickness.value : t.soil_thickness[i];
+           }}};
 }
 
 }  // namespace

@@ -193,9 +193,21 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   if (!sections_.faces.empty()) backend_->set_faces(sections_.faces);
   find_coast_cells();
   // the initial values of the fields the processes own (process.hpp ProcessInfo::initial)
+  // (a strip of rows at a time: a whole field in double would be 8 B per cell beside the
+  // state, the setup's peak)
   for (const Process p : step_sequence(params_))
     if (const auto initial = process_info(p).initial)
-      for (const auto& [id, values] : initial(terrain_, params_)) backend_->set_field(id, values);
+      for (const InitialField& f : initial(terrain_, params_)) {
+        constexpr int kStrip = 256;  // rows
+        std::vector<double> values;
+        for (int row0 = 0; row0 < g.ny; row0 += kStrip) {
+          const int row1 = std::min(g.ny, row0 + kStrip);
+          const std::size_t first = static_cast<std::size_t>(row0) * g.nx;
+          values.resize(static_cast<std::size_t>(row1 - row0) * g.nx);
+          for (std::size_t i = 0; i < values.size(); ++i) values[i] = f.value(first + i);
+          backend_->set_field_rows(f.id, row0, row1, values);
+        }
+      }
   // the terrain classes of the initial state, so that the first snapshot shows them (the
   // first step classifies the same state again: the same classes)
   if (params_.terrain_classes.enabled) {

@@ -3,7 +3,9 @@
 #include "h5.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
+#include <utility>
 
 #include "erodem/error.hpp"
 #include "erodem/io/paths.hpp"
@@ -127,7 +129,14 @@ H5Id create_dataset(hid_t loc, const std::string& name, hid_t type,
     }
   }
   if (fill != nullptr) checked(H5Pset_fill_value(dcpl, type, fill), path, "fill of " + name);
-  return checked(H5Dcreate2(loc, name.c_str(), type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
+  // Compressed (field) datasets are written a whole chunk at a time (the writer's strips), so
+  // they need no chunk cache: HDF5's default keeps up to 1 MiB per open dataset, 25 MiB for
+  // the fields of a run's result file at 512^2 chunks, for the whole run.
+  H5Id dapl = checked(H5Pcreate(H5P_DATASET_ACCESS), path, "access properties of " + name);
+  if (!chunk.empty() && compress)
+    checked(H5Pset_chunk_cache(dapl, H5D_CHUNK_CACHE_NSLOTS_DEFAULT, 0, H5D_CHUNK_CACHE_W0_DEFAULT),
+            path, "chunk cache of " + name);
+  return checked(H5Dcreate2(loc, name.c_str(), type, space, H5P_DEFAULT, dcpl, dapl), path,
                  "dataset " + name);
 }
 
@@ -164,6 +173,47 @@ void read_row(hid_t ds, hid_t mem_type, hsize_t row, void* data, const std::stri
           path, name);
   H5Id mem_space = checked(H5Screate_simple(rank, count.data(), nullptr), path, name);
   checked(H5Dread(ds, mem_type, mem_space, space, H5P_DEFAULT, data), path, "(reading) " + name);
+}
+
+hsize_t grow_row(hid_t ds, const std::string& path, const std::string& name) {
+  H5Id space = checked(H5Dget_space(ds), path, name);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space)));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  const hsize_t index = dims[0]++;
+  checked(H5Dset_extent(ds, dims.data()), path, "(extending) " + name);
+  return index;
+}
+
+namespace {
+
+/// The file and memory spaces of rows [y0, y0 + rows) of row `index` of a dataset (time, y, x).
+std::pair<H5Id, H5Id> strip_spaces(hid_t ds, hsize_t index, hsize_t y0, hsize_t rows,
+                                   const std::string& path, const std::string& name) {
+  H5Id space = checked(H5Dget_space(ds), path, name);
+  std::array<hsize_t, 3> dims{};
+  if (H5Sget_simple_extent_ndims(space) != 3)
+    throw Error(ExitCode::internal, path + ": " + name + " is not a dataset (time, y, x)");
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  const std::array<hsize_t, 3> start{index, y0, 0}, count{1, rows, dims[2]};
+  checked(H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+          path, name);
+  H5Id memory = checked(H5Screate_simple(3, count.data(), nullptr), path, name);
+  return {std::move(space), std::move(memory)};
+}
+
+}  // namespace
+
+void write_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows,
+                 const void* data, const std::string& path, const std::string& name) {
+  const auto [file_space, mem_space] = strip_spaces(ds, index, y0, rows, path, name);
+  checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+}
+
+void read_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows, void* data,
+                const std::string& path, const std::string& name) {
+  const auto [file_space, mem_space] = strip_spaces(ds, index, y0, rows, path, name);
+  checked(H5Dread(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path,
+          "(reading) " + name);
 }
 
 bool exists(hid_t loc, const std::string& path) {

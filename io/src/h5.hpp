@@ -130,6 +130,17 @@ void append_rows(hid_t ds, hid_t mem_type, hsize_t rows, const void* data, const
 void read_row(hid_t ds, hid_t mem_type, hsize_t row, void* data, const std::string& path,
               const std::string& name);
 
+/// Adds one row along the first (unlimited) dimension of dataset `ds` (its fill value until
+/// written); returns that row's index.
+hsize_t grow_row(hid_t ds, const std::string& path, const std::string& name);
+
+/// Writes (write_strip) or reads (read_strip) `data`, the rows [y0, y0 + rows) of row
+/// `index` of a dataset (time, y, x): a snapshot's field a strip at a time.
+void write_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows,
+                 const void* data, const std::string& path, const std::string& name);
+void read_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows, void* data,
+                const std::string& path, const std::string& name);
+
 /// Whether `path` names an existing object (every link on the way exists).
 bool exists(hid_t loc, const std::string& path);
 

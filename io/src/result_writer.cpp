@@ -49,6 +49,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// The side of the fields' chunks (time, y, x) = (1, 512, 512), and the rows of a strip the
+/// writer takes at a time: whole chunks, so that no compressed chunk is written twice.
+constexpr hsize_t kChunkSide = 512;
+
+/// Calls f(row0, row1) for the strips of kChunkSide rows of a grid of ny rows, in order,
+/// until one returns false; whether all returned true.
+template <class F>
+bool for_strips(int ny, const F& f) {
+  for (int row0 = 0; row0 < ny; row0 += static_cast<int>(kChunkSide))
+    if (!f(row0, std::min(ny, row0 + static_cast<int>(kChunkSide)))) return false;
+  return true;
+}
+
 std::string iso_utc_now() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -419,8 +432,8 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   const hsize_t ny = grid.ny, nx = grid.nx;
   for (auto& [info, ds] : m.fields) {
     ds = create_dataset(m.file, info.name, H5T_IEEE_F32LE, {0, ny, nx}, {H5S_UNLIMITED, ny, nx},
-                        {1, std::min<hsize_t>(ny, 512), std::min<hsize_t>(nx, 512)}, true, &fnan,
-                        partial_);
+                        {1, std::min<hsize_t>(ny, kChunkSide), std::min<hsize_t>(nx, kChunkSide)},
+                        true, &fnan, partial_);
     checked(H5DSattach_scale(ds, m.time, 0), partial_, std::string(info.name) + " dimensions");
     checked(H5DSattach_scale(ds, y, 1), partial_, std::string(info.name) + " dimensions");
     checked(H5DSattach_scale(ds, x, 2), partial_, std::string(info.name) + " dimensions");
@@ -467,9 +480,10 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     for (FieldId id : state_fields()) {
       const auto& info = field_info(id);
       const bool once = !step_writes(params, info.name);
-      H5Id ds = create_dataset(group, info.name, type, {0, ny, nx}, {H5S_UNLIMITED, ny, nx},
-                               {1, std::min<hsize_t>(ny, 512), std::min<hsize_t>(nx, 512)}, true,
-                               nullptr, partial_);
+      H5Id ds =
+          create_dataset(group, info.name, type, {0, ny, nx}, {H5S_UNLIMITED, ny, nx},
+                         {1, std::min<hsize_t>(ny, kChunkSide), std::min<hsize_t>(nx, kChunkSide)},
+                         true, nullptr, partial_);
       if (!once)
         checked(H5DSattach_scale(ds, m.restart_time, 0), partial_,
                 std::string("restart/") + info.name);
@@ -590,34 +604,44 @@ void ResultWriter::store_state(const Simulation& sim) {
   // at once: 8 bytes per cell for each of them, the run's peak at every snapshot).
   // A float32 state is written from the doubles: HDF5 rounds them to the dataset's floats
   // (as static_cast<float>) a strip at a time, so no float copy of the field is held.
+  const int ny = m.grid.ny;
   for (std::size_t k = 0; k < state_fields().size(); ++k) {
-    const std::vector<double> v = sim.field(state_fields()[k]);
-    const std::string name = std::string("restart/") + field_info(state_fields()[k]).name;
-    const void* row = v.data();
+    const FieldId id = state_fields()[k];
+    const std::string name = std::string("restart/") + field_info(id).name;
+    const hid_t ds = m.restart_fields[k];
     if (m.once[k]) {  // a new row only when the values differ from the last one stored
       bool same = false;
-      if (m.row_count[k] > 0) {  // compared with that row as the file holds it
+      if (m.row_count[k] > 0) {  // compared with that row as the file holds it, strip by strip
         const hsize_t last_row = static_cast<hsize_t>(m.row_count[k] - 1);
-        if (m.restart_f64) {
-          std::vector<double> last(v.size());
-          read_row(m.restart_fields[k], H5T_NATIVE_DOUBLE, last_row, last.data(), partial_, name);
-          same = std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
-        } else {
-          std::vector<float> last(v.size());
-          read_row(m.restart_fields[k], H5T_NATIVE_FLOAT, last_row, last.data(), partial_, name);
-          same = true;
-          for (std::size_t i = 0; i < v.size() && same; ++i) {
-            const float f = static_cast<float>(v[i]);
-            same = std::memcmp(&last[i], &f, sizeof(float)) == 0;
+        same = for_strips(ny, [&](int row0, int row1) {
+          const std::vector<double> v = sim.field_rows(id, row0, row1);
+          if (m.restart_f64) {
+            std::vector<double> last(v.size());
+            read_strip(ds, H5T_NATIVE_DOUBLE, last_row, row0, row1 - row0, last.data(), partial_,
+                       name);
+            return std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
           }
-        }
+          std::vector<float> last(v.size());
+          read_strip(ds, H5T_NATIVE_FLOAT, last_row, row0, row1 - row0, last.data(), partial_,
+                     name);
+          for (std::size_t i = 0; i < v.size(); ++i) {
+            const float f = static_cast<float>(v[i]);
+            if (std::memcmp(&last[i], &f, sizeof(float)) != 0) return false;
+          }
+          return true;
+        });
       }
       const std::int32_t index = same ? m.row_count[k] - 1 : m.row_count[k];
       append_rows(m.restart_rows[k], H5T_NATIVE_INT32, 1, &index, partial_, name + "_row");
       if (same) continue;
       ++m.row_count[k];
     }
-    append_rows(m.restart_fields[k], H5T_NATIVE_DOUBLE, 1, row, partial_, name);
+    const hsize_t index = grow_row(ds, partial_, name);
+    for_strips(ny, [&](int row0, int row1) {
+      const std::vector<double> v = sim.field_rows(id, row0, row1);
+      write_strip(ds, H5T_NATIVE_DOUBLE, index, row0, row1 - row0, v.data(), partial_, name);
+      return true;
+    });
   }
   const std::int64_t steps = sim.steps_done();
   append_rows(m.restart_steps, H5T_NATIVE_INT64, 1, &steps, partial_, "restart/steps");
@@ -657,10 +681,16 @@ void ResultWriter::take_snapshot(const Simulation& sim, bool last) {
   const auto& terrain = sim.terrain();
   for (auto& [info, ds] : m.fields) {
     // NaN on the cells outside the DEM; HDF5 rounds the doubles to the dataset's floats
-    auto values = sim.field(info.id);
-    for (std::size_t i = 0; i < values.size(); ++i)
-      if (!terrain.active(i)) values[i] = std::nan("");
-    append_rows(ds, H5T_NATIVE_DOUBLE, 1, values.data(), partial_, info.name);
+    const hsize_t index = grow_row(ds, partial_, info.name);
+    for_strips(g.ny, [&](int row0, int row1) {
+      auto values = sim.field_rows(info.id, row0, row1);
+      const std::size_t first = static_cast<std::size_t>(row0) * g.nx;
+      for (std::size_t i = 0; i < values.size(); ++i)
+        if (!terrain.active(first + i)) values[i] = std::nan("");
+      write_strip(ds, H5T_NATIVE_DOUBLE, index, row0, row1 - row0, values.data(), partial_,
+                  info.name);
+      return true;
+    });
   }
   const bool state = m.restart && (last || times_.size() % m.restart_every == 0);
   if (state) store_state(sim);

@@ -97,9 +97,10 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   take(hardness_, s.hardness);
   take(rain_factor_, s.rain_factor);
   bed_residual_.assign(n, Real(0));
+  const bool flux_twins = params.flow.scheme == FlowScheme::shallow_water;
   for (int k = 0; k < 4; ++k) {
     flux_[k].assign(n, Real(0));
-    flux_next_[k].assign(n, Real(0));
+    if (flux_twins) flux_next_[k].assign(n, Real(0));
   }
   velocity_x_.assign(n, Real(0));
   velocity_y_.assign(n, Real(0));
@@ -412,13 +413,24 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
 
 template <class Real>
 std::vector<double> CpuBackend<Real>::field(FieldId id) const {
-  // the rows this rank owns (all of them in one process), then every rank's in row order
-  std::vector<double> out(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(own1_ - own0_));
-  const Field* src = fields_.peek(id);  // a field not made yet reads as zeros
-  for (int y = own0_; y < own1_; ++y)
-    for (int c = 0; c < nx_; ++c)
-      out[static_cast<std::size_t>(y - own0_) * nx_ + c] = value_at(id, src, at(c + 1, y));
-  return banded_ ? parallel::allgather(out) : out;
+  return field_rows(id, 0, ny_);
+}
+
+template <class Real>
+std::vector<double> CpuBackend<Real>::field_rows(FieldId id, int row0, int row1) const {
+  // the rows of [row0, row1) this rank owns (all of them in one process; DEM row r is padded
+  // row r + 1 - row0_), then every rank's in row order
+  const int y0 = std::max(own0_, row0 + 1 - row0_), y1 = std::min(own1_, row1 + 1 - row0_);
+  std::vector<double> out(static_cast<std::size_t>(nx_) *
+                          static_cast<std::size_t>(std::max(y1 - y0, 0)));
+  if (!fields_.reads_zeros(id)) {  // a field not made yet: its zeros, without an array of them
+    const Field* src = fields_.peek(id);
+    for (int y = y0; y < y1; ++y)
+      for (int c = 0; c < nx_; ++c)
+        out[static_cast<std::size_t>(y - y0) * nx_ + c] = value_at(id, src, at(c + 1, y));
+  }
+  if (banded_) return parallel::allgather(out);
+  return out;  // (a conditional expression would return a copy)
 }
 
 template <class Real>
@@ -426,6 +438,13 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
   if (values.size() != static_cast<std::size_t>(nx_) * ny_)
     throw Error(ExitCode::data, fmt::format("field '{}': {} values for a grid of {} x {}",
                                             field_info(id).name, values.size(), nx_, ny_));
+  set_field_rows(id, 0, ny_, values);
+}
+
+template <class Real>
+void CpuBackend<Real>::set_field_rows(FieldId id, int row0, int row1,
+                                      const std::vector<double>& values) {
+  check_rows(id, row0, row1, values.size(), nx_, ny_);
   if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Field* dst = field_storage(id);
   if (!dst)
@@ -436,10 +455,10 @@ void CpuBackend<Real>::set_field(FieldId id, const std::vector<double>& values) 
   // the DEM rows the padded raster holds (a band's own and halo rows in an MPI run)
   for (int y = 0; y < H_; ++y) {
     const int r = y + row0_ - 1;
-    if (r < 0 || r >= ny_) continue;
+    if (r < row0 || r >= row1) continue;
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, y);
-      const double value = values[static_cast<std::size_t>(r) * nx_ + c];
+      const double value = values[static_cast<std::size_t>(r - row0) * nx_ + c];
       const auto v = static_cast<Real>(value);
       (*dst)[p] = v;
       if (twin) (*twin)[p] = v;

@@ -64,7 +64,9 @@ class CpuBackend final : public Backend {
   void set_faces(const std::vector<Face>& faces) override;
   std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   std::vector<double> field(FieldId id) const override;
+  std::vector<double> field_rows(FieldId id, int row0, int row1) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
+  void set_field_rows(FieldId id, int row0, int row1, const std::vector<double>& values) override;
   HostView host_view(FieldId id) override;
 
   // One function per process, each in kernels/cpu/<process>.cpp.
@@ -122,9 +124,10 @@ class CpuBackend final : public Backend {
   std::size_t padded(std::int64_t cell) const {
     return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1 - row0_);
   }
-  /// Local inertial or pipes: the outflows of every padded row into flux_next_ from flux_,
-  /// each thread walking its block [y0, y1) of for_row_blocks top to bottom and calling
-  /// after_row(y, y0, y1) once row y's outflows are stored (kernels/cpu/flow.cpp).
+  /// Local inertial or pipes: the new outflows of every padded row over the old ones in
+  /// flux_ (in place: flux_next_ is the shallow-water scheme's only), each thread walking its
+  /// block [y0, y1) of for_row_blocks top to bottom and calling after_row(y, y0, y1) once row
+  /// y's outflows are stored (kernels/cpu/flow.cpp).
   template <class AfterRow>
   void flow_blocks(Real dt, const AfterRow& after_row);
   /// The rain on padded row y (1 .. H - 2), then the step's inflows at that row in the order
@@ -159,6 +162,17 @@ class CpuBackend final : public Backend {
 #pragma omp parallel for schedule(static) num_threads(threads_)
     for (int y = y0; y < y1; ++y) f(y);
   }
+  /// The calling thread's block [y0, y1) of the padded rows [0, H) in a parallel region: the
+  /// team's threads take contiguous blocks in thread order (all rows without OpenMP).
+  static std::pair<int, int> thread_row_block(int H) {
+#ifdef _OPENMP
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+#else
+    const int t = 0, nt = 1;
+#endif
+    return {static_cast<int>(static_cast<long>(H) * t / nt),
+            static_cast<int>(static_cast<long>(H) * (t + 1) / nt)};
+  }
   /// Calls f(y0, y1) once on each of the backend's threads with its block of the padded rows
   /// [0, H), the static blocks schedule(static) gives; for loops that walk their block top to
   /// bottom, carrying rows of faces from one row to the next.
@@ -166,13 +180,7 @@ class CpuBackend final : public Backend {
   void for_row_blocks(int H, const F& f) const {
 #pragma omp parallel num_threads(threads_)
     {
-#ifdef _OPENMP
-      const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-#else
-      const int t = 0, nt = 1;
-#endif
-      const int y0 = static_cast<int>(static_cast<long>(H) * t / nt);
-      const int y1 = static_cast<int>(static_cast<long>(H) * (t + 1) / nt);
+      const auto [y0, y1] = thread_row_block(H);
       if (y0 < y1) f(y0, y1);
     }
   }
@@ -250,7 +258,9 @@ class CpuBackend final : public Backend {
   Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the water update
                               // started from (used by conservative transport)
   Field sediment_, sediment_next_;
-  std::array<Field, 4> flux_, flux_next_;  // left, right, top, bottom (m^3/s)
+  // left, right, top, bottom (m^3/s); flux_next_ (the second buffers) only with the
+  // shallow-water scheme: local inertial and pipes update flux_ in place (flow_blocks)
+  std::array<Field, 4> flux_, flux_next_;
   Field velocity_x_, velocity_y_;
   Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   Field stage_depth_;  // shallow water, second order: the depth after Heun's first stage

@@ -8,6 +8,13 @@
 // computed once per thread (the faces between two blocks twice), and every inner loop runs
 // over x with values, not calls through pointers, so GCC vectorises it.
 //
+// Local inertial and pipes write the new outflows over the old ones (no second buffers: 16 B
+// per cell). A pipe cell reads only its own old outflows. A local-inertial row y reads its own
+// (the faces east of its cells) and, through the unit discharges of the faces south of rows
+// j, rows j and j + 1: a thread takes those of row y + 1 before it writes row y, and those it
+// needs of rows its neighbouring blocks write (the first three and the last two of its block)
+// before any thread writes (a barrier), so every face reads the old outflows, as before.
+//
 // Shallow water (common/shallow_water.h): the same walk (shallow_water_rows): per row the
 // velocities (and for the second order the slopes) of the rows it needs next, the faces south
 // of the row and those of the row, each once, then the row's cells from their four faces; the
@@ -504,8 +511,7 @@ void CpuBackend<Real>::run_flow(Real dt) {
     std::swap(flux_, flux_next_);
     return;
   }
-  flow_blocks(dt, [](int, int, int) {});
-  std::swap(flux_, flux_next_);
+  flow_blocks(dt, [](int, int, int) {});  // in place
 }
 
 template <class Real>
@@ -515,10 +521,9 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
   const Real g = f.gravity;
   const Kind* kind = kind_.data();
   const Real *b = bed_.data(), *d = depth_.data();
-  const Real *fl = flux_[0].data(), *fr = flux_[1].data(), *ft = flux_[2].data(),
-             *fb = flux_[3].data();
-  Real *ol = flux_next_[0].data(), *orr = flux_next_[1].data(), *ot = flux_next_[2].data(),
-       *ob = flux_next_[3].data();
+  // in place: the old outflows are read through fl .. fb, the new written through ol .. ob
+  Real *ol = flux_[0].data(), *orr = flux_[1].data(), *ot = flux_[2].data(), *ob = flux_[3].data();
+  const Real *fl = ol, *fr = orr, *ft = ot, *fb = ob;
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const int W = W_, H = H_;
   if (params_.flow.scheme == FlowScheme::pipes) {
@@ -549,7 +554,11 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
   }
   const InertialParams<Real> p{dt, g, f.theta, f.dry_depth, periodic_};
   const Real* manning = manning_.data();
-  for_row_blocks(H, [&](int y0, int y1) {
+  // for_row_blocks' blocks, with a barrier all threads meet (flow_blocks' comment above)
+#pragma omp parallel num_threads(threads_)
+  {
+    const std::pair<int, int> block = thread_row_block(H);
+    const int y0 = block.first, y1 = block.second;  // (lambdas below capture them)
     const std::size_t w = static_cast<std::size_t>(W);
     // Rings of rows: cell kinds as int (slot j mod 6; walls beyond the raster), unit
     // discharges of the faces south of rows j (slot j mod 3) and discharges of the faces
@@ -577,27 +586,46 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
     auto unit_q = [&](int j) {
       if (j >= 0 && j <= H - 2) unit_discharge_y_row(j, W, ft, fb, dx, q_row(j));
     };
-    auto faces_y = [&](int j) {
-      if (j < 0 || j > H - 2) return;
-      face_y_row(j, W, H, kind_row(j - 1), kind_row(j), kind_row(j + 1), kind_row(j + 2), b, d,
-                 manning, dx, dy, j >= 1 ? q_row(j - 1) : q_row(j), q_row(j),
-                 j + 1 <= H - 2 ? q_row(j + 1) : q_row(j), p, face_row(j));
+    // The unit discharges of the faces south of rows y1 - 1 and y1, which read rows of the
+    // next block (slot j - y1 + 1), taken before the barrier with those of the block's first
+    // rows (which read the previous block's rows) into the ring.
+    std::vector<Real> q_tail(2 * w);
+    const auto tail_row = [&](int j) {
+      return q_tail.data() + static_cast<std::size_t>(j - y1 + 1) * w;
     };
-    unit_q(y0 - 2);
-    unit_q(y0 - 1);
-    unit_q(y0);
-    faces_y(y0 - 1);
-    for (int y = y0; y < y1; ++y) {
-      unit_q(y + 1);
-      faces_y(y);
-      face_x_row(y, W, kind_row(y), b, d, manning, dx, dy, fl, fr, p, q_x.data(), face_x.data());
-      const Real* top = y >= 1 ? face_row(y - 1) : zeros.data();
-      const Real* bottom = y <= H - 2 ? face_row(y) : zeros.data();
-      split_row(y, W, kind_row(y), kind_row(y - 1), kind_row(y + 1), d, area, face_x.data(), top,
-                bottom, dt, ol, orr, ot, ob);
-      after_row(y, y0, y1);
+    const auto in_tail = [&](int j) { return j >= std::max(y0 + 1, y1 - 1) && j <= y1; };
+    if (y0 < y1) {
+      unit_q(y0 - 2);
+      unit_q(y0 - 1);
+      unit_q(y0);
+      for (int j = std::max(y0 + 1, y1 - 1); j <= y1; ++j)
+        if (j >= 0 && j <= H - 2) unit_discharge_y_row(j, W, ft, fb, dx, tail_row(j));
     }
-  });
+#pragma omp barrier
+    if (y0 < y1) {
+      auto faces_y = [&](int j) {
+        if (j < 0 || j > H - 2) return;
+        face_y_row(j, W, H, kind_row(j - 1), kind_row(j), kind_row(j + 1), kind_row(j + 2), b, d,
+                   manning, dx, dy, j >= 1 ? q_row(j - 1) : q_row(j), q_row(j),
+                   j + 1 <= H - 2 ? q_row(j + 1) : q_row(j), p, face_row(j));
+      };
+      faces_y(y0 - 1);
+      for (int y = y0; y < y1; ++y) {
+        if (in_tail(y + 1)) {
+          if (y + 1 <= H - 2) std::copy(tail_row(y + 1), tail_row(y + 1) + w, q_row(y + 1));
+        } else {
+          unit_q(y + 1);
+        }
+        faces_y(y);
+        face_x_row(y, W, kind_row(y), b, d, manning, dx, dy, fl, fr, p, q_x.data(), face_x.data());
+        const Real* top = y >= 1 ? face_row(y - 1) : zeros.data();
+        const Real* bottom = y <= H - 2 ? face_row(y) : zeros.data();
+        split_row(y, W, kind_row(y), kind_row(y - 1), kind_row(y + 1), d, area, face_x.data(), top,
+                  bottom, dt, ol, orr, ot, ob);
+        after_row(y, y0, y1);
+      }
+    }
+  }
 }
 
 template <class Real>
@@ -611,8 +639,8 @@ void CpuBackend<Real>::run_flow_water(Real dt, StepTally& tally, bool evaporatio
   std::stable_sort(point_rows_.begin(), point_rows_.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   const Real rate = static_cast<Real>(in.rain_rate);
-  const std::array<const Real*, 4> out{flux_next_[0].data(), flux_next_[1].data(),
-                                       flux_next_[2].data(), flux_next_[3].data()};
+  const std::array<const Real*, 4> out{flux_[0].data(), flux_[1].data(), flux_[2].data(),
+                                       flux_[3].data()};  // the flow's, in place
   const int H = H_;
   // evaporation on the water update's output (depth_next_ until the swap), row by row
   GenericRows evaporate;
@@ -666,7 +694,6 @@ void CpuBackend<Real>::run_flow_water(Real dt, StepTally& tally, bool evaporatio
 #pragma omp for schedule(static)
     for (int k = 0; k < nw; ++k) water_evaporation_stats(water_rows[static_cast<std::size_t>(k)]);
   }
-  std::swap(flux_, flux_next_);
   measure_water_faces();  // the outflows the water update applied, as run(water) measures them
   book_water_rows(dt, tally);
   if (evaporation) evaporate.book(tally);

@@ -15,7 +15,9 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
   const Kind* kind = kind_.data();
   const Real *bed = bed_.data(), *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const Real* wet = wetness_.data();
-  const Real* talus = field_storage(FieldId::talus_slope)->data();  // read with by_class only
+  // The talus slopes are read only where the classes set them (by_class); otherwise any
+  // array of the grid's size stands in, so that no field of zeros is made for them (4 B/cell).
+  const Real* talus = cell_.thermal.by_class ? field_storage(FieldId::talus_slope)->data() : wet;
   Real *share = thermal_share_.data(), *bed_out = bed_next_.data(), *bed_lo = bed_residual_.data();
   const cell_params::ThermalParams<Real> params = cell_.thermal;
   const int W = W_;

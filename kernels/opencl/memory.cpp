@@ -63,11 +63,13 @@ void OpenClBackend::read(const Buffer& b, std::size_t bytes, void* dst, bool blo
 namespace {
 
 /// The DEM cells (the padded raster without its halo) of a buffer, row-major (ny, nx).
-std::vector<float> read_interior(cl_command_queue q, cl_mem b, int nx, int ny) {
-  std::vector<float> out(static_cast<std::size_t>(nx) * ny);
-  const std::size_t origin[3] = {sizeof(float), 1, 0};
+/// DEM rows [row0, row1) of a padded buffer of DEM width nx, without its ghost cells.
+std::vector<float> read_interior(cl_command_queue q, cl_mem b, int nx, int row0, int row1) {
+  std::vector<float> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(row1 - row0));
+  if (out.empty()) return out;
+  const std::size_t origin[3] = {sizeof(float), static_cast<std::size_t>(row0) + 1, 0};
   const std::size_t region[3] = {static_cast<std::size_t>(nx) * sizeof(float),
-                                 static_cast<std::size_t>(ny), 1};
+                                 static_cast<std::size_t>(row1 - row0), 1};
   check(clEnqueueReadBufferRect(q, b, CL_TRUE, origin, std::array<std::size_t, 3>{0, 0, 0}.data(),
                                 region, (static_cast<std::size_t>(nx) + 2) * sizeof(float), 0,
                                 static_cast<std::size_t>(nx) * sizeof(float), 0, out.data(), 0,
@@ -76,11 +78,14 @@ std::vector<float> read_interior(cl_command_queue q, cl_mem b, int nx, int ny) {
   return out;
 }
 
-void write_interior(cl_command_queue q, cl_mem b, int nx, int ny, const std::vector<float>& v) {
-  const std::size_t origin[3] = {sizeof(float), 1, 0};
+/// `v` into DEM rows [row0, row1) of a padded buffer of DEM width nx, its ghost cells kept.
+void write_interior(cl_command_queue q, cl_mem b, int nx, int row0, int row1,
+                    const std::vector<float>& v) {
+  if (row1 <= row0) return;
+  const std::size_t origin[3] = {sizeof(float), static_cast<std::size_t>(row0) + 1, 0};
   const std::size_t host_origin[3] = {0, 0, 0};
   const std::size_t region[3] = {static_cast<std::size_t>(nx) * sizeof(float),
-                                 static_cast<std::size_t>(ny), 1};
+                                 static_cast<std::size_t>(row1 - row0), 1};
   check(clEnqueueWriteBufferRect(q, b, CL_TRUE, origin, host_origin, region,
                                  (static_cast<std::size_t>(nx) + 2) * sizeof(float), 0,
                                  static_cast<std::size_t>(nx) * sizeof(float), 0, v.data(), 0,
@@ -119,13 +124,18 @@ double OpenClBackend::compose(FieldId id, const float* parts, std::size_t stride
 }
 
 std::vector<double> OpenClBackend::field(FieldId id) const {
+  return field_rows(id, 0, ny_);
+}
+
+std::vector<double> OpenClBackend::field_rows(FieldId id, int row0, int row1) const {
+  const std::size_t n = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(row1 - row0);
+  if (fields_.reads_zeros(id)) return std::vector<double>(n);  // without a buffer of zeros
   auto* self = const_cast<OpenClBackend*>(this);
   const auto parts = self->field_parts(id);
-  const std::size_t n = static_cast<std::size_t>(nx_) * ny_;
   std::vector<float> raw;
   raw.reserve(parts.size() * n);
   for (const Buffer* b : parts) {
-    const auto v = read_interior(queue_.get(), b->get(), nx_, ny_);
+    const auto v = read_interior(queue_.get(), b->get(), nx_, row0, row1);
     raw.insert(raw.end(), v.begin(), v.end());
   }
   std::vector<double> out(n);
@@ -206,6 +216,12 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
   if (values.size() != static_cast<std::size_t>(nx_) * ny_)
     throw Error(ExitCode::data, fmt::format("field '{}': {} values for a grid of {} x {}",
                                             field_info(id).name, values.size(), nx_, ny_));
+  set_field_rows(id, 0, ny_, values);
+}
+
+void OpenClBackend::set_field_rows(FieldId id, int row0, int row1,
+                                   const std::vector<double>& values) {
+  check_rows(id, row0, row1, values.size(), nx_, ny_);
   if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Buffer* dst = field_buffer(id);
   if (!dst)
@@ -214,14 +230,14 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
   // Fields kept in two buffers get both, so the next step starts from the new values.
   Buffer* twin = fields_.twin(id);
   const std::vector<float> v(values.begin(), values.end());
-  write_interior(queue_.get(), dst->get(), nx_, ny_, v);
-  if (twin) write_interior(queue_.get(), twin->get(), nx_, ny_, v);
+  write_interior(queue_.get(), dst->get(), nx_, row0, row1, v);
+  if (twin) write_interior(queue_.get(), twin->get(), nx_, row0, row1, v);
   if (id == FieldId::bed) {
     // a bed keeps what float cannot hold in its residual (set bed_residual after the bed)
     std::vector<float> lo(v.size());
     for (std::size_t i = 0; i < v.size(); ++i)
       lo[i] = static_cast<float>(values[i] - static_cast<double>(v[i]));
-    write_interior(queue_.get(), bed_residual_.get(), nx_, ny_, lo);
+    write_interior(queue_.get(), bed_residual_.get(), nx_, row0, row1, lo);
     exchange_halo(bed_residual_);
   }
   exchange_halo(*dst);

@@ -538,7 +538,9 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
 
 void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   cl_kernel share = kernel("thermal_share");
-  const Buffer& talus = *field_buffer(FieldId::talus_slope);  // read with by_class only
+  // The talus slopes are read only where the classes set them (by_class); otherwise any
+  // buffer of the grid's size stands in, so that no field of zeros is made for them (4 B/cell).
+  const Buffer& talus = cell_.thermal.by_class ? *field_buffer(FieldId::talus_slope) : wetness_;
   set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, talus, dx_, dy_, area_,
            thermal_share_, dt, cell_.thermal);
   launch_interior(share);

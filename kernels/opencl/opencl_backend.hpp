@@ -159,7 +159,9 @@ class OpenClBackend final : public Backend {
   void finish() override;
   std::vector<KernelTime> kernel_times() const override;
   std::vector<double> field(FieldId id) const override;
+  std::vector<double> field_rows(FieldId id, int row0, int row1) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
+  void set_field_rows(FieldId id, int row0, int row1, const std::vector<double>& values) override;
 
  private:
   using Real = float;

@@ -104,6 +104,9 @@ struct HostView {
 /// Checks that every cell of `cells` is a DEM cell of an nx x ny grid (0 <= cell < nx ny):
 /// Error(ExitCode::usage) naming `what` and the first cell that is not.
 void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const char* what);
+/// Throws Error(usage) unless [row0, row1) are rows of a grid of nx x ny cells, and
+/// Error(data) unless `count` (values given for field `id`) is (row1 - row0) * nx.
+void check_rows(FieldId id, int row0, int row1, std::size_t count, int nx, int ny);
 
 /// The faces as the backends index them: 2 * (padded cell index) + axis, with the padded
 /// index (col + 1) + (row + 1) * (nx + 2) of the cell west or north of the face.
@@ -171,10 +174,19 @@ class Backend {
   /// ERODEM_OPENCL_PROFILE=1: a profiling event on every launch and read; `erodem bench`
   /// prints them), by name; empty elsewhere. Complete after finish().
   virtual std::vector<KernelTime> kernel_times() const { return {}; }
-  /// A field of the DEM grid, row-major (ny, nx), converted to double.
+  /// A field of the DEM grid, row-major (ny, nx), converted to double: field_rows(id, 0, ny).
   virtual std::vector<double> field(FieldId id) const = 0;
-  /// Replaces a field of the DEM grid (row-major (ny, nx)).
+  /// Rows [row0, row1) of field(id), row-major ((row1 - row0), nx), the same values: what the
+  /// result writer takes a strip at a time, so that no whole field in double is held beside
+  /// the state (8 B per cell at every snapshot). Collective in an MPI run, as field() is.
+  virtual std::vector<double> field_rows(FieldId id, int row0, int row1) const = 0;
+  /// Replaces a field of the DEM grid (row-major (ny, nx)): set_field_rows(id, 0, ny, values).
   virtual void set_field(FieldId id, const std::vector<double>& values) = 0;
+  /// Replaces rows [row0, row1) of a field of the DEM grid (`values` row-major, (row1 - row0)
+  /// x nx): a field a strip at a time. A field not made yet stays unmade where the strip is
+  /// all +0 (what its reads give), so strips give the same field as one whole-field call.
+  virtual void set_field_rows(FieldId id, int row0, int row1,
+                              const std::vector<double>& values) = 0;
   /// The field in host memory, to read or write in place; empty where it is not there.
   virtual HostView host_view(FieldId) { return {}; }
 

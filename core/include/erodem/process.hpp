@@ -9,7 +9,9 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -89,6 +91,12 @@ struct TallyInfo {
   double Ledger::*ledger;
 };
 
+/// One field's initial values: value(cell) at each DEM cell (row-major index row * nx + col).
+struct InitialField {
+  FieldId id;
+  std::function<double(std::size_t cell)> value;
+};
+
 struct ProcessInfo {
   Process id;
   const char* name;            ///< process_name(), the bench's row names
@@ -101,12 +109,12 @@ struct ProcessInfo {
   std::vector<const char*> tallies;
   /// The file of kernels/opencl/ with its kernels.
   const char* opencl_source;
-  /// The initial values of fields it owns (a field of field_table() and one value per DEM
-  /// cell, row-major), from the terrain and the parameters: Simulation sets them when it is
-  /// built, before the initial ledger (a restart then replaces them). nullptr: none (the
-  /// backends start every field they do not build from the terrain at 0).
-  std::vector<std::pair<FieldId, std::vector<double>>> (*initial)(const Terrain&,
-                                                                  const Params&) = nullptr;
+  /// The initial values of fields it owns (fields of field_table()), from the terrain and
+  /// the parameters: Simulation sets them when it is built, before the initial ledger (a
+  /// restart then replaces them), a strip of rows at a time (no whole field in double beside
+  /// the state: the setup's peak). nullptr: none (the backends start every field they do not
+  /// build from the terrain at 0).
+  std::vector<InitialField> (*initial)(const Terrain&, const Params&) = nullptr;
 };
 
 /// Which parameter fields the terrain classes' tables write (terrain_class.h): those of a

@@ -146,6 +146,10 @@ class Simulation {
   const Backend& backend() const { return *backend_; }
   /// A field, row-major (ny, nx), in SI units.
   std::vector<double> field(FieldId id) const { return backend_->field(id); }
+  /// Rows [row0, row1) of field(id) (Backend::field_rows): a field a strip at a time.
+  std::vector<double> field_rows(FieldId id, int row0, int row1) const {
+    return backend_->field_rows(id, row0, row1);
+  }
   /// The processes a step runs with these parameters, in order.
   std::vector<Process> sequence() const;
   /// The passes a step runs them in (process.hpp step_passes, with numerics.fused_sweeps).
