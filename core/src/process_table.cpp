@@ -636,6 +636,31 @@ std::vector<std::string> halo_fields(const SweepInfo& sweep,
   return out;
 }
 
+std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo) {
+  const std::vector<std::string> needed =
+      halo ? neighbour_read_fields(params) : std::vector<std::string>();
+  std::vector<SweepsTail> tails;
+  for (const ProcessInfo& info : process_table()) {
+    const auto p = static_cast<std::size_t>(info.id);
+    if (tails.size() <= p) tails.resize(p + 1);
+    SweepsTail& t = tails[p];
+    t.sweeps = info.sweeps(params);
+    t.exchange.assign(t.sweeps.size(), {});
+    if (!halo) continue;
+    for (std::size_t k = 0; k < t.sweeps.size(); ++k) {
+      std::vector<std::string> done;
+      if (!t.sweeps[k].generic)
+        for (std::size_t j = k + 1; j < t.sweeps.size(); ++j)
+          if (!t.sweeps[j].generic)
+            for (const FieldUse& u : t.sweeps[j].uses)
+              if (reads_neighbours(u.access) && !writes(u.access)) done.emplace_back(u.field);
+      for (const std::string& f : halo_fields(t.sweeps[k], needed))
+        if (std::find(done.begin(), done.end(), f) == done.end()) t.exchange[k].push_back(f);
+    }
+  }
+  return tails;
+}
+
 namespace {
 
 /// Whether a sweep of the step (on the cells only, or on any domain) writes `field`.

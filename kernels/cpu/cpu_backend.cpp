@@ -61,7 +61,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
     own1_ = H_ - 1;
   }
   periodic_ = s.periodic_x;
-  halo_needed_ = neighbour_read_fields(params);
+  tails_ = sweeps_tails(params, periodic_ || banded_);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
@@ -201,7 +201,7 @@ void CpuBackend<Real>::run(Process p) {
   // the generic sweeps of the process (SweepInfo::generic), after its own loops, and the halo
   // exchange after every sweep (run_thermal and run_flow exchange between their own passes)
   run_sweeps_tail(
-      process_info(p).sweeps(params_), periodic_ || banded_, halo_needed_,
+      tails_.at(static_cast<std::size_t>(p)),
       [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
       [&](const std::vector<std::string>& names) { exchange_halo(names); });
 }

@@ -247,9 +247,9 @@ class CpuBackend final : public Backend {
   std::vector<Real> halo_buffer_;  // exchange_fields: send up, receive up, send/receive down
   int threads_;
   bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
-  // What the halo exchanges after a sweep may hold: the fields read at a neighbour
-  // (process.hpp neighbour_read_fields)
-  std::vector<std::string> halo_needed_;
+  // By Process: run()'s sweeps and what the halo exchanges after each, only fields read at a
+  // neighbour (process.hpp sweeps_tails, neighbour_read_fields), worked out once
+  std::vector<SweepsTail> tails_;
   std::vector<Kind> kind_;
   std::vector<Real> dx_, dy_, area_;  // per padded row
   // The bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is only

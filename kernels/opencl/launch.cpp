@@ -91,11 +91,12 @@ void OpenClBackend::launch_interior(cl_kernel k) {
   launch_rows(k, 1, H_ - 1);
 }
 
-void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1) {
+void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1, std::size_t row_group) {
   if (y1 <= y0) return;
   const std::size_t offset[2] = {0, static_cast<std::size_t>(y0)};
-  const std::size_t global[2] = {groups_x_ * local_x_, static_cast<std::size_t>(y1 - y0)};
-  const std::size_t local[2] = {local_x_, 1};
+  const std::size_t global[2] = {row_group > 0 ? row_group : groups_x_ * local_x_,
+                                 static_cast<std::size_t>(y1 - y0)};
+  const std::size_t local[2] = {row_group > 0 ? row_group : local_x_, 1};
   check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr,
                                profile_event(k)),
         "clEnqueueNDRangeKernel");

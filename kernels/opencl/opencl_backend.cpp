@@ -64,7 +64,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                                             nx_, ny_));
   PaddedState state = build_padded_state(terrain, params);
   periodic_ = state.periodic_x;
-  halo_needed_ = neighbour_read_fields(params);
+  tails_ = sweeps_tails(params, periodic_);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
@@ -265,7 +265,7 @@ void OpenClBackend::run(Process p) {
   // the generic sweeps of the process (SweepInfo::generic), after its own loops, and the halo
   // exchange after every sweep (run_thermal and run_flow exchange between their own passes)
   run_sweeps_tail(
-      process_info(p).sweeps(params_), periodic_, halo_needed_,
+      tails_.at(static_cast<std::size_t>(p)),
       [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
       [&](const std::vector<std::string>& names) { exchange_halo(names); });
 }
@@ -617,16 +617,10 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, depth_, sediment_, velocity_x_,
            velocity_y_, area_, partial_a_, partial_cells_);
   const int rows = H_ - 2;
-  if (stats_local_ == 0) {
+  if (stats_local_ == 0)
     launch_interior(k);  // whole rows: a cell kernel, groups_x_ partials per row
-  } else {               // one group of stats_local_ work-items per row: one partial per row
-    const std::size_t offset[2] = {0, 1};
-    const std::size_t global[2] = {stats_local_, static_cast<std::size_t>(rows)};
-    const std::size_t local[2] = {stats_local_, 1};
-    check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr,
-                                 profile_event(k)),
-          "clEnqueueNDRangeKernel(field_stats)");
-  }
+  else                   // one group of stats_local_ work-items per row: one partial per row
+    launch_rows(k, 1, H_ - 1, stats_local_);
   const std::size_t partials_per_row = stats_local_ == 0 ? groups_x_ : 1;
   cl_kernel r = kernel("stats_rows");
   set_args(r, cl_int{W_}, cl_int{rows}, static_cast<cl_int>(partials_per_row), partial_a_,

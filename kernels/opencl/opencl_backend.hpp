@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <string>
@@ -195,8 +196,10 @@ class OpenClBackend final : public Backend {
   /// processes but flow touch), in interior_groups_ work-groups of (local_x_, 1).
   void launch_interior(cl_kernel k);
   /// Runs a cell kernel over the padded rows [y0, y1) only (global offset y0; work-groups of
-  /// (local_x_, 1)); nothing when the range is empty.
-  void launch_rows(cl_kernel k, int y0, int y1);
+  /// (local_x_, 1)), or with `row_group` > 0 one work-group of (row_group, 1) per row (a
+  /// kernel that walks its row's columns itself: field_stats on GPUs); nothing when the range
+  /// is empty.
+  void launch_rows(cl_kernel k, int y0, int y1, std::size_t row_group = 0);
   /// Sums the water exchange (slot ERODEM_TALLY_EXCHANGE) or the sediment carried out
   /// (ERODEM_TALLY_SEDIMENT) over the cells beside ghosts into the tally partials.
   void launch_edge_tallies(int slot, Real dt);
@@ -205,7 +208,8 @@ class OpenClBackend final : public Backend {
   /// Enqueues a read of `bytes` of `b` into `dst`; blocking or not.
   void read(const Buffer& b, std::size_t bytes, void* dst, bool blocking);
   /// Where profiling (ERODEM_OPENCL_PROFILE=1): an event slot for the command about to be
-  /// enqueued, booked under `name` once resolved; else nullptr (no event).
+  /// enqueued, booked under `name` once resolved; else nullptr (no event). The slot stays
+  /// where it is until resolve_profile (a deque: later slots do not move it).
   cl_event* profile_event(const std::string& name);
   cl_event* profile_event(cl_kernel k);
   /// Books the device time of the completed commands' events (all of them after a wait).
@@ -250,7 +254,7 @@ class OpenClBackend final : public Backend {
   // ERODEM_OPENCL_PROFILE=1: the queue profiles, every launch and read takes an event, and
   // finish() and end_step() book their device time per kernel name (kernel_times()).
   bool profiling_ = false;
-  std::vector<std::pair<std::string, cl_event>> profile_pending_;
+  std::deque<std::pair<std::string, cl_event>> profile_pending_;
   std::map<std::string, KernelTime> profile_;
   std::map<cl_kernel, std::string> kernel_names_;
 
@@ -261,8 +265,9 @@ class OpenClBackend final : public Backend {
   std::vector<std::pair<std::string, Kernel>> kernels_;
   int nx_, ny_, W_, H_;
   bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
-  // What the halo exchanges after a sweep may hold (process.hpp neighbour_read_fields)
-  std::vector<std::string> halo_needed_;
+  // By Process: run()'s sweeps and what the halo exchanges after each (process.hpp
+  // sweeps_tails), worked out once
+  std::vector<SweepsTail> tails_;
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
   // The cell kernels' groups: (local_x_, 1) work-items, groups_x_ per padded row (the global

@@ -192,38 +192,35 @@ std::vector<std::string> neighbour_read_fields(const Params& params);
 std::vector<std::string> halo_fields(const SweepInfo& sweep,
                                      const std::vector<std::string>& needed);
 
+/// What Backend::run(p) does after the process's own loops, worked out once for a run: the
+/// process's sweeps and the fields to exchange after each (empty without a shared halo).
+struct SweepsTail {
+  std::vector<SweepInfo> sweeps;
+  /// exchange[k]: after sweep k, halo_fields(sweeps[k], needed), less, for a sweep of the
+  /// process's own loops, what a later one of them reads at a neighbour and leaves as it is
+  /// (the loop has exchanged that already: thermal's shares before it applies them)
+  std::vector<std::vector<std::string>> exchange;
+};
+
+/// The SweepsTail of every process (indexed by Process) for a run of `params`: `halo` whether
+/// the halo is shared (boundary.periodic_x, MPI bands); the exchanges hold only what
+/// neighbour_read_fields(params) holds.
+std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo);
+
 /// The tail of Backend::run(p) in both backends, the one place of the halo exchange: after the
 /// process's own loops (which exchange in between where a pass reads what an earlier one of
-/// theirs wrote), the exchange of their sweeps' fields; then each generic sweep of `sweeps`
-/// (`run_generic(sweep)`) and its exchange (`exchange(halo_fields(sweep, needed))`). `halo`:
-/// whether the halo is shared (boundary.periodic_x, MPI bands); without it only the generic
-/// sweeps run. `needed`: neighbour_read_fields of the run's parameters.
+/// theirs wrote), the exchange of their sweeps' fields; then each generic sweep
+/// (`run_generic(sweep)`) and its exchange (`exchange(fields)`), as `tail` (sweeps_tails)
+/// lists them.
 template <class RunGeneric, class Exchange>
-void run_sweeps_tail(const std::vector<SweepInfo>& sweeps, bool halo,
-                     const std::vector<std::string>& needed, const RunGeneric& run_generic,
+void run_sweeps_tail(const SweepsTail& tail, const RunGeneric& run_generic,
                      const Exchange& exchange) {
-  auto exchange_written = [&](const SweepInfo& s, const std::vector<std::string>& done) {
-    std::vector<std::string> fields;
-    for (const std::string& f : halo_fields(s, needed))
-      if (std::find(done.begin(), done.end(), f) == done.end()) fields.push_back(f);
-    if (!fields.empty()) exchange(fields);
-  };
-  if (halo)
-    for (std::size_t k = 0; k < sweeps.size(); ++k) {
-      if (sweeps[k].generic) continue;
-      // what a later sweep of the process reads at a neighbour and leaves as it is, the
-      // process's own loop has exchanged already (thermal's shares before it applies them)
-      std::vector<std::string> done;
-      for (std::size_t j = k + 1; j < sweeps.size(); ++j)
-        if (!sweeps[j].generic)
-          for (const FieldUse& u : sweeps[j].uses)
-            if (reads_neighbours(u.access) && !writes(u.access)) done.emplace_back(u.field);
-      exchange_written(sweeps[k], done);
-    }
-  for (const SweepInfo& s : sweeps)
-    if (s.generic) {
-      run_generic(s);
-      if (halo) exchange_written(s, {});
+  for (std::size_t k = 0; k < tail.sweeps.size(); ++k)
+    if (!tail.sweeps[k].generic && !tail.exchange[k].empty()) exchange(tail.exchange[k]);
+  for (std::size_t k = 0; k < tail.sweeps.size(); ++k)
+    if (tail.sweeps[k].generic) {
+      run_generic(tail.sweeps[k]);
+      if (!tail.exchange[k].empty()) exchange(tail.exchange[k]);
     }
 }
 
