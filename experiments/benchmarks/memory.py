@@ -11,6 +11,10 @@ the OpenCL buffers live in host memory, so they are in the figure too.
 Usage (from the repository root, after building build/cli/erodem):
   python3 experiments/benchmarks/memory.py                  # 2048^2, every configuration
   python3 experiments/benchmarks/memory.py --size 4096 --backends cpu
+  # the 16385^2 run of docs/performance.md (about 22 GiB, 5 minutes on 2 cores): the default
+  # erosion configuration, the depth alone written, no restart state
+  python3 experiments/benchmarks/memory.py --size 16385 --backends cpu --precisions float32 \
+      --schemes local_inertial --erosion on --light-output
 Prints a Markdown table (docs/performance.md, "Resident memory").
 """
 import argparse
@@ -47,19 +51,22 @@ precision = "{precision}"
 [output]
 path = "{output}"
 every = {steps}
-"""
+{light}"""
 
 SCHEMES = ["pipes", "local_inertial", "shallow_water"]
 
 
-def peak_rss(erodem, folder, size, steps, scheme, erosion, precision, backend):
-    """The child's peak resident set (bytes) for one run."""
+def peak_rss(erodem, folder, size, steps, scheme, erosion, precision, backend, light=False):
+    """The child's peak resident set (bytes) for one run; `light`: the depth alone written,
+    without the restart state (a run whose output would otherwise take longer than its steps)."""
     output = os.path.join(folder, "m.h5")
     cfg = os.path.join(folder, "m.toml")
     with open(cfg, "w") as f:
         f.write(CONFIG.format(size=size, steps=steps, scheme=scheme,
                               erosion="true" if erosion else "false", precision=precision,
-                              output=output))
+                              output=output,
+                              light='fields = ["water_depth"]\nrestart_state = false\n'
+                              if light else ""))
     env = dict(os.environ, OMP_NUM_THREADS="2")
     # Each run in a fresh child of a fresh helper: RUSAGE_CHILDREN keeps the largest child
     # seen so far, so a small run after a large one would read the large one's peak.
@@ -84,20 +91,26 @@ def main():
     ap.add_argument("--steps", type=int, default=3)
     ap.add_argument("--backends", default="cpu,opencl")
     ap.add_argument("--erodem", default=os.path.join(ROOT, "build", "cli", "erodem"))
+    ap.add_argument("--schemes", default=",".join(SCHEMES))
+    ap.add_argument("--precisions", default="float32,float64")
+    ap.add_argument("--erosion", choices=["off", "on", "both"], default="both",
+                    help="erosion + thermal off, on, or both runs")
+    ap.add_argument("--light-output", action="store_true",
+                    help="write the depth alone and no restart state")
     a = ap.parse_args()
     cells = a.size * a.size - 64 * 64
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for backend in a.backends.split(","):
-            for precision in ["float32", "float64"]:
+            for precision in a.precisions.split(","):
                 if backend == "opencl" and precision == "float64":
                     continue  # the OpenCL kernels are float32
-                for scheme in SCHEMES:
-                    for erosion in (False, True):
+                for scheme in a.schemes.split(","):
+                    for erosion in {"off": (False,), "on": (True,), "both": (False, True)}[a.erosion]:
                         base = peak_rss(a.erodem, folder, 64, a.steps, scheme, erosion,
-                                        precision, backend)
+                                        precision, backend, a.light_output)
                         big = peak_rss(a.erodem, folder, a.size, a.steps, scheme, erosion,
-                                       precision, backend)
+                                       precision, backend, a.light_output)
                         per_cell = (big - base) / cells
                         rows.append((backend, precision, scheme, erosion, big, per_cell))
                         print("%-6s %-7s %-14s erosion %-5s peak %7.1f MiB  %6.1f B/cell"
