@@ -16,11 +16,15 @@ void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const c
                               ny, n - 1));
 }
 
-void check_rows(FieldId id, int row0, int row1, std::size_t count, int nx, int ny) {
+void check_row_range(FieldId id, int row0, int row1, int nx, int ny) {
   if (row0 < 0 || row1 > ny || row0 > row1)
     throw Error(ExitCode::usage, fmt::format("field '{}': rows [{}, {}) are not rows of a grid "
                                              "of {} x {} (0 .. {})",
                                              field_info(id).name, row0, row1, nx, ny, ny));
+}
+
+void check_rows(FieldId id, int row0, int row1, std::size_t count, int nx, int ny) {
+  check_row_range(id, row0, row1, nx, ny);
   const std::size_t expected = static_cast<std::size_t>(row1 - row0) * static_cast<std::size_t>(nx);
   if (count != expected)
     throw Error(ExitCode::data,

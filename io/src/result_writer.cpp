@@ -612,21 +612,26 @@ void ResultWriter::store_state(const Simulation& sim) {
     if (m.once[k]) {  // a new row only when the values differ from the last one stored
       bool same = false;
       if (m.row_count[k] > 0) {  // compared with that row as the file holds it, strip by strip
+        // (every strip, also after one differs: field_rows is collective in an MPI run, so
+        // every rank makes the same calls whatever its own file holds)
         const hsize_t last_row = static_cast<hsize_t>(m.row_count[k] - 1);
-        same = for_strips(ny, [&](int row0, int row1) {
+        same = true;
+        for_strips(ny, [&](int row0, int row1) {
           const std::vector<double> v = sim.field_rows(id, row0, row1);
+          if (!same) return true;  // (the file need not be read)
           if (m.restart_f64) {
             std::vector<double> last(v.size());
             read_strip(ds, H5T_NATIVE_DOUBLE, last_row, row0, row1 - row0, last.data(), partial_,
                        name);
-            return std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
+            same = std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
+            return true;
           }
           std::vector<float> last(v.size());
           read_strip(ds, H5T_NATIVE_FLOAT, last_row, row0, row1 - row0, last.data(), partial_,
                      name);
-          for (std::size_t i = 0; i < v.size(); ++i) {
+          for (std::size_t i = 0; i < v.size() && same; ++i) {
             const float f = static_cast<float>(v[i]);
-            if (std::memcmp(&last[i], &f, sizeof(float)) != 0) return false;
+            same = std::memcmp(&last[i], &f, sizeof(float)) == 0;
           }
           return true;
         });

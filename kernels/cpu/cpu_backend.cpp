@@ -418,6 +418,7 @@ std::vector<double> CpuBackend<Real>::field(FieldId id) const {
 
 template <class Real>
 std::vector<double> CpuBackend<Real>::field_rows(FieldId id, int row0, int row1) const {
+  check_row_range(id, row0, row1, nx_, ny_);
   // the rows of [row0, row1) this rank owns (all of them in one process; DEM row r is padded
   // row r + 1 - row0_), then every rank's in row order
   const int y0 = std::max(own0_, row0 + 1 - row0_), y1 = std::min(own1_, row1 + 1 - row0_);

@@ -128,6 +128,7 @@ std::vector<double> OpenClBackend::field(FieldId id) const {
 }
 
 std::vector<double> OpenClBackend::field_rows(FieldId id, int row0, int row1) const {
+  check_row_range(id, row0, row1, nx_, ny_);
   const std::size_t n = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(row1 - row0);
   if (fields_.reads_zeros(id)) return std::vector<double>(n);  // without a buffer of zeros
   auto* self = const_cast<OpenClBackend*>(this);

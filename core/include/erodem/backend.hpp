@@ -104,8 +104,11 @@ struct HostView {
 /// Checks that every cell of `cells` is a DEM cell of an nx x ny grid (0 <= cell < nx ny):
 /// Error(ExitCode::usage) naming `what` and the first cell that is not.
 void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const char* what);
-/// Throws Error(usage) unless [row0, row1) are rows of a grid of nx x ny cells, and
-/// Error(data) unless `count` (values given for field `id`) is (row1 - row0) * nx.
+/// Throws Error(usage) unless [row0, row1) are rows of a grid of nx x ny cells (row0 <= row1),
+/// naming field `id`.
+void check_row_range(FieldId id, int row0, int row1, int nx, int ny);
+/// check_row_range, and Error(data) unless `count` (values given for field `id`) is
+/// (row1 - row0) * nx.
 void check_rows(FieldId id, int row0, int row1, std::size_t count, int nx, int ny);
 
 /// The faces as the backends index them: 2 * (padded cell index) + axis, with the padded
