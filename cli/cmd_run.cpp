@@ -71,9 +71,10 @@ std::string command_line() {
   return line;
 }
 
-/// Where a rank of an MPI run other than 0 writes its result file: a fresh directory in the
-/// temporary directory, removed with this (docs/mpi.md: every rank runs the writer, whose
-/// reads of the fields gather them from all ranks; rank 0's file is the result).
+/// Where a rank of an MPI run other than 0 writes its result file in a build without parallel
+/// HDF5: a fresh directory in the temporary directory, removed with this (docs/mpi.md: every
+/// rank runs the writer, whose reads of the fields gather them from all ranks; rank 0's file
+/// is the result).
 class ScratchDir {
  public:
   ScratchDir() {
@@ -154,13 +155,16 @@ int run(const RunOptions& o) {
                             "without MPI (ERODEM_MPI off): each would run the whole grid into the "
                             "same output; rebuild with MPI (docs/mpi.md) or run one process",
                             parallel::launched_size()));
-  // MPI (docs/mpi.md): rank 0 writes the result and reports; the others run the same session
-  // quietly into a scratch file.
+  // MPI (docs/mpi.md): rank 0 reports; every rank writes the one result file with parallel
+  // HDF5 (io::collective_files), or, in a build with serial HDF5 only, rank 0 writes it and the
+  // others run the same session quietly into a scratch file.
   const bool root = parallel::rank() == 0;
   std::optional<ScratchDir> scratch;
   if (!root) {
-    scratch.emplace();
-    p.output.path = (scratch->path() / std::filesystem::path(p.output.path).filename()).string();
+    if (!io::collective_files()) {
+      scratch.emplace();
+      p.output.path = (scratch->path() / std::filesystem::path(p.output.path).filename()).string();
+    }
     spdlog::set_level(spdlog::level::off);
   }
   if (o.dump_config) {

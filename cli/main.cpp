@@ -41,7 +41,11 @@ int main(int argc, char** argv) {
   io::skip_hdf5_exit_cleanup();  // one error line, not HDF5's page (corrupt result files)
   CLI::App app{"erodem — hydrology and hydraulic erosion on real terrain"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("erodem ") + ERODEM_VERSION);
+  // the version, and how an MPI run writes its result (docs/mpi.md)
+  app.set_version_flag("--version", std::string("erodem ") + ERODEM_VERSION +
+                                        (!parallel::built_with_mpi()      ? ""
+                                         : io::built_with_parallel_hdf5() ? " (MPI, parallel HDF5)"
+                                                                          : " (MPI, serial HDF5)"));
   std::map<CLI::App*, cli::Action> actions;
   auto add = [&](cli::Action (*f)(CLI::App&)) {
     const auto before = app.get_subcommands({}).size();

@@ -10,6 +10,7 @@
 #include "erodem/error.hpp"
 #include "erodem/io/paths.hpp"
 #include "erodem/io/results.hpp"
+#include "erodem/parallel.hpp"
 
 namespace erodem::io {
 
@@ -58,7 +59,97 @@ void checked(herr_t status, const std::string& path, const std::string& what) {
   if (status < 0) write_failed(path, what);
 }
 
-void put_text(hid_t obj, const char* name, const std::string& value, const std::string& path) {
+bool built_with_parallel_hdf5() {
+#ifdef ERODEM_PARALLEL_HDF5
+  return true;
+#else
+  return false;
+#endif
+}
+
+bool collective_files() {
+  return built_with_parallel_hdf5() && parallel::size() > 1;
+}
+
+H5Id file_access(const std::string& path) {
+  H5Id fapl = checked(H5Pcreate(H5P_FILE_ACCESS), path, "file access properties");
+#ifdef ERODEM_PARALLEL_HDF5
+  if (collective_files())
+    checked(H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL), path, "MPI-IO file access");
+#endif
+  return fapl;
+}
+
+std::string root_text(const std::string& value) {
+  if (!collective_files()) return value;
+  const bool root = parallel::rank() == 0;
+  const std::vector<unsigned char> all =
+      parallel::allgather_bytes(root ? value.data() : nullptr, root ? value.size() : 0);
+  return std::string(all.begin(), all.end());
+}
+
+namespace {
+
+/// The transfer properties of a write: collective MPI-IO where collective_files().
+H5Id write_transfer(const std::string& path) {
+  H5Id dxpl = checked(H5Pcreate(H5P_DATASET_XFER), path, "transfer properties");
+#ifdef ERODEM_PARALLEL_HDF5
+  if (collective_files())
+    checked(H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE), path, "collective transfer");
+#endif
+  return dxpl;
+}
+
+/// The dataset's type in memory (native): a collective write that would convert types falls
+/// back to independent I/O, which a compressed dataset refuses, so the writes convert first.
+H5Id native_type(hid_t ds, const std::string& path, const std::string& name) {
+  const H5Id file_type = checked(H5Dget_type(ds), path, name);
+  return checked(H5Tget_native_type(file_type, H5T_DIR_ASCEND), path, name);
+}
+
+/// `n` values of `mem_type` at `data` as `type` (native_type): the conversion H5Dwrite makes
+/// (H5Tconvert), so the file holds the same bits.
+std::vector<unsigned char> converted(hid_t type, hid_t mem_type, std::size_t n, const void* data,
+                                     const std::string& path, const std::string& name) {
+  const std::size_t from = H5Tget_size(mem_type), to = H5Tget_size(type);
+  std::vector<unsigned char> bytes(n * std::max(from, to));
+  if (n == 0) return bytes;
+  std::memcpy(bytes.data(), data, n * from);
+  if (H5Tequal(type, mem_type) <= 0)
+    checked(H5Tconvert(mem_type, type, n, bytes.data(), nullptr, H5P_DEFAULT), path,
+            name + " (converting)");
+  return bytes;
+}
+
+}  // namespace
+
+void write_shared(hid_t ds, hid_t mem_type, hid_t mem_space, hid_t file_space, const void* data,
+                  const std::string& path, const std::string& name) {
+  if (!collective_files()) {
+    checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+    return;
+  }
+  const H5Id dxpl = write_transfer(path);
+  if (parallel::rank() == 0) {
+    H5Id all;
+    if (mem_space == H5S_ALL) all = checked(H5Dget_space(ds), path, name);
+    const hssize_t n = H5Sget_select_npoints(mem_space == H5S_ALL ? all.get() : mem_space);
+    const H5Id type = native_type(ds, path, name);
+    const auto bytes = converted(type, mem_type, static_cast<std::size_t>(n), data, path, name);
+    checked(H5Dwrite(ds, type, mem_space, file_space, dxpl, bytes.data()), path, name);
+    return;
+  }
+  // the other ranks take part in the collective write with nothing selected
+  H5Id none_file = checked(H5Dget_space(ds), path, name);
+  H5Sselect_none(none_file);
+  const hsize_t one = 1;
+  H5Id none_mem = checked(H5Screate_simple(1, &one, nullptr), path, name);
+  H5Sselect_none(none_mem);
+  checked(H5Dwrite(ds, native_type(ds, path, name), none_mem, none_file, dxpl, data), path, name);
+}
+
+void put_text(hid_t obj, const char* name, const std::string& text, const std::string& path) {
+  const std::string value = root_text(text);
   const std::size_t size = std::max<std::size_t>(value.size(), 2);
   std::string buf = value;
   buf.resize(size, '\0');
@@ -157,7 +248,7 @@ void append_rows(hid_t ds, hid_t mem_type, hsize_t rows, const void* data, const
       H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
       path, name);
   H5Id mem_space = checked(H5Screate_simple(rank, count.data(), nullptr), path, name);
-  checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+  write_shared(ds, mem_type, mem_space, file_space, data, path, name);
 }
 
 void read_row(hid_t ds, hid_t mem_type, hsize_t row, void* data, const std::string& path,
@@ -205,8 +296,25 @@ std::pair<H5Id, H5Id> strip_spaces(hid_t ds, hsize_t index, hsize_t y0, hsize_t 
 
 void write_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows,
                  const void* data, const std::string& path, const std::string& name) {
-  const auto [file_space, mem_space] = strip_spaces(ds, index, y0, rows, path, name);
-  checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+  if (!collective_files()) {
+    const auto [file_space, mem_space] = strip_spaces(ds, index, y0, rows, path, name);
+    checked(H5Dwrite(ds, mem_type, mem_space, file_space, H5P_DEFAULT, data), path, name);
+    return;
+  }
+  // every rank in the collective write, with its rows or with none selected
+  const auto [file_space, mem_space] =
+      strip_spaces(ds, index, y0, std::max<hsize_t>(rows, 1), path, name);
+  if (rows == 0) {
+    H5Sselect_none(file_space);
+    H5Sselect_none(mem_space);
+  }
+  std::array<hsize_t, 3> dims{};
+  H5Sget_simple_extent_dims(file_space, dims.data(), nullptr);
+  const H5Id type = native_type(ds, path, name);
+  const auto bytes =
+      converted(type, mem_type, static_cast<std::size_t>(rows * dims[2]), data, path, name);
+  checked(H5Dwrite(ds, type, mem_space, file_space, write_transfer(path), bytes.data()), path,
+          name);
 }
 
 void read_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows, void* data,

@@ -100,10 +100,31 @@ void checked(herr_t status, const std::string& path, const std::string& what);
 
 constexpr unsigned kCreationOrder = H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED;
 
+// ---- MPI: one result file written by every rank (parallel HDF5) ----------------------------
+
+// collective_files() (results.hpp): every rank makes the same HDF5 calls, in the same order,
+// with the same values, on one file (MPI-IO). What changes the file's structure (datasets,
+// attributes, extents, flushes) is collective in parallel HDF5, and so is every write here (a
+// compressed dataset takes no other).
+
+/// The access properties of a result file: MPI-IO over every rank where collective_files(),
+/// else HDF5's defaults.
+H5Id file_access(const std::string& path);
+
+/// Rank 0's `value` on every rank where collective_files() (collective), else `value`.
+std::string root_text(const std::string& value);
+
+/// Writes `data`, which every rank holds alike, to the selection of `file_space` (H5S_ALL: the
+/// whole dataset) from `mem_space`: collectively, rank 0's values, where collective_files();
+/// as one H5Dwrite otherwise.
+void write_shared(hid_t ds, hid_t mem_type, hid_t mem_space, hid_t file_space, const void* data,
+                  const std::string& path, const std::string& name);
+
 // ---- attributes -----------------------------------------------------------------------------
 
 /// A text attribute as netCDF-4 writes one (NC_CHAR: fixed-length string, scalar). Values
-/// shorter than 2 bytes are null-padded to 2 so that h5py/h5netcdf decode them to str.
+/// shorter than 2 bytes are null-padded to 2 so that h5py/h5netcdf decode them to str. Where
+/// collective_files(), rank 0's value (the time of `created` may differ between ranks).
 void put_text(hid_t obj, const char* name, const std::string& value, const std::string& path);
 
 /// A numeric attribute: one value (scalar) or an array.
@@ -135,7 +156,9 @@ void read_row(hid_t ds, hid_t mem_type, hsize_t row, void* data, const std::stri
 hsize_t grow_row(hid_t ds, const std::string& path, const std::string& name);
 
 /// Writes (write_strip) or reads (read_strip) `data`, the rows [y0, y0 + rows) of row
-/// `index` of a dataset (time, y, x): a snapshot's field a strip at a time.
+/// `index` of a dataset (time, y, x): a snapshot's field a strip at a time. Where
+/// collective_files(), write_strip is collective and each rank gives the rows it computed
+/// (Simulation::own_field_rows; `rows` 0: none); read_strip reads independently.
 void write_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows,
                  const void* data, const std::string& path, const std::string& name);
 void read_strip(hid_t ds, hid_t mem_type, hsize_t index, hsize_t y0, hsize_t rows, void* data,

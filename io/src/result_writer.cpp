@@ -24,6 +24,7 @@
 #include "erodem/fields.hpp"
 #include "erodem/io/paths.hpp"
 #include "erodem/io/results.hpp"
+#include "erodem/parallel.hpp"
 #include "erodem/process.hpp"
 #include "erodem/schema.hpp"
 #include "h5.hpp"
@@ -60,6 +61,20 @@ bool for_strips(int ny, const F& f) {
   for (int row0 = 0; row0 < ny; row0 += static_cast<int>(kChunkSide))
     if (!f(row0, std::min(ny, row0 + static_cast<int>(kChunkSide)))) return false;
   return true;
+}
+
+/// The rows of strip [row0, row1) of field `id` that this process writes: in an MPI run that
+/// writes one file together (collective_files()) the rows of its band, none where the band
+/// misses the strip (no field is gathered to every rank); otherwise the whole strip.
+OwnRows rows_to_write(const Simulation& sim, FieldId id, int row0, int row1) {
+  if (collective_files()) return sim.own_field_rows(id, row0, row1);
+  return {row0, row1, sim.field_rows(id, row0, row1)};
+}
+
+/// Whether `yes` holds on every rank of an MPI run (collective); `yes` in one process.
+bool on_every_rank(bool yes) {
+  const std::vector<std::uint8_t> all = parallel::allgather(std::vector<std::uint8_t>{yes});
+  return std::all_of(all.begin(), all.end(), [](std::uint8_t v) { return v != 0; });
 }
 
 std::string iso_utc_now() {
@@ -202,8 +217,7 @@ struct ResultWriter::Impl {
     H5Id ds = create_dataset(loc, name, type, {dims}, {maxdims},
                              unlimited ? std::vector<hsize_t>{512} : std::vector<hsize_t>{}, false,
                              nullptr, partial);
-    if (!unlimited && n > 0)
-      checked(H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values), partial, name);
+    if (!unlimited && n > 0) write_shared(ds, type, H5S_ALL, H5S_ALL, values, partial, name);
     checked(H5DSset_scale(ds, name.c_str()), partial, "dimension scale " + name);
     return ds;
   }
@@ -334,10 +348,14 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   H5Id fcpl = checked(H5Pcreate(H5P_FILE_CREATE), partial_, "file properties");
   H5Pset_link_creation_order(fcpl, kCreationOrder);
   H5Pset_attr_creation_order(fcpl, kCreationOrder);
-  m.file = H5Id(H5Fcreate(partial_.c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT));
+  // MPI with parallel HDF5: every rank writes rank 0's partial file (collective_files)
+  partial_ = root_text(partial_);
+  m.partial = partial_;
+  const H5Id fapl = file_access(partial_);
+  m.file = H5Id(H5Fcreate(partial_.c_str(), H5F_ACC_TRUNC, fcpl, fapl));
   if (!m.file.valid())
     throw Error(ExitCode::cant_create, partial_ + ": cannot create" + h5_open_reason(partial_));
-  remove_stale_partials(path);
+  if (parallel::rank() == 0) remove_stale_partials(path);
 
   // Root attributes.
   const std::pair<const char*, std::string> root_attrs[] = {
@@ -402,8 +420,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
       if (values->size() != static_cast<std::size_t>(grid.ny)) continue;
       H5Id ds = create_dataset(m.file, name, H5T_IEEE_F64LE, {ys.size()}, {ys.size()}, {}, false,
                                nullptr, partial_);
-      checked(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values->data()),
-              partial_, name);
+      write_shared(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, values->data(), partial_, name);
       checked(H5DSattach_scale(ds, y, 0), partial_, std::string(name) + " dimensions");
       put_text(ds, "units", k == 2 ? "m2" : "m", partial_);
       put_text(ds, "long_name", row_long[k], partial_);
@@ -414,7 +431,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   {
     const std::int32_t zero = 0;
     H5Id crs = create_dataset(m.file, "crs", H5T_STD_I32LE, {}, {}, {}, false, nullptr, partial_);
-    checked(H5Dwrite(crs, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, &zero), partial_, "crs");
+    write_shared(crs, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, &zero, partial_, "crs");
     put_text(crs, "long_name", "coordinate reference system", partial_);
     if (!geo.crs_wkt.empty()) {
       put_text(crs, "crs_wkt", geo.crs_wkt, partial_);
@@ -523,8 +540,8 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
     put_text(gauge, "long_name", "gauge index in output.gauges", partial_);
     for (const auto& [name, values] : {std::pair{"x", &gx}, std::pair{"y", &gy}}) {
       H5Id ds = create_dataset(group, name, H5T_IEEE_F64LE, {n}, {n}, {}, false, nullptr, partial_);
-      checked(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values->data()),
-              partial_, std::string("gauges/") + name);
+      write_shared(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, values->data(), partial_,
+                   std::string("gauges/") + name);
       checked(H5DSattach_scale(ds, gauge, 0), partial_, std::string("gauges/") + name);
       const bool is_x = std::string(name) == "x";
       put_text(ds, "units", geo.is_geographic ? (is_x ? "degrees_east" : "degrees_north") : units,
@@ -566,8 +583,8 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
              partial_);
     H5Id is_outlet =
         create_dataset(group, "outlet", H5T_STD_I32LE, {n}, {n}, {}, false, nullptr, partial_);
-    checked(H5Dwrite(is_outlet, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, outlet.data()),
-            partial_, "sections/outlet");
+    write_shared(is_outlet, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, outlet.data(), partial_,
+                 "sections/outlet");
     checked(H5DSattach_scale(is_outlet, sec, 0), partial_, "sections/outlet");
     put_text(is_outlet, "units", "1", partial_);
     put_text(is_outlet, "long_name", "1 for an [[outlet]], 0 for a [[section]]", partial_);
@@ -612,29 +629,28 @@ void ResultWriter::store_state(const Simulation& sim) {
     if (m.once[k]) {  // a new row only when the values differ from the last one stored
       bool same = false;
       if (m.row_count[k] > 0) {  // compared with that row as the file holds it, strip by strip
-        // (every strip, also after one differs: field_rows is collective in an MPI run, so
-        // every rank makes the same calls whatever its own file holds)
+        // (in an MPI run each rank its own rows, read independently, then whether they are the
+        // same on every rank: every rank decides alike)
         const hsize_t last_row = static_cast<hsize_t>(m.row_count[k] - 1);
-        same = true;
-        for_strips(ny, [&](int row0, int row1) {
-          const std::vector<double> v = sim.field_rows(id, row0, row1);
-          if (!same) return true;  // (the file need not be read)
+        same = on_every_rank(for_strips(ny, [&](int row0, int row1) {
+          const OwnRows own = sim.own_field_rows(id, row0, row1);
+          const std::vector<double>& v = own.values;
+          const hsize_t rows = static_cast<hsize_t>(own.row1 - own.row0);
+          if (rows == 0) return true;
           if (m.restart_f64) {
             std::vector<double> last(v.size());
-            read_strip(ds, H5T_NATIVE_DOUBLE, last_row, row0, row1 - row0, last.data(), partial_,
+            read_strip(ds, H5T_NATIVE_DOUBLE, last_row, own.row0, rows, last.data(), partial_,
                        name);
-            same = std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
-            return true;
+            return std::memcmp(last.data(), v.data(), v.size() * sizeof(double)) == 0;
           }
           std::vector<float> last(v.size());
-          read_strip(ds, H5T_NATIVE_FLOAT, last_row, row0, row1 - row0, last.data(), partial_,
-                     name);
-          for (std::size_t i = 0; i < v.size() && same; ++i) {
+          read_strip(ds, H5T_NATIVE_FLOAT, last_row, own.row0, rows, last.data(), partial_, name);
+          for (std::size_t i = 0; i < v.size(); ++i) {
             const float f = static_cast<float>(v[i]);
-            same = std::memcmp(&last[i], &f, sizeof(float)) == 0;
+            if (std::memcmp(&last[i], &f, sizeof(float)) != 0) return false;
           }
           return true;
-        });
+        }));
       }
       const std::int32_t index = same ? m.row_count[k] - 1 : m.row_count[k];
       append_rows(m.restart_rows[k], H5T_NATIVE_INT32, 1, &index, partial_, name + "_row");
@@ -643,8 +659,9 @@ void ResultWriter::store_state(const Simulation& sim) {
     }
     const hsize_t index = grow_row(ds, partial_, name);
     for_strips(ny, [&](int row0, int row1) {
-      const std::vector<double> v = sim.field_rows(id, row0, row1);
-      write_strip(ds, H5T_NATIVE_DOUBLE, index, row0, row1 - row0, v.data(), partial_, name);
+      const OwnRows r = rows_to_write(sim, id, row0, row1);
+      write_strip(ds, H5T_NATIVE_DOUBLE, index, r.row0, r.row1 - r.row0, r.values.data(), partial_,
+                  name);
       return true;
     });
   }
@@ -688,11 +705,11 @@ void ResultWriter::take_snapshot(const Simulation& sim, bool last) {
     // NaN on the cells outside the DEM; HDF5 rounds the doubles to the dataset's floats
     const hsize_t index = grow_row(ds, partial_, info.name);
     for_strips(g.ny, [&](int row0, int row1) {
-      auto values = sim.field_rows(info.id, row0, row1);
-      const std::size_t first = static_cast<std::size_t>(row0) * g.nx;
-      for (std::size_t i = 0; i < values.size(); ++i)
-        if (!terrain.active(first + i)) values[i] = std::nan("");
-      write_strip(ds, H5T_NATIVE_DOUBLE, index, row0, row1 - row0, values.data(), partial_,
+      OwnRows r = rows_to_write(sim, info.id, row0, row1);
+      const std::size_t first = static_cast<std::size_t>(r.row0) * g.nx;
+      for (std::size_t i = 0; i < r.values.size(); ++i)
+        if (!terrain.active(first + i)) r.values[i] = std::nan("");
+      write_strip(ds, H5T_NATIVE_DOUBLE, index, r.row0, r.row1 - r.row0, r.values.data(), partial_,
                   info.name);
       return true;
     });
@@ -799,6 +816,7 @@ void ResultWriter::finish() {
   m.close();
   impl_.reset();
 
+  if (parallel::rank() != 0) return;  // MPI: rank 0 publishes (the file is closed on all ranks)
   publish();
   write_xdmf(path_, grid, xname, yname, times_, infos);
 }

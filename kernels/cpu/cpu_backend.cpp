@@ -418,20 +418,29 @@ std::vector<double> CpuBackend<Real>::field(FieldId id) const {
 
 template <class Real>
 std::vector<double> CpuBackend<Real>::field_rows(FieldId id, int row0, int row1) const {
+  // this rank's rows of [row0, row1), then every rank's in row order
+  OwnRows own = own_field_rows(id, row0, row1);
+  if (banded_) return parallel::allgather(own.values);
+  return std::move(own.values);
+}
+
+template <class Real>
+OwnRows CpuBackend<Real>::own_field_rows(FieldId id, int row0, int row1) const {
   check_row_range(id, row0, row1, nx_, ny_);
   // the rows of [row0, row1) this rank owns (all of them in one process; DEM row r is padded
-  // row r + 1 - row0_), then every rank's in row order
+  // row r + 1 - row0_)
   const int y0 = std::max(own0_, row0 + 1 - row0_), y1 = std::min(own1_, row1 + 1 - row0_);
-  std::vector<double> out(static_cast<std::size_t>(nx_) *
-                          static_cast<std::size_t>(std::max(y1 - y0, 0)));
+  OwnRows out;
+  out.row0 = y1 > y0 ? y0 - 1 + row0_ : row0;
+  out.row1 = y1 > y0 ? y1 - 1 + row0_ : row0;
+  out.values.resize(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(std::max(y1 - y0, 0)));
   if (!fields_.reads_zeros(id)) {  // a field not made yet: its zeros, without an array of them
     const Field* src = fields_.peek(id);
     for (int y = y0; y < y1; ++y)
       for (int c = 0; c < nx_; ++c)
-        out[static_cast<std::size_t>(y - y0) * nx_ + c] = value_at(id, src, at(c + 1, y));
+        out.values[static_cast<std::size_t>(y - y0) * nx_ + c] = value_at(id, src, at(c + 1, y));
   }
-  if (banded_) return parallel::allgather(out);
-  return out;  // (a conditional expression would return a copy)
+  return out;
 }
 
 template <class Real>

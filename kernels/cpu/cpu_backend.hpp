@@ -65,6 +65,7 @@ class CpuBackend final : public Backend {
   std::vector<double> sample(const std::vector<std::int64_t>& cells, FieldId id) const override;
   std::vector<double> field(FieldId id) const override;
   std::vector<double> field_rows(FieldId id, int row0, int row1) const override;
+  OwnRows own_field_rows(FieldId id, int row0, int row1) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
   void set_field_rows(FieldId id, int row0, int row1, const std::vector<double>& values) override;
   HostView host_view(FieldId id) override;

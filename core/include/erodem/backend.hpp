@@ -101,6 +101,13 @@ struct HostView {
   std::ptrdiff_t row_stride = 0;  ///< elements between the starts of two rows
 };
 
+/// Rows [row0, row1) of a field, row-major ((row1 - row0), nx), as Backend::own_field_rows
+/// gives them: the rows of a strip that this process computes.
+struct OwnRows {
+  int row0 = 0, row1 = 0;  ///< DEM rows [row0, row1); row0 == row1: none
+  std::vector<double> values;
+};
+
 /// Checks that every cell of `cells` is a DEM cell of an nx x ny grid (0 <= cell < nx ny):
 /// Error(ExitCode::usage) naming `what` and the first cell that is not.
 void check_cells(const std::vector<std::int64_t>& cells, int nx, int ny, const char* what);
@@ -183,6 +190,13 @@ class Backend {
   /// result writer takes a strip at a time, so that no whole field in double is held beside
   /// the state (8 B per cell at every snapshot). Collective in an MPI run, as field() is.
   virtual std::vector<double> field_rows(FieldId id, int row0, int row1) const = 0;
+  /// The rows of field_rows(id, row0, row1) that this process computes, without any
+  /// communication: in an MPI band the rows of [row0, row1) it owns (none where the band
+  /// misses them), else all of them. Each rank of an MPI run writes these into the one result
+  /// file (parallel HDF5, docs/mpi.md), so no field is gathered to every rank.
+  virtual OwnRows own_field_rows(FieldId id, int row0, int row1) const {
+    return {row0, row1, field_rows(id, row0, row1)};
+  }
   /// Replaces a field of the DEM grid (row-major (ny, nx)): set_field_rows(id, 0, ny, values).
   virtual void set_field(FieldId id, const std::vector<double>& values) = 0;
   /// Replaces rows [row0, row1) of a field of the DEM grid (`values` row-major, (row1 - row0)

@@ -150,6 +150,11 @@ class Simulation {
   std::vector<double> field_rows(FieldId id, int row0, int row1) const {
     return backend_->field_rows(id, row0, row1);
   }
+  /// The rows of field_rows(id, row0, row1) this process computes (Backend::own_field_rows):
+  /// an MPI band's own rows, all of them in one process; no communication.
+  OwnRows own_field_rows(FieldId id, int row0, int row1) const {
+    return backend_->own_field_rows(id, row0, row1);
+  }
   /// The processes a step runs with these parameters, in order.
   std::vector<Process> sequence() const;
   /// The passes a step runs them in (process.hpp step_passes, with numerics.fused_sweeps).

@@ -50,6 +50,14 @@ std::string partial_path(const std::string& path);
 /// Removes the partial files of `path` left by processes of this host that have ended
 /// (".run.h5.HOST-PID.partial" whose PID does not exist); those of other hosts stay.
 void remove_stale_partials(const std::string& path);
+/// Whether this build writes an MPI run's result file with parallel HDF5
+/// (ERODEM_PARALLEL_HDF5: CMake found the MPI build of HDF5, Debian's libhdf5-openmpi-dev).
+bool built_with_parallel_hdf5();
+/// Whether the ranks of this MPI run write one result file together: a build with parallel
+/// HDF5 (ERODEM_PARALLEL_HDF5) and more than one rank (docs/mpi.md). Every rank then runs the
+/// same ResultWriter calls on rank 0's partial file, each writing the rows of its band, and
+/// rank 0 renames it into place; otherwise each process writes a file of its own.
+bool collective_files();
 /// The XDMF sidecar of a result file: "dir/run.h5" -> "dir/run.xmf".
 std::string xdmf_path(const std::string& path);
 
