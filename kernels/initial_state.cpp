@@ -29,7 +29,7 @@ std::uint8_t cell_kind(BoundaryKind b) {
 
 }  // namespace
 
-PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
+PaddedState build_padded_state(const Terrain& terrain, const Params& params, int y0, int y1) {
   const auto& g = terrain.grid;
   g.validate();
   const std::size_t cells = g.cells();
@@ -44,57 +44,70 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
   check_size(terrain.hardness, "erosion.hardness");
   check_size(terrain.rain_factor, "rain.raster");
 
+  const int nx = g.nx, ny = g.ny, W = nx + 2, H = ny + 2;
+  if (y1 < 0) y1 = H;
+  if (!(0 <= y0 && y0 < y1 && y1 <= H))
+    throw Error(ExitCode::internal,
+                fmt::format("padded state: rows [{}, {}) of a grid of {} padded rows", y0, y1, H));
+  // Built on the rows [a, b): the rows asked for and one beside them each way, which the cells
+  // held at the level read (their active neighbours' beds); cut to [y0, y1) at the end.
+  const int a = std::max(0, y0 - 1), b = std::min(H, y1 + 1);
   PaddedState s;
-  s.nx = g.nx;
-  s.ny = g.ny;
-  s.W = g.nx + 2;
-  s.H = g.ny + 2;
-  const int nx = s.nx, ny = s.ny, W = s.W, H = s.H;
+  s.nx = nx;
+  s.ny = b - a - 2;
+  s.W = W;
+  s.H = b - a;
   const std::size_t n = s.size();
+  // the cell at column x of padded row y (of the whole grid), and DEM cell (c, r)
+  const auto at = [&s, a](int x, int y) { return s.at(x, y - a); };
+  const auto dem = [nx](int c, int r) { return static_cast<std::size_t>(r) * nx + c; };
+  // the DEM rows [r0, r1) on the rows [a, b), and the same as padded rows [first, last]
+  const int r0 = std::max(0, a - 1), r1 = std::min(ny, b - 1);
+  const int first = r0 + 1, last = r1;
 
   // Geometry per padded row; halo rows repeat their neighbours.
-  s.dx.resize(H);
-  s.dy.resize(H);
-  s.area.resize(H);
-  for (int y = 0; y < H; ++y) {
+  s.dx.resize(s.H);
+  s.dy.resize(s.H);
+  s.area.resize(s.H);
+  for (int y = a; y < b; ++y) {
     const int r = std::clamp(y - 1, 0, ny - 1);
-    s.dx[y] = g.dx[r];
-    s.dy[y] = g.dy[r];
-    s.area[y] = g.area[r];
+    s.dx[y - a] = g.dx[r];
+    s.dy[y - a] = g.dy[r];
+    s.area[y - a] = g.area[r];
   }
 
   // Cell kinds: DEM cells active, or not (a wall, or held at the level: boundary_codes.hpp);
   // halo by the edge's condition there (the edge's, or boundary.raster's at the edge cell).
   s.kind.assign(n, ERODEM_CELL_WALL);
-  for (int r = 0; r < ny; ++r)
+  for (int r = r0; r < r1; ++r)
     for (int c = 0; c < nx; ++c) {
-      const auto i = static_cast<std::size_t>(r) * nx + c;
-      s.kind[s.at(c + 1, r + 1)] = terrain.active(i)                   ? ERODEM_CELL_ACTIVE
-                                   : held_at_level(terrain, params, i) ? ERODEM_CELL_FIXED
-                                                                       : ERODEM_CELL_WALL;
+      const auto i = dem(c, r);
+      s.kind[at(c + 1, r + 1)] = terrain.active(i)                   ? ERODEM_CELL_ACTIVE
+                                 : held_at_level(terrain, params, i) ? ERODEM_CELL_FIXED
+                                                                     : ERODEM_CELL_WALL;
     }
-  for (int y = 1; y <= ny; ++y) {
-    if (s.kind[s.at(1, y)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(0, y)] = cell_kind(ghost_condition(terrain, params, 0, y - 1, Side::west));
-    if (s.kind[s.at(nx, y)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(nx + 1, y)] =
+  for (int y = first; y <= last; ++y) {
+    if (s.kind[at(1, y)] == ERODEM_CELL_ACTIVE)
+      s.kind[at(0, y)] = cell_kind(ghost_condition(terrain, params, 0, y - 1, Side::west));
+    if (s.kind[at(nx, y)] == ERODEM_CELL_ACTIVE)
+      s.kind[at(nx + 1, y)] =
           cell_kind(ghost_condition(terrain, params, nx - 1, y - 1, Side::east));
   }
   for (int x = 1; x <= nx; ++x) {
-    if (s.kind[s.at(x, 1)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(x, 0)] = cell_kind(ghost_condition(terrain, params, x - 1, 0, Side::north));
-    if (s.kind[s.at(x, ny)] == ERODEM_CELL_ACTIVE)
-      s.kind[s.at(x, ny + 1)] =
+    if (a == 0 && s.kind[at(x, 1)] == ERODEM_CELL_ACTIVE)
+      s.kind[at(x, 0)] = cell_kind(ghost_condition(terrain, params, x - 1, 0, Side::north));
+    if (b == H && s.kind[at(x, ny)] == ERODEM_CELL_ACTIVE)
+      s.kind[at(x, ny + 1)] =
           cell_kind(ghost_condition(terrain, params, x - 1, ny - 1, Side::south));
   }
 
   // Bed and initial water (computed in double; backends round once).
   s.bed.assign(n, 0.0);
   s.depth.assign(n, 0.0);
-  for (int r = 0; r < ny; ++r)
+  for (int r = r0; r < r1; ++r)
     for (int c = 0; c < nx; ++c) {
-      const auto i = static_cast<std::size_t>(r) * nx + c;
-      const auto p = s.at(c + 1, r + 1);
+      const auto i = dem(c, r);
+      const auto p = at(c + 1, r + 1);
       if (s.kind[p] != ERODEM_CELL_ACTIVE) continue;
       s.bed[p] = terrain.bed[i];
       if (!terrain.water_depth.empty())
@@ -106,14 +119,15 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
     }
   // Cells held at the level: nodata sea cells over a bed no higher than their active
   // neighbours nor the lowest level (so the sea never runs dry), cells coded fixed_level on
-  // their own bed; each holds the level at t = 0 and the sediment its water carries in.
+  // their own bed; each holds the level at t = 0 and the sediment its water carries in. (On
+  // the DEM rows among those asked for: the rows beside them are built.)
   s.sediment.assign(n, 0.0);
   const double sea = boundary_level(params, 0.0), lowest = boundary_level_range(params).first;
-  for (int y = 1; y <= ny; ++y)
+  for (int y = std::max(1, y0); y <= std::min(ny, y1 - 1); ++y)
     for (int x = 1; x <= nx; ++x) {
-      const auto p = s.at(x, y);
+      const auto p = at(x, y);
       if (s.kind[p] == ERODEM_CELL_ACTIVE) continue;
-      const auto i = static_cast<std::size_t>(y - 1) * nx + (x - 1);
+      const auto i = dem(x - 1, y - 1);
       double low = lowest;
       for (auto q : {p - 1, p + 1, p - W, p + W})
         if (s.kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, s.bed[q]);
@@ -128,15 +142,16 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
   auto raster_or = [&](const std::vector<double>& raster, double scalar) {
     std::vector<double> out(n, scalar);
     if (raster.empty()) return out;
-    for (int y = 0; y < H; ++y)
+    for (int y = a; y < b; ++y)
       for (int x = 0; x < W; ++x) {
         const int r = std::clamp(y - 1, 0, ny - 1), c = std::clamp(x - 1, 0, nx - 1);
-        out[s.at(x, y)] = raster[static_cast<std::size_t>(r) * nx + c];
+        out[at(x, y)] = raster[dem(c, r)];
       }
     return out;
   };
   s.manning = raster_or(terrain.manning_n, params.flow.manning_n.value);
-  // erosion.hardness = "noise": the noise field stands where a hardness raster would.
+  // erosion.hardness = "noise": the noise field stands where a hardness raster would (the
+  // whole grid's: it is scaled to the range of its active cells).
   if (params.erosion.hardness_noise && !terrain.hardness.empty())
     throw config_error("erosion.hardness",
                        "is \"noise\", but the terrain carries a hardness raster; give one");
@@ -152,37 +167,24 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params) {
                                    nx));
   if (s.periodic_x) {
     // the ghost columns repeat the opposite DEM columns (the corners the ghost rows' ends)
-    copy_periodic_columns(s.kind.data(), W, H);
+    copy_periodic_columns(s.kind.data(), W, s.H);
     for (auto* f : {&s.bed, &s.depth, &s.sediment, &s.manning, &s.hardness, &s.rain_factor})
-      copy_periodic_columns(f->data(), W, H);
+      copy_periodic_columns(f->data(), W, s.H);
   }
-  return s;
-}
 
-PaddedState padded_rows(const PaddedState& s, int y0, int y1) {
-  PaddedState out;
-  out.nx = s.nx;
-  out.ny = y1 - y0 - 2;
-  out.W = s.W;
-  out.H = y1 - y0;
-  out.periodic_x = s.periodic_x;
-  const auto rows = [&](const auto& v, std::size_t per_row) {
-    using V = std::decay_t<decltype(v)>;
-    return V(v.begin() + static_cast<std::ptrdiff_t>(per_row) * y0,
-             v.begin() + static_cast<std::ptrdiff_t>(per_row) * y1);
+  // The rows asked for: [y0, y1) of [a, b).
+  const auto cut = [&](auto& v, std::size_t per_row) {
+    v.erase(v.begin() + static_cast<std::ptrdiff_t>(per_row) * (y1 - a), v.end());
+    v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(per_row) * (y0 - a));
   };
-  const auto W = static_cast<std::size_t>(s.W);
-  out.kind = rows(s.kind, W);
-  out.dx = rows(s.dx, 1);
-  out.dy = rows(s.dy, 1);
-  out.area = rows(s.area, 1);
-  out.bed = rows(s.bed, W);
-  out.depth = rows(s.depth, W);
-  out.sediment = rows(s.sediment, W);
-  out.manning = rows(s.manning, W);
-  out.hardness = rows(s.hardness, W);
-  out.rain_factor = rows(s.rain_factor, W);
-  return out;
+  const auto row = static_cast<std::size_t>(W);
+  cut(s.kind, row);
+  for (auto* f : {&s.bed, &s.depth, &s.sediment, &s.manning, &s.hardness, &s.rain_factor})
+    cut(*f, row);
+  for (auto* f : {&s.dx, &s.dy, &s.area}) cut(*f, 1);
+  s.H = y1 - y0;
+  s.ny = s.H - 2;
+  return s;
 }
 
 }  // namespace erodem

@@ -30,7 +30,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       ny_(terrain.grid.ny),
       W_(terrain.grid.nx + 2),
       H_(terrain.grid.ny + 2) {
-  PaddedState s = build_padded_state(terrain, params);
+  int y0 = 0, y1 = H_;  // the padded rows this backend holds: all of them, or a band's
   if (const int ranks = parallel::size(); ranks > 1) {
     // A band of rows of an MPI run (docs/mpi.md): its rows, halo_rows_ rows of each
     // neighbouring band, and the grid's ghost row where the band meets the edge.
@@ -49,9 +49,8 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
                   fmt::format("mpirun -np {}: the grid's {} rows give rank {} {} rows, and each "
                               "rank needs at least {} (the halo); run fewer ranks",
                               ranks, ny_, r, band.row1 - band.row0, halo_rows_));
-    const int y0 = r == 0 ? 0 : band.row0 + 1 - halo_rows_;
-    const int y1 = r == ranks - 1 ? ny_ + 2 : band.row1 + 1 + halo_rows_;
-    s = padded_rows(s, y0, y1);
+    y0 = r == 0 ? 0 : band.row0 + 1 - halo_rows_;
+    y1 = r == ranks - 1 ? ny_ + 2 : band.row1 + 1 + halo_rows_;
     banded_ = true;
     row0_ = y0;
     H_ = y1 - y0;
@@ -60,6 +59,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   } else {
     own1_ = H_ - 1;
   }
+  PaddedState s = build_padded_state(terrain, params, y0, y1);
   periodic_ = s.periodic_x;
   tails_ = sweeps_tails(params, periodic_ || banded_);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;

@@ -36,11 +36,11 @@ struct PaddedState {
 /// wall or sea), bed and initial water (computed in double: initial.water_level - bed, a
 /// raster, or a uniform depth), sea ghosts over the lowest active neighbour, and the
 /// parameter rasters with their halo. Throws erodem::Error(data) on rasters of the wrong size.
-PaddedState build_padded_state(const Terrain& terrain, const Params& params);
-
-/// The padded rows [y0, y1) of `s` (a band of the MPI decomposition with its halo rows): the
-/// same fields, H = y1 - y0 rows.
-PaddedState padded_rows(const PaddedState& s, int y0, int y1);
+/// The padded rows [y0, y1) only (y1 < 0: to the last, H = ny + 2), H = y1 - y0 rows: a band
+/// of the MPI decomposition with its halo rows, the same values as those rows of the whole
+/// state, built without it (a rank holds its band's initial state, not the grid's).
+PaddedState build_padded_state(const Terrain& terrain, const Params& params, int y0 = 0,
+                               int y1 = -1);
 
 /// The periodic halo of a padded field of W x H: ghost column 0 takes column W - 2, ghost
 /// column W - 1 takes column 1, on every row (the corners too).
