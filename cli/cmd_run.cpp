@@ -78,7 +78,16 @@ std::string command_line() {
 class ScratchDir {
  public:
   ScratchDir() {
-    std::string name = (std::filesystem::temp_directory_path() / "erodem-rank-XXXXXX").string();
+    std::error_code ec;
+    const std::filesystem::path tmp = std::filesystem::temp_directory_path(ec);
+    if (ec) {
+      const char* env = std::getenv("TMPDIR");
+      throw Error(ExitCode::cant_create,
+                  fmt::format("MPI rank {}: no temporary directory for its scratch file "
+                              "(TMPDIR={}): {}",
+                              parallel::rank(), env ? env : "(unset)", ec.message()));
+    }
+    std::string name = (tmp / "erodem-rank-XXXXXX").string();
     if (!mkdtemp(name.data()))
       throw Error(ExitCode::cant_create,
                   fmt::format("MPI rank {}: cannot create a scratch directory {}: {}",
