@@ -97,7 +97,7 @@ std::vector<Case> cases() {
 }
 
 TEST(InitialState, ABandIsThoseRowsOfTheWholeState) {
-  // Every band [y0, y1) of the padded rows (ny + 2 = 10: 45 bands, from one row to all) must
+  // Every band [y0, y1) of the padded rows (ny + 2 = 10: 55 bands, from one row to all) must
   // give those rows of the whole state, bit for bit, in every field and in the rows' geometry.
   // A band that built its held cells without the row beside it (a sea cell's bed from its
   // active neighbours), its ghost rows without the DEM row next to them, or its rasters'

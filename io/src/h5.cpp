@@ -133,7 +133,8 @@ void write_shared(hid_t ds, hid_t mem_type, hid_t mem_space, hid_t file_space, c
   if (parallel::rank() == 0) {
     H5Id all;
     if (mem_space == H5S_ALL) all = checked(H5Dget_space(ds), path, name);
-    const hssize_t n = H5Sget_select_npoints(mem_space == H5S_ALL ? all.get() : mem_space);
+    // the memory space's whole extent: `data` holds it (callers select all of it)
+    const hssize_t n = H5Sget_simple_extent_npoints(mem_space == H5S_ALL ? all.get() : mem_space);
     const H5Id type = native_type(ds, path, name);
     const auto bytes = converted(type, mem_type, static_cast<std::size_t>(n), data, path, name);
     checked(H5Dwrite(ds, type, mem_space, file_space, dxpl, bytes.data()), path, name);

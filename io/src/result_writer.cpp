@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <system_error>
@@ -606,6 +607,13 @@ ResultWriter::~ResultWriter() {
 
 void ResultWriter::close() {
   if (!impl_) return;
+  if (collective_files() && std::uncaught_exceptions() > 0) {
+    // MPI, one file: closing is collective, and the other ranks may be waiting elsewhere (an
+    // error this rank alone met): the handles are left open for MPI_Abort (main.cpp), which
+    // ends every rank; the partial file holds what its last flush wrote (every snapshot's).
+    static_cast<void>(impl_.release());
+    return;
+  }
   QuietH5 quiet;
   try {
     impl_->flush_pending();
