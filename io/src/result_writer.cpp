@@ -310,7 +310,7 @@ ResultWriter::ResultWriter(const std::string& path, const Simulation& sim,
 
 ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Params& params,
                            const Provenance& prov, bool overwrite)
-    : path_(path), partial_(partial_path(path)), overwrite_(overwrite) {
+    : path_(path), partial_(root_text(partial_path(path))), overwrite_(overwrite) {
   QuietH5 quiet;
   check_output_path(path, overwrite);  // folder exists and is writable, no file in the way
   seen_ = file_identity(path);         // what --overwrite may replace at finish()
@@ -349,9 +349,7 @@ ResultWriter::ResultWriter(const std::string& path, const Grid& grid, const Para
   H5Id fcpl = checked(H5Pcreate(H5P_FILE_CREATE), partial_, "file properties");
   H5Pset_link_creation_order(fcpl, kCreationOrder);
   H5Pset_attr_creation_order(fcpl, kCreationOrder);
-  // MPI with parallel HDF5: every rank writes rank 0's partial file (collective_files)
-  partial_ = root_text(partial_);
-  m.partial = partial_;
+  // (MPI with parallel HDF5: every rank opens rank 0's partial file, root_text above)
   const H5Id fapl = file_access(partial_);
   m.file = H5Id(H5Fcreate(partial_.c_str(), H5F_ACC_TRUNC, fcpl, fapl));
   if (!m.file.valid())
