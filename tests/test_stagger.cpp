@@ -1,9 +1,12 @@
 // erodem — field arrays at different offsets modulo 4 KiB (kernels/stagger.hpp): the slots
 // the OpenCL backend's sub-buffers and the CPU reference's allocator use.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <set>
 #include <vector>
 
@@ -79,6 +82,58 @@ TEST(Stagger, AllocatorGivesLargeFieldsTheirOwnOffsets) {
   std::vector<double, StaggeredAllocator<double>> doubles(kStaggerMin / sizeof(double), 0.5);
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(doubles.data()) % 128, 0u);
   EXPECT_EQ(doubles.back(), 0.5);
+}
+
+/// The resident set of this process (bytes), from /proc/self/statm; 0 where there is none.
+double resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  double size = 0, resident = 0;
+  if (!(statm >> size >> resident)) return 0;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+TEST(Stagger, ValueInitialisedFieldsAreZeroWhateverTheMemoryHeld) {
+  // resize within the capacity constructs over the old values: 5 and -0 (whose bits are not
+  // zero) must become +0.
+  using Field = std::vector<float, StaggeredAllocator<float>>;
+  for (const float old : {5.0f, -0.0f}) {
+    for (const std::size_t n : {std::size_t{1000}, kStaggerMin / sizeof(float) * 2}) {
+      Field f(n, old);
+      f.resize(10);
+      f.resize(n);
+      std::size_t wrong = 0;
+      for (std::size_t i = 10; i < n; ++i) wrong += f[i] != 0.0f || std::signbit(f[i]);
+      EXPECT_EQ(wrong, 0u) << n << " values over " << old;
+      EXPECT_EQ(f[0], old);
+    }
+  }
+}
+
+TEST(Stagger, AFieldOfZerosTakesMemoryOnlyWhereWritten) {
+#ifndef ERODEM_STAGGER_MMAP
+  GTEST_SKIP() << "fields come from operator new in this build (AddressSanitizer or no mmap)";
+#else
+  using Field = std::vector<float, StaggeredAllocator<float>>;
+  const std::size_t n = std::size_t{64} << 20 >> 2;  // 64 MiB of floats
+  const double mib = 1024.0 * 1024.0, before = resident_bytes();
+  if (before == 0) GTEST_SKIP() << "no /proc/self/statm";
+  Field f(n);
+  double sum = 0;
+  for (std::size_t i = 0; i < n; i += 1024) sum += f[i];  // reads map the zero page
+  const double made = resident_bytes();
+  for (std::size_t i = 0; i < n / 2; ++i) f[i] = 1.0f;
+  const double half = resident_bytes();
+  // Bounds: writing the zeros would take the whole 64 MiB at once; the first half's writes
+  // must show as 32 MiB (so the measure itself can see them).
+  std::printf(
+      "a field of 64 MiB of zeros: %.1f MiB resident once made and read (bound 8), "
+      "%.1f MiB once half written (bound 28 to 40)\n",
+      (made - before) / mib, (half - before) / mib);
+  EXPECT_EQ(sum, 0.0);
+  EXPECT_LT(made - before, 8 * mib);
+  EXPECT_GT(half - before, 28 * mib);
+  EXPECT_LT(half - before, 40 * mib);
+#endif
 }
 
 }  // namespace

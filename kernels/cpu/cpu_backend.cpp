@@ -96,20 +96,22 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   take(manning_, s.manning);
   take(hardness_, s.hardness);
   take(rain_factor_, s.rain_factor);
-  bed_residual_.assign(n, Real(0));
+  // The fields that start at zero: value-initialised, so their pages are taken when a step
+  // first writes them, after the terrain's own arrays are freed (stagger.hpp).
+  bed_residual_ = Field(n);
   const bool flux_twins = params.flow.scheme == FlowScheme::shallow_water;
   for (int k = 0; k < 4; ++k) {
-    flux_[k].assign(n, Real(0));
-    if (flux_twins) flux_next_[k].assign(n, Real(0));
+    flux_[k] = Field(n);
+    if (flux_twins) flux_next_[k] = Field(n);
   }
-  velocity_x_.assign(n, Real(0));
-  velocity_y_.assign(n, Real(0));
-  thermal_share_.assign(n, Real(0));
+  velocity_x_ = Field(n);
+  velocity_y_ = Field(n);
+  thermal_share_ = Field(n);
   row_sums_a_.assign(H_, 0.0);
   row_sums_b_.assign(H_, 0.0);
   row_sums_c_.assign(H_, 0.0);
   const std::size_t cells = n;
-  fields_.bind(*this, [cells] { return Field(cells, Real(0)); });
+  fields_.bind(*this, [cells] { return Field(cells); });
   run_boundary();
   exchange_halo({"bed", "water_depth", "sediment"});  // the corners after the ghost rows
 }
