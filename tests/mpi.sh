@@ -27,8 +27,9 @@
 #    step 40 on 2 ranks and on 4, and on one process from a file written by 4 ranks, each
 #    against the serial run of 40 steps;
 #  - refusals: what N > 1 ranks refuse, each with its exit code and a message naming it:
-#    --backend opencl (2), transport.scheme = "semi_lagrangian" (78), and bands thinner than
-#    the halo (4 ranks on 7 rows: 2).
+#    --backend opencl (2), transport.scheme = "semi_lagrangian" (78), bands thinner than
+#    the halo (4 ranks on 7 rows: 2), and (parallel HDF5, where unshare -m may mount) an
+#    output folder rank 1 sees as another, empty folder (73).
 # The ranks write their one result file together where the build has parallel HDF5: then they
 # run with a TMPDIR that names no folder, so a rank that made a scratch file of its own fails.
 # Fails too where a run under mpirun exits non-zero (but the refusals).
@@ -201,6 +202,36 @@ if [ "$scenario" = refusals ]; then
     --backend cpu --set transport.scheme=semi_lagrangian
   refused "bands thinner than the halo" 2 "each rank needs at least 2" -np 4 --backend cpu \
     --set dem.size=7
+  # An output folder that is not one folder for every rank: rank 1 runs in a mount namespace
+  # of its own (unshare -m) with an empty tmpfs over ./shared, as a node-local disk would be.
+  # Exit 73 naming the folder and rank 1, and nothing left in the folder. Needs parallel HDF5
+  # (else rank 0 alone writes the file) and the right to mount (root, CAP_SYS_ADMIN).
+  if "$erodem" --version | grep -q "parallel HDF5" && unshare -m true 2>/dev/null; then
+    mkdir -p shared
+    cat >private.sh <<'EOF'
+#!/bin/sh
+# rank 1 of mpirun runs "$@" with a private, empty tmpfs over ./shared
+if [ "${OMPI_COMM_WORLD_RANK:-0}" = 1 ]; then
+  exec unshare -m sh -c 'mount -t tmpfs none shared && exec "$@"' sh "$@"
+fi
+exec "$@"
+EOF
+    # (without the check the ranks wait for each other for ever: 124 here)
+    rc=0
+    timeout 120 "${mpi[@]}" -np 2 sh private.sh "$erodem" run scenario.toml \
+      --output shared/out.h5 --backend cpu >private.log 2>&1 || rc=$?
+    if [ $rc -ne 73 ] || [ -n "$(ls -A shared)" ] ||
+      ! grep -qF "'shared' is not one folder shared by every MPI rank (rank 1 of 2" private.log; then
+      echo "FAIL output folder not shared: exit $rc (expected 73), shared/ holds:" \
+        "$(ls -A shared | tr '\n' ' '), message:"
+      grep "^erodem:" private.log | head -2
+      failed=1
+    else
+      echo "output folder not shared: exit $rc, shared/ left empty, $(grep -m1 "^erodem:" private.log)"
+    fi
+  else
+    echo "output folder not shared: not checked (needs parallel HDF5 and unshare -m)"
+  fi
 elif [ "$scenario" = restart ]; then
   run serial serial.h5 "$erodem" run scenario.toml
   run "np 3, 20 steps" first3.h5 "${mpi[@]}" -np 3 "$erodem" run scenario.toml --set time.steps=20

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <sstream>
 
 #include "erodem/error.hpp"
+#include "erodem/parallel.hpp"
 
 namespace erodem::io {
 
@@ -36,6 +38,62 @@ void check_output_path(const std::string& path, bool overwrite) {
   if (!overwrite && fs::exists(p, ec))
     throw Error(ExitCode::cant_create,
                 path + ": exists; not overwritten (give --overwrite to replace it)");
+}
+
+void check_output_folder_shared(const std::string& path) {
+  namespace fs = std::filesystem;
+  const int ranks = parallel::size();
+  if (ranks <= 1) return;
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  // Rank 0 creates the probe (O_EXCL: a name of this host, process and moment) holding its
+  // own name, and hands the name to every rank (an empty name: it could not create it).
+  std::string probe;
+  if (parallel::rank() == 0) {
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::steady_clock::now().time_since_epoch())
+                        .count();
+    const std::string name = ".erodem-shared-folder-probe-" + host_name() + "-" +
+                             std::to_string(::getpid()) + "-" + std::to_string(ns);
+    probe = (dir / name).string();
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    const bool written =
+        fd >= 0 && ::write(fd, probe.data(), probe.size()) == static_cast<ssize_t>(probe.size());
+    if (fd >= 0) ::close(fd);
+    if (!written) {
+      if (fd >= 0) ::unlink(probe.c_str());
+      probe.clear();
+    }
+  }
+  const std::vector<unsigned char> name =
+      parallel::allgather_bytes(probe.data(), parallel::rank() == 0 ? probe.size() : 0);
+  probe.assign(name.begin(), name.end());
+  // Each rank reads it back (open, not stat: NFS's close-to-open consistency).
+  unsigned char seen = 0;
+  if (!probe.empty()) {
+    std::ifstream in(probe, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    seen = static_cast<unsigned char>(in.is_open() && text == probe);
+  }
+  const std::vector<unsigned char> all = parallel::allgather_bytes(&seen, 1);
+  if (parallel::rank() == 0 && !probe.empty()) ::unlink(probe.c_str());
+  if (probe.empty())
+    throw Error(ExitCode::cant_create, path + ": cannot create output: MPI rank 0 could not " +
+                                           "create a file in folder '" + dir.string() + "'");
+  std::string missing;
+  int count = 0;
+  for (int r = 0; r < ranks && r < static_cast<int>(all.size()); ++r)
+    if (!all[static_cast<std::size_t>(r)]) {
+      missing += (count++ ? ", " : "") + std::to_string(r);
+    }
+  if (count)
+    throw Error(ExitCode::cant_create,
+                path + ": cannot create output: folder '" + dir.string() +
+                    "' is not one folder shared by every MPI rank (rank" +
+                    (count > 1 ? "s " : " ") + missing + " of " + std::to_string(ranks) +
+                    " cannot see a file rank 0 created there); the ranks write one result file "
+                    "together, so the output must be on a file system every rank sees "
+                    "(docs/mpi.md)");
 }
 
 bool FileIdentity::operator==(const FileIdentity& o) const {

@@ -131,6 +131,8 @@ Params stored_params(const std::string& restart_arg) {
 RunSession::RunSession(Params params, SessionOptions options) : options_(std::move(options)) {
   // The output can be created: checked before the (possibly long) reading of the inputs.
   if (options_.write) check_output_path(params.output.path, options_.overwrite);
+  // MPI with parallel HDF5: every rank opens the one file, so every rank must see its folder
+  if (options_.write && collective_files()) check_output_folder_shared(params.output.path);
   if (options_.terrain && !has_parameter_rasters(params)) {
     Terrain t = *options_.terrain;
     auto backend = make_backend(options_.backend, t, params);

@@ -13,6 +13,13 @@ namespace erodem::io {
 /// long work, so nothing is spent on a run whose output cannot be written.
 void check_output_path(const std::string& path, bool overwrite);
 
+/// Under MPI with more than one rank, for a file every rank opens (parallel HDF5): fails on
+/// every rank with ExitCode::cant_create, naming the folder and the ranks, unless each rank
+/// sees a file rank 0 creates in the folder of `path` (a file of a name no other run uses,
+/// removed again). A folder on a disk of each node's own (/tmp, a node-local scratch) would
+/// otherwise give each node a result file of its own. Collective; nothing in one process.
+void check_output_folder_shared(const std::string& path);
+
 /// What tells one file at a path from another that replaced it: device, inode, modification
 /// time and size (stat(2)); `exists` is false when nothing is at the path.
 struct FileIdentity {
