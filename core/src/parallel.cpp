@@ -148,6 +148,13 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) 
   return std::vector<unsigned char>(p, p + bytes);
 }
 
+std::string root_string(const std::string& text) {
+  const bool root = rank() == 0;
+  const std::vector<unsigned char> all =
+      allgather_bytes(root ? text.data() : nullptr, root ? text.size() : 0);
+  return std::string(all.begin(), all.end());
+}
+
 void exchange(const void* send_up, void* recv_up, const void* send_down, void* recv_down,
               std::size_t bytes) {
 #ifdef ERODEM_HAVE_MPI

@@ -81,11 +81,7 @@ H5Id file_access(const std::string& path) {
 }
 
 std::string root_text(const std::string& value) {
-  if (!collective_files()) return value;
-  const bool root = parallel::rank() == 0;
-  const std::vector<unsigned char> all =
-      parallel::allgather_bytes(root ? value.data() : nullptr, root ? value.size() : 0);
-  return std::string(all.begin(), all.end());
+  return collective_files() ? parallel::root_string(value) : value;
 }
 
 namespace {

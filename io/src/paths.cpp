@@ -65,9 +65,7 @@ void check_output_folder_shared(const std::string& path) {
       probe.clear();
     }
   }
-  const std::vector<unsigned char> name =
-      parallel::allgather_bytes(probe.data(), parallel::rank() == 0 ? probe.size() : 0);
-  probe.assign(name.begin(), name.end());
+  probe = parallel::root_string(probe);
   // Each rank reads it back (open, not stat: NFS's close-to-open consistency).
   unsigned char seen = 0;
   if (!probe.empty()) {
@@ -75,7 +73,7 @@ void check_output_folder_shared(const std::string& path) {
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     seen = static_cast<unsigned char>(in.is_open() && text == probe);
   }
-  const std::vector<unsigned char> all = parallel::allgather_bytes(&seen, 1);
+  const std::vector<unsigned char> all = parallel::allgather(std::vector<unsigned char>{seen});
   if (parallel::rank() == 0 && !probe.empty()) ::unlink(probe.c_str());
   if (probe.empty())
     throw Error(ExitCode::cant_create, path + ": cannot create output: MPI rank 0 could not " +

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstring>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -57,6 +58,10 @@ std::vector<T> allgather(const std::vector<T>& mine) {
   if (!raw.empty()) std::memcpy(out.data(), raw.data(), raw.size());
   return out;
 }
+
+/// Rank 0's `text` on every rank (what each rank's own may differ in: a time, a process id).
+/// Collective (in one process: `text`).
+std::string root_string(const std::string& text);
 
 /// Items each owned by one rank (`owner[j]`, of this run's ranks), with `mine` this rank's
 /// values of its items in item order: every item's value in item order, from its owner.
