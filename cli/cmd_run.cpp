@@ -26,10 +26,15 @@ namespace erodem::cli {
 
 namespace {
 
+/// A request to stop: Ctrl-C (SIGINT), SIGTERM (a batch system's time limit, `kill`) or
+/// SIGUSR1 (which mpirun passes on to every rank). The first finishes the step and stores it;
+/// a second of the same signal takes that signal's default action (ends the process).
 std::atomic<bool> g_interrupted{false};
-void on_sigint(int) {
+extern "C" void on_stop_signal(int sig) {
   g_interrupted = true;
+  std::signal(sig, SIG_DFL);
 }
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGUSR1};
 
 struct RunOptions {
   std::string config;
@@ -212,24 +217,38 @@ int run(const RunOptions& o) {
   const Simulation& sim = session.sim();
   const auto& g = sim.grid();
 
-  auto previous = std::signal(SIGINT, on_sigint);
+  std::vector<void (*)(int)> previous;
+  for (const int sig : kStopSignals) previous.push_back(std::signal(sig, on_stop_signal));
+  const auto restore_signals = [&previous] {
+    for (std::size_t k = 0; k < previous.size(); ++k) std::signal(kStopSignals[k], previous[k]);
+  };
   Progress progress(root && stderr_is_terminal());
   io::Stop stop = io::Stop::finished;
   try {
-    // To the configured end, or Ctrl-C; an unstable step throws with the partial-file note.
+    // To the configured end, or a stop signal; an unstable step throws with the partial-file
+    // note. Under MPI the ranks stop at the same step: a signal may reach one rank a step
+    // before another, so before each step they ask whether any rank has one (parallel::any).
     stop = session.advance(
-        {}, [] { return g_interrupted.load(); }, [&](const Simulation& s) { progress.update(s); });
+        {}, [] { return parallel::any(g_interrupted.load()); },
+        [&](const Simulation& s) { progress.update(s); });
   } catch (...) {
     progress.done();
-    std::signal(SIGINT, previous);
+    restore_signals();
     throw;
   }
   progress.done();
-  std::signal(SIGINT, previous);
-  if (stop == io::Stop::interrupted || g_interrupted) {
+  restore_signals();
+  // (and one signal after the last step's question: every rank again decides alike)
+  if (stop == io::Stop::interrupted || parallel::any(g_interrupted.load())) {
+    // Under MPI: once one rank exits (130), mpirun ends the others with SIGTERM, which must
+    // not cut short their own way to exit 130 (the writer's close below is collective, so
+    // they are at most a moment behind).
+    if (parallel::size() > 1)
+      for (const int sig : kStopSignals) std::signal(sig, SIG_IGN);
     session.abandon();  // a snapshot of the step reached; the file stays .partial
-    std::fprintf(stderr, "erodem: interrupted at step %ld (t = %.6g s); %s\n", sim.steps_done(),
-                 sim.time(), session.partial_note().c_str());
+    if (root)
+      std::fprintf(stderr, "erodem: interrupted at step %ld (t = %.6g s); %s\n", sim.steps_done(),
+                   sim.time(), session.partial_note().c_str());
     return 130;
   }
   session.finish();

@@ -29,7 +29,9 @@
 #  - refusals: what N > 1 ranks refuse, each with its exit code and a message naming it:
 #    --backend opencl (2), transport.scheme = "semi_lagrangian" (78), bands thinner than
 #    the halo (4 ranks on 7 rows: 2), and (parallel HDF5, where unshare -m may mount) an
-#    output folder rank 1 sees as another, empty folder (73).
+#    output folder rank 1 sees as another, empty folder (73);
+#  - interrupt: a stop signal (SIGTERM, SIGUSR1) to erodem, and to each rank under mpirun 0.5 s
+#    apart: exit 130 and a partial file identical to the serial run to the step it names.
 # The ranks write their one result file together where the build has parallel HDF5: then they
 # run with a TMPDIR that names no folder, so a rank that made a scratch file of its own fails.
 # Fails too where a run under mpirun exits non-zero (but the refusals).
@@ -132,9 +134,9 @@ EOF
   shallow_water)
     sets=(--set flow.scheme=shallow_water --set flow.order=2 --set boundary.periodic_x=true)
     ;;
-  refusals) ;;
+  refusals | interrupt) ;;
   *)
-    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, water_cycle, restart, refusals)"
+    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, water_cycle, restart, refusals, interrupt)"
     exit 2
     ;;
 esac
@@ -232,6 +234,60 @@ EOF
   else
     echo "output folder not shared: not checked (needs parallel HDF5 and unshare -m)"
   fi
+elif [ "$scenario" = interrupt ]; then
+  # A stop signal ends a long run at a step every rank agrees on: exit 130, one message (rank
+  # 0's) naming the step N, and a partial file identical to the serial run of N steps
+  # (snapshots, diagnostics, restart state: same_as). Without mpirun: SIGTERM to erodem. Under
+  # mpirun: the signal to each rank 0.5 s apart (as a batch system's signal reaches the ranks
+  # of several nodes; this OpenMPI's mpirun passes no SIGUSR1 on), steps apart here, so the
+  # ranks must agree on the step; without that they wait for each other for ever.
+  stopped() { # LABEL OUT SIGNAL N COMMAND...: COMMAND (a run of a million steps, N processes)
+    # in the background, then SIGNAL to each of its processes
+    local label=$1 out=$2 sig=$3 count=$4 rc=0 partial="" n=""
+    shift 4
+    "$@" run scenario.toml --backend cpu --output "$out" --overwrite --set time.steps=1000000 \
+      --set output.every=500 >"$out.log" 2>&1 &
+    local pid=$!
+    (sleep 90 && kill -9 $pid) >/dev/null 2>&1 &
+    local watchdog=$!
+    # the processes to signal (the ranks: mpirun's children), once each catches SIGNAL (its
+    # handler is installed when the time loop starts: /proc/PID/status SigCgt)
+    local targets=() number ready
+    number=$(kill -l "$sig")
+    for _ in $(seq 600); do
+      if [ "$1" = "$erodem" ]; then targets=($pid); else mapfile -t targets < <(pgrep -P $pid || true); fi
+      ready=${#targets[@]}
+      for t in "${targets[@]}"; do
+        mask=$(awk '/^SigCgt/ {print $2}' /proc/$t/status 2>/dev/null || true)
+        if [ -z "$mask" ] || (((16#$mask >> (number - 1) & 1) == 0)); then ready=0; fi
+      done
+      [ "$ready" -eq "$count" ] && break
+      sleep 0.1
+    done
+    sleep 0.5
+    for t in "${targets[@]}"; do
+      kill -$sig $t 2>/dev/null || true
+      sleep 0.5
+    done
+    wait $pid || rc=$?
+    pkill -P $watchdog 2>/dev/null || true
+    n=$(grep -o "interrupted at step [0-9]*" "$out.log" | grep -o "[0-9]*$" || true)
+    partial=$(ls .$out.*.partial 2>/dev/null | head -1 || true)
+    if [ $rc -ne 130 ] || [ -z "$n" ] || [ -z "$partial" ] ||
+      [ "$(grep -c "interrupted at step" "$out.log")" -ne 1 ]; then
+      echo "FAIL $label: exit $rc (expected 130), step '${n}', partial file '${partial}', log:"
+      tail -5 "$out.log"
+      failed=1
+      return
+    fi
+    run "serial, $n steps" "ref_$out" "$erodem" run scenario.toml --set time.steps="$n" \
+      --set output.every=500
+    echo "$label: exit $rc at step $n ($(grep -m1 "interrupted at step" "$out.log" | cut -c1-60)...)"
+    same_as "ref_$out" "$partial" "$label, the partial file against the serial run of $n steps"
+  }
+  stopped "SIGTERM, no mpirun" int1.h5 TERM 1 "$erodem"
+  stopped "SIGUSR1 to each of 2 ranks" int2.h5 USR1 2 "${mpi[@]}" -np 2 "$erodem"
+  stopped "SIGTERM to each of 3 ranks" int3.h5 TERM 3 "${mpi[@]}" -np 3 "$erodem"
 elif [ "$scenario" = restart ]; then
   run serial serial.h5 "$erodem" run scenario.toml
   run "np 3, 20 steps" first3.h5 "${mpi[@]}" -np 3 "$erodem" run scenario.toml --set time.steps=20

@@ -1,5 +1,6 @@
 #include "erodem/parallel.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 
@@ -146,6 +147,11 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) 
   }
 #endif
   return std::vector<unsigned char>(p, p + bytes);
+}
+
+bool any(bool yes) {
+  const std::vector<unsigned char> all = allgather(std::vector<unsigned char>{yes});
+  return std::any_of(all.begin(), all.end(), [](unsigned char v) { return v != 0; });
 }
 
 std::string root_string(const std::string& text) {

@@ -72,12 +72,6 @@ OwnRows rows_to_write(const Simulation& sim, FieldId id, int row0, int row1) {
   return {row0, row1, sim.field_rows(id, row0, row1)};
 }
 
-/// Whether `yes` holds on every rank of an MPI run (collective); `yes` in one process.
-bool on_every_rank(bool yes) {
-  const std::vector<std::uint8_t> all = parallel::allgather(std::vector<std::uint8_t>{yes});
-  return std::all_of(all.begin(), all.end(), [](std::uint8_t v) { return v != 0; });
-}
-
 std::string iso_utc_now() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -638,7 +632,7 @@ void ResultWriter::store_state(const Simulation& sim) {
         // (in an MPI run each rank its own rows, read independently, then whether they are the
         // same on every rank: every rank decides alike)
         const hsize_t last_row = static_cast<hsize_t>(m.row_count[k] - 1);
-        same = on_every_rank(for_strips(ny, [&](int row0, int row1) {
+        same = !parallel::any(!for_strips(ny, [&](int row0, int row1) {
           const OwnRows own = sim.own_field_rows(id, row0, row1);
           const std::vector<double>& v = own.values;
           const hsize_t rows = static_cast<hsize_t>(own.row1 - own.row0);

@@ -59,6 +59,10 @@ std::vector<T> allgather(const std::vector<T>& mine) {
   return out;
 }
 
+/// Whether `yes` holds on any rank (a decision every rank must take alike: to stop, to store
+/// again). Collective (in one process: `yes`).
+bool any(bool yes);
+
 /// Rank 0's `text` on every rank (what each rank's own may differ in: a time, a process id).
 /// Collective (in one process: `text`).
 std::string root_string(const std::string& text);
