@@ -27,12 +27,15 @@ namespace erodem::cli {
 namespace {
 
 /// A request to stop: Ctrl-C (SIGINT), SIGTERM (a batch system's time limit, `kill`) or
-/// SIGUSR1 (which mpirun passes on to every rank). The first finishes the step and stores it;
-/// a second of the same signal takes that signal's default action (ends the process).
+/// SIGUSR1 (`kill -USR1`; OpenMPI 4.1's mpirun does not pass it on to the ranks). The first
+/// finishes the step and stores it; in one process a second of the same signal takes that
+/// signal's default action (ends the process). Under MPI a rank may get a signal twice (from
+/// the batch system and from mpirun), so there it stays caught until the ranks have agreed.
 std::atomic<bool> g_interrupted{false};
+std::atomic<bool> g_second_ends{true};
 extern "C" void on_stop_signal(int sig) {
   g_interrupted = true;
-  std::signal(sig, SIG_DFL);
+  if (g_second_ends) std::signal(sig, SIG_DFL);
 }
 constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGUSR1};
 
@@ -217,6 +220,7 @@ int run(const RunOptions& o) {
   const Simulation& sim = session.sim();
   const auto& g = sim.grid();
 
+  g_second_ends = parallel::size() <= 1;
   std::vector<void (*)(int)> previous;
   for (const int sig : kStopSignals) previous.push_back(std::signal(sig, on_stop_signal));
   const auto restore_signals = [&previous] {
@@ -237,14 +241,17 @@ int run(const RunOptions& o) {
     throw;
   }
   progress.done();
-  restore_signals();
   // (and one signal after the last step's question: every rank again decides alike)
-  if (stop == io::Stop::interrupted || parallel::any(g_interrupted.load())) {
+  const bool interrupted = stop == io::Stop::interrupted || parallel::any(g_interrupted.load());
+  if (interrupted && parallel::size() > 1) {
     // Under MPI: once one rank exits (130), mpirun ends the others with SIGTERM, which must
     // not cut short their own way to exit 130 (the writer's close below is collective, so
-    // they are at most a moment behind).
-    if (parallel::size() > 1)
-      for (const int sig : kStopSignals) std::signal(sig, SIG_IGN);
+    // they are at most a moment behind): the stop signals stay ignored from here.
+    for (const int sig : kStopSignals) std::signal(sig, SIG_IGN);
+  } else {
+    restore_signals();
+  }
+  if (interrupted) {
     session.abandon();  // a snapshot of the step reached; the file stays .partial
     if (root)
       std::fprintf(stderr, "erodem: interrupted at step %ld (t = %.6g s); %s\n", sim.steps_done(),

@@ -12,7 +12,8 @@
 // value-initialisation (std::vector's size constructor and resize) writes a zero only where
 // the memory does not hold one already: a field that starts at zero (the outflows, the
 // velocities, ...) takes memory as the steps first write it, not while the run sets up
-// (performance.md, "Resident memory per cell").
+// (performance.md, "Resident memory per cell"). Each such block is its own mapping, given back
+// when freed: a field made and freed within every step would pay its page faults every step.
 #pragma once
 
 #include <atomic>
@@ -66,7 +67,8 @@ struct StaggeredAllocator {
 
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
-    if (bytes < kStaggerMin) return static_cast<T*>(::operator new(bytes));
+    // (operator new's blocks are zeroed, so construct() reads no indeterminate bytes)
+    if (bytes < kStaggerMin) return static_cast<T*>(std::memset(::operator new(bytes), 0, bytes));
     static std::atomic<std::size_t> next{0};
     const std::size_t offset =
         stagger_offset(next.fetch_add(1, std::memory_order_relaxed), alignof(std::max_align_t));
@@ -78,6 +80,7 @@ struct StaggeredAllocator {
 #else
     auto* block = static_cast<unsigned char*>(
         ::operator new (bytes + kStaggerPeriod, std::align_val_t{kStaggerPeriod}));
+    std::memset(block, 0, bytes + kStaggerPeriod);
 #endif
     return reinterpret_cast<T*>(block + offset);
   }

@@ -150,8 +150,14 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) 
 }
 
 bool any(bool yes) {
-  const std::vector<unsigned char> all = allgather(std::vector<unsigned char>{yes});
-  return std::any_of(all.begin(), all.end(), [](unsigned char v) { return v != 0; });
+#ifdef ERODEM_HAVE_MPI
+  if (size() > 1) {
+    int v = yes ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD);
+    return v != 0;
+  }
+#endif
+  return yes;
 }
 
 std::string root_string(const std::string& text) {

@@ -47,7 +47,7 @@ void check_output_folder_shared(const std::string& path) {
   const fs::path p(path);
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   // Rank 0 creates the probe (O_EXCL: a name of this host, process and moment) holding its
-  // own name, and hands the name to every rank (an empty name: it could not create it).
+  // own name, and hands the name to every rank (where it could not: a NUL and the reason).
   std::string probe;
   if (parallel::rank() == 0) {
     const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -61,23 +61,22 @@ void check_output_folder_shared(const std::string& path) {
         fd >= 0 && ::write(fd, probe.data(), probe.size()) == static_cast<ssize_t>(probe.size());
     if (fd >= 0) ::close(fd);
     if (!written) {
+      const int error = errno;
       if (fd >= 0) ::unlink(probe.c_str());
-      probe.clear();
+      probe = std::string(1, '\0') + std::strerror(error);  // a reason, not a name
     }
   }
   probe = parallel::root_string(probe);
-  // Each rank reads it back (open, not stat: NFS's close-to-open consistency).
-  unsigned char seen = 0;
-  if (!probe.empty()) {
-    std::ifstream in(probe, std::ios::binary);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    seen = static_cast<unsigned char>(in.is_open() && text == probe);
-  }
-  const std::vector<unsigned char> all = parallel::allgather(std::vector<unsigned char>{seen});
-  if (parallel::rank() == 0 && !probe.empty()) ::unlink(probe.c_str());
-  if (probe.empty())
+  if (!probe.empty() && probe[0] == '\0')  // on every rank alike
     throw Error(ExitCode::cant_create, path + ": cannot create output: MPI rank 0 could not " +
-                                           "create a file in folder '" + dir.string() + "'");
+                                           "create a file in folder '" + dir.string() + "' (" +
+                                           probe.substr(1) + ")");
+  // Each rank reads it back (open, not stat: NFS's close-to-open consistency).
+  std::ifstream in(probe, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const unsigned char seen = static_cast<unsigned char>(in.is_open() && text == probe);
+  const std::vector<unsigned char> all = parallel::allgather(std::vector<unsigned char>{seen});
+  if (parallel::rank() == 0) ::unlink(probe.c_str());
   std::string missing;
   int count = 0;
   for (int r = 0; r < ranks && r < static_cast<int>(all.size()); ++r)
