@@ -1,6 +1,5 @@
 #include "erodem/parallel.hpp"
 
-#include <algorithm>
 #include <climits>
 #include <cstdlib>
 

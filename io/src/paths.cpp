@@ -21,10 +21,17 @@
 
 namespace erodem::io {
 
+namespace {
+/// The folder an output path names a file in ("." for a bare file name).
+std::filesystem::path output_folder(const std::filesystem::path& p) {
+  return p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+}
+}  // namespace
+
 void check_output_path(const std::string& path, bool overwrite) {
   namespace fs = std::filesystem;
   const fs::path p(path);
-  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  const fs::path dir = output_folder(p);
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     throw Error(ExitCode::cant_create,
@@ -44,8 +51,7 @@ void check_output_folder_shared(const std::string& path) {
   namespace fs = std::filesystem;
   const int ranks = parallel::size();
   if (ranks <= 1) return;
-  const fs::path p(path);
-  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  const fs::path dir = output_folder(path);
   // Rank 0 creates the probe (O_EXCL: a name of this host, process and moment) holding its
   // own name, and hands the name to every rank (where it could not: a NUL and the reason).
   std::string probe;
