@@ -217,6 +217,19 @@ CellParams<real> cell_params_of(const Params& params) {
   return c;
 }
 
+/// The pitches of the cell parameter arrays (values per row, param_index in common/compat.h)
+/// in every struct whose cell functions read them: W where the backend holds a value per cell,
+/// 0 where it holds one row of a uniform value. cell_params_of leaves them 0; each backend sets
+/// them once it holds the arrays, and again whenever one changes from uniform to per cell.
+template <class real>
+void set_param_pitches(CellParams<real>& c, int manning, int hardness, int rain_factor) {
+  c.flow.manning_pitch = manning;
+  c.sediment.manning_pitch = manning;
+  c.erosion.hardness_pitch = hardness;
+  c.sediment.hardness_pitch = hardness;
+  c.snow.rain_factor_pitch = rain_factor;
+}
+
 /// The level of the fixed-level cells in the step of `in` (m): its boundary_level, or
 /// boundary.sea_level where it has none; the backends set BoundaryParams::sea_level to it when
 /// a step begins.
@@ -278,13 +291,13 @@ extern template ParamBytes cell_params_bytes(const CellParams<double>&, Process)
 // Members of type real or int only: the host's structs have the device's layout (OpenCL
 // passes them by value as kernel arguments).
 static_assert(sizeof(cell_params::BoundaryParams<float>) == 2 * sizeof(float));
-static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float) + sizeof(int));
+static_assert(sizeof(cell_params::FlowParams<float>) == 5 * sizeof(float) + 2 * sizeof(int));
 static_assert(sizeof(cell_params::WaterParams<float>) == 1 * sizeof(float));
-static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float));
-static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 3 * sizeof(int));
+static_assert(sizeof(cell_params::ErosionParams<float>) == 6 * sizeof(float) + sizeof(int));
+static_assert(sizeof(cell_params::SedimentParams<float>) == 20 * sizeof(float) + 5 * sizeof(int));
 static_assert(sizeof(cell_params::ThermalParams<float>) == 4 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::EvaporationParams<float>) == 2 * sizeof(float) + sizeof(int));
-static_assert(sizeof(cell_params::SnowParams<float>) == 11 * sizeof(float));
+static_assert(sizeof(cell_params::SnowParams<float>) == 11 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::InfiltrationParams<float>) == 2 * sizeof(float) + sizeof(int));
 static_assert(sizeof(cell_params::TerrainClassParams<float>) ==
               (6 + 6 * ERODEM_CLASS_COUNT) * sizeof(float) + 6 * sizeof(int));

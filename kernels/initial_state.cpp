@@ -139,13 +139,16 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
     }
 
   // Rasters or scalars; halo cells copy the nearest DEM cell (Manning n is read at faces).
+  // (A scalar stays one value: CellParameter::is_uniform.)
   auto raster_or = [&](const std::vector<double>& raster, double scalar) {
-    std::vector<double> out(n, scalar);
+    CellParameter out;
+    out.uniform = scalar;
     if (raster.empty()) return out;
+    out.cells.assign(n, scalar);
     for (int y = a; y < b; ++y)
       for (int x = 0; x < W; ++x) {
         const int r = std::clamp(y - 1, 0, ny - 1), c = std::clamp(x - 1, 0, nx - 1);
-        out[at(x, y)] = raster[dem(c, r)];
+        out.cells[at(x, y)] = raster[dem(c, r)];
       }
     return out;
   };
@@ -168,8 +171,9 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
   if (s.periodic_x) {
     // the ghost columns repeat the opposite DEM columns (the corners the ghost rows' ends)
     copy_periodic_columns(s.kind.data(), W, s.H);
-    for (auto* f : {&s.bed, &s.depth, &s.sediment, &s.manning, &s.hardness, &s.rain_factor})
-      copy_periodic_columns(f->data(), W, s.H);
+    for (auto* f :
+         {&s.bed, &s.depth, &s.sediment, &s.manning.cells, &s.hardness.cells, &s.rain_factor.cells})
+      if (!f->empty()) copy_periodic_columns(f->data(), W, s.H);
   }
 
   // The rows asked for: [y0, y1) of [a, b).
@@ -179,8 +183,9 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
   };
   const auto row = static_cast<std::size_t>(W);
   cut(s.kind, row);
-  for (auto* f : {&s.bed, &s.depth, &s.sediment, &s.manning, &s.hardness, &s.rain_factor})
-    cut(*f, row);
+  for (auto* f :
+       {&s.bed, &s.depth, &s.sediment, &s.manning.cells, &s.hardness.cells, &s.rain_factor.cells})
+    if (!f->empty()) cut(*f, row);
   for (auto* f : {&s.dx, &s.dy, &s.area}) cut(*f, 1);
   s.H = y1 - y0;
   s.ny = s.H - 2;

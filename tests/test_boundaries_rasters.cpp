@@ -479,6 +479,94 @@ TEST_P(RasterParameters, HardnessRasterZeroKeepsItsBed) {
   vr::expect_above(fig("hardness 1 half: eroded (m^3)"), soft_eroded, 1.0);
 }
 
+TEST_P(RasterParameters, AConstantRasterGivesTheBitsOfItsUniformValue) {
+  // The CPU reference holds a parameter given as one value as one row and reads it at
+  // param_index(x, y, 0) (docs/architecture.md "Uniform parameters"); a raster, even of one
+  // value everywhere, is held per cell and read at pitch W. Two runs of a storm on a bumpy
+  // 48 x 40 grid (5 cm of water, rain 100 mm/h on a snow pack at 2 degC, erosion, thermal
+  // collapse, open edges; 120 fixed steps of 0.5 s): Manning n 0.045, hardness 0.6 and the
+  // rain factor 1 given as scalars, or as rasters of those values, must give the same bits in
+  // every output field and in the ledger (bound 0): a pitch read wrong reads another row's
+  // value (or past the row) and changes them. Both laws of erosion (Mei's reads the hardness;
+  // the physical law the hardness and Manning n) and both flow schemes with friction (local
+  // inertial's face loops, shallow water's cell loop). A third run sets a hardness that varies
+  // (0.2 to 1 by column) into the scalar run's backend before its first step, which then holds
+  // it per cell (field_storage), and must give the bits of the run with that raster (with
+  // every pitch 0, 14 737 to 17 130 values differ). The runs must move water and material (an
+  // idle solver would pass the first comparison): eroded volume > 1e-3 m^3, shown beside its
+  // bound.
+  const int n = 48, ny = 40;
+  const double cell = 5.0;
+  for (const bool physical : {false, true}) {
+    Terrain base = bumpy_terrain(n, cell);
+    base.grid = Grid::uniform(n, ny, cell);
+    base.bed.resize(base.grid.cells());
+    Params p = quiet_params(physical ? FlowScheme::shallow_water : FlowScheme::local_inertial, 0.5);
+    p.flow.order = 2;
+    p.flow.manning_n.value = 0.045;
+    p.rain.rate = 100.0 / 1000.0 / 3600.0;
+    p.erosion.enabled = true;
+    p.erosion.law = physical ? ErosionLaw::physical : ErosionLaw::mei;
+    p.erosion.hardness.value = 0.6;
+    p.thermal.enabled = true;
+    p.snow.enabled = true;
+    p.snow.initial.value = 0.02;
+    p.snow.air_temperature = 2.0;  // rain, not snow (above 1 degC), and a melting pack
+    p.initial.water_depth.value = 0.05;
+    p.boundary.north = p.boundary.south = p.boundary.east = p.boundary.west = BoundaryKind::open;
+    Terrain rasters = base;
+    rasters.manning_n.assign(base.grid.cells(), 0.045);
+    rasters.hardness.assign(base.grid.cells(), 0.6);
+    rasters.rain_factor.assign(base.grid.cells(), 1.0);
+    std::vector<double> varying(base.grid.cells());
+    for (std::size_t i = 0; i < varying.size(); ++i)
+      varying[i] = 0.2 + 0.8 * static_cast<double>(i % n) / (n - 1);
+    Terrain varying_raster = base;
+    varying_raster.hardness = varying;
+
+    auto uniform = make_simulation(base, p, target());
+    auto per_cell = make_simulation(rasters, p, target());
+    auto set_later = make_simulation(base, p, target());
+    set_later.backend().set_field(FieldId::hardness, varying);
+    auto varying_run = make_simulation(varying_raster, p, target());
+    const long steps = 120;
+    for (Simulation* s : {&uniform, &per_cell, &set_later, &varying_run}) s->step(steps);
+
+    const auto differing = [](const Simulation& a, const Simulation& b) {
+      std::size_t count = 0;
+      for (const FieldId id :
+           {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
+            FieldId::velocity_y, FieldId::snow, FieldId::erosion, FieldId::shear_stress,
+            FieldId::hardness, FieldId::wetness}) {
+        const auto x = a.field(id), y = b.field(id);
+        for (std::size_t i = 0; i < x.size(); ++i) count += x[i] != y[i];
+      }
+      const Ledger &la = a.ledger(), &lb = b.ledger();
+      count += la.rain != lb.rain;
+      count += la.eroded != lb.eroded;
+      count += la.deposited != lb.deposited;
+      return count;
+    };
+    const std::size_t constant = differing(uniform, per_cell),
+                      set = differing(set_later, varying_run);
+    const auto hard = uniform.field(FieldId::hardness);
+    std::size_t hardness_read = 0;  // the uniform run's hardness field must read 0.6 (rounded)
+    const double h = target().f64() ? 0.6 : static_cast<double>(0.6f);
+    for (const double v : hard) hardness_read += v != h;
+    const double eroded = eroded_from_fields(uniform);
+    std::printf(
+        "[uniform parameters] %s, %s: values that differ from the constant rasters' run %zu "
+        "(bound 0), from the varying hardness raster's run after set_field %zu (bound 0); "
+        "hardness read back != 0.6: %zu cells (bound 0); eroded %.3g m^3 (bound > 1e-3)\n",
+        target().label().c_str(), physical ? "shallow water, physical law" : "local inertial, Mei",
+        constant, set, hardness_read, eroded);
+    EXPECT_EQ(constant, 0u);
+    EXPECT_EQ(set, 0u);
+    EXPECT_EQ(hardness_read, 0u);
+    EXPECT_GT(eroded, 1e-3);
+  }
+}
+
 TEST_P(RasterParameters, RainRasterFactorScalesEachRegion) {
   // Three closed basins in one 24 x 22 grid of 5 m cells, separated by nodata rows (walls):
   // rows 0-5 rain factor 0.5, row 6 nodata, rows 7-16 factor 2, row 17 nodata, rows 18-21

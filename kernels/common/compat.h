@@ -148,6 +148,15 @@ inline float erodem_bits_float(unsigned int b) {
 #endif
 
 ERODEM_BEGIN_NAMESPACE
+/* The index of padded cell (x, y) in a cell parameter array (hardness, Manning n, the rain
+ * factor) of `pitch` values per row: W when the array holds a value per cell, 0 when the
+ * parameter is uniform and the array one row of W copies of it (the CPU reference then keeps
+ * W values, not W H: docs/architecture.md "Uniform parameters"). The pitch is a member of
+ * the reading process's parameter struct, set by the backend that holds the array. */
+ERODEM_INLINE int param_index(int x, int y, int pitch) {
+  return x + y * pitch;
+}
+
 /* First guess of the cube root of a positive normal float x, within 3.3 % (Kahan's bit
  * trick): the bits of x over 3 plus the bias of the exponent times 2/3. The division by 3
  * is done in float, (float)bits * (1/3) truncated (exact enough for a guess), since neither

@@ -14,6 +14,7 @@ ERODEM_PARAMS_BEGIN(ErosionParams)
   real min_tilt;        /* sin_min (1) */
   real min_depth;       /* depth below which the capacity ramps to 0 (m); 0 = off */
   real bedrock;         /* no erosion below this bed elevation (m); -inf without one */
+  int hardness_pitch;   /* values per row of the hardness array (param_index, compat.h) */
 ERODEM_PARAMS_END(ErosionParams)
 
 /* The run constants of the physical erosion law (erosion.law = "physical", docs/model.md
@@ -44,6 +45,8 @@ ERODEM_PARAMS_BEGIN(SedimentParams)
   real soil_inv_tau_d;    /* cohesive: 1 / tau_c,d (1/Pa) of Krone's deposition; 0 = always */
   real rock_inv_tau_d;    /* the bedrock's */
   real morfac;            /* morphological acceleration factor (1): bed change per exchange */
+  int manning_pitch;      /* values per row of the Manning n array (param_index, compat.h) */
+  int hardness_pitch;     /* values per row of the hardness array */
 ERODEM_PARAMS_END(SedimentParams)
 
 ERODEM_BEGIN_NAMESPACE
@@ -143,7 +146,7 @@ ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
   const real s = sediment[i];
   const real b = bed[i];
   const real lo = bed_residual[i];
-  const real k_erode = p.dissolving_rate * hardness[i] * dt;
+  const real k_erode = p.dissolving_rate * hardness[param_index(x, y, p.hardness_pitch)] * dt;
   const real erode = (k_erode < (real)1 ? k_erode : (real)1) * (capacity - s);
   const real above = (b - p.bedrock) + lo; /* +inf without a bedrock level */
   const real above_rock = above > 0 ? above : (real)0;
@@ -316,8 +319,9 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
                              real* bed_residual_out, real* sediment_out, real* soil_out,
                              real* moved_out, real* rock_out, real* bulking_out) {
   const int i = x + y * W;
-  const real h = depth[i], u = velocity_x[i], v = velocity_y[i], n = manning[i];
-  const real s = sediment[i], soil_l = soil[i], r = hardness[i];
+  const real h = depth[i], u = velocity_x[i], v = velocity_y[i];
+  const real n = manning[param_index(x, y, p.manning_pitch)];
+  const real s = sediment[i], soil_l = soil[i], r = hardness[param_index(x, y, p.hardness_pitch)];
   const real tan2 = bed_slope_tan2(x, y, W, kind, bed, dx, dy);
   const ERODEM_S(BedLoad) b = bed_load_of(h, u, v, n, tan2, p);
   const real speed = sqrt(u * u + v * v);

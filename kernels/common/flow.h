@@ -14,13 +14,16 @@
 
 /* The run constants of the flow schemes (flow_params, kernels/cell_params.cpp). */
 ERODEM_PARAMS_BEGIN(FlowParams)
-  real gravity;     /* g (m/s^2) */
-  real theta;       /* local inertial: de Almeida's weighting (1) */
-  real dry_depth;   /* local inertial: faces shallower carry no flow (m) */
-  real pipe_area;   /* pipes: the pipe cross-section A (m^2) */
-  real pipe_length; /* pipes: the pipe length l (m); 0 = the cell size */
-  int periodic_x;   /* boundary.periodic_x: the second-order shallow water's cells two columns
-                       off wrap around the seam (shallow_water_muscl_cell) */
+  real gravity;      /* g (m/s^2) */
+  real theta;        /* local inertial: de Almeida's weighting (1) */
+  real dry_depth;    /* local inertial: faces shallower carry no flow (m) */
+  real pipe_area;    /* pipes: the pipe cross-section A (m^2) */
+  real pipe_length;  /* pipes: the pipe length l (m); 0 = the cell size */
+  int periodic_x;    /* boundary.periodic_x: the second-order shallow water's cells two columns
+                        off wrap around the seam (shallow_water_muscl_cell) */
+  int manning_pitch; /* values per row of the Manning n array (param_index, compat.h), read so
+                        by the CPU reference's flow loops; the OpenCL flow kernels read it at
+                        cell indices (OpenCL keeps a value per cell: pitch W) */
 ERODEM_PARAMS_END(FlowParams)
 
 ERODEM_BEGIN_NAMESPACE

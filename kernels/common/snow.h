@@ -24,6 +24,7 @@ ERODEM_PARAMS_BEGIN(SnowParams)
   real rain_rate;            /* the step's rain rate (m/s; times the cell's rain factor) */
   real tan_slide;            /* tan of snow.slide_angle (1) */
   real slide_rate;           /* fraction of a sliding pack that moves per second (1/s) */
+  int rain_factor_pitch;     /* values per row of the rain factor array (param_index, compat.h) */
 ERODEM_PARAMS_END(SnowParams)
 
 ERODEM_BEGIN_NAMESPACE
@@ -52,13 +53,14 @@ ERODEM_FN real snow_melt_cell(real snow, real T, real rain, real dt, ERODEM_P(Sn
  *   it back (*rain_on_snow) and it melts rain c_w max(0, T) / L_f more;
  *   the melt M (snow_melt_cell) turns pack into liquid water (*melted);
  *   the liquid water above retention times the pack that is left reaches the depth (*runoff).
- * Others keep everything. Volumes in m^3 (0 for others); `a` is the cell's area. Branch-free. */
-ERODEM_FN void snow_pack_cell(int i, int active, real T, GLOBAL const real* rain_factor,
-                              GLOBAL real* snow, GLOBAL real* liquid, GLOBAL real* depth, real a,
-                              real dt, ERODEM_P(SnowParams) p, real* snowfall, real* rain_on_snow,
+ * Others keep everything. Volumes in m^3 (0 for others); `a` is the cell's area, f its rain
+ * factor. Branch-free. */
+ERODEM_FN void snow_pack_cell(int i, int active, real T, real f, GLOBAL real* snow,
+                              GLOBAL real* liquid, GLOBAL real* depth, real a, real dt,
+                              ERODEM_P(SnowParams) p, real* snowfall, real* rain_on_snow,
                               real* melted, real* runoff) {
   /* unconditional loads: if-convertible */
-  const real s = snow[i], l = liquid[i], d = depth[i], f = rain_factor[i];
+  const real s = snow[i], l = liquid[i], d = depth[i];
   const real rained = dt * p.rain_rate * f; /* as rain_cell (sources.h) computed it */
   const real P = active ? (rained < d ? rained : d) : (real)0;
   const int snows = T < p.snowfall_temperature;
@@ -90,8 +92,9 @@ ERODEM_FN void snow_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* 
                                real* snowfall, real* rain_on_snow, real* melted, real* runoff) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-  snow_pack_cell(i, active, snow_air_temperature(bed[i], p), rain_factor, snow, liquid, depth,
-                 area[y], dt, p, snowfall, rain_on_snow, melted, runoff);
+  snow_pack_cell(i, active, snow_air_temperature(bed[i], p),
+                 rain_factor[param_index(x, y, p.rain_factor_pitch)], snow, liquid, depth, area[y],
+                 dt, p, snowfall, rain_on_snow, melted, runoff);
 }
 
 /* The snow sweep with snow.temperature_grids (the generic sweep "snow_gridded"): as
@@ -106,8 +109,8 @@ ERODEM_FN void snow_gridded_sweep_cell(int x, int y, int W, GLOBAL const erodem_
                                        real* runoff) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-  snow_pack_cell(i, active, air_temperature[i], rain_factor, snow, liquid, depth, area[y], dt, p,
-                 snowfall, rain_on_snow, melted, runoff);
+  snow_pack_cell(i, active, air_temperature[i], rain_factor[param_index(x, y, p.rain_factor_pitch)],
+                 snow, liquid, depth, area[y], dt, p, snowfall, rain_on_snow, melted, runoff);
 }
 
 /* Sliding, pass 1 (the generic sweep "snow_slide_share"), padded cell (x, y) of a row

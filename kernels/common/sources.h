@@ -38,13 +38,15 @@ ERODEM_FN real wetness_cell(real wetness, real depth, real dt, real tau) {
 
 /* The rain sweep for padded cell (x, y) of a row 1 <= y <= H - 2, the body of both backends'
  * loops (kernels/cpu/sources.cpp, kernels/opencl/sources.cl): active cells take the rain of
- * rate (m/s) times their factor over dt (s); others keep their depth. */
+ * rate (m/s) times their factor over dt (s); others keep their depth. The rain factor array
+ * holds factor_pitch values per row (param_index, compat.h). */
 ERODEM_FN void rain_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                               GLOBAL real* depth, GLOBAL const real* rain_factor, real dt,
-                               real rate) {
+                               GLOBAL real* depth, GLOBAL const real* rain_factor, int factor_pitch,
+                               real dt, real rate) {
   const int i = x + y * W;
   const real d = depth[i];
-  depth[i] = kind[i] == ERODEM_CELL_ACTIVE ? rain_cell(d, dt, rate, rain_factor[i]) : d;
+  const real f = rain_factor[param_index(x, y, factor_pitch)];
+  depth[i] = kind[i] == ERODEM_CELL_ACTIVE ? rain_cell(d, dt, rate, f) : d;
 }
 
 /* The evaporation sweep for padded cell (x, y) of a row 1 <= y <= H - 2, the body of both

@@ -93,9 +93,11 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   wetness_ = depth_;
   take(sediment_, s.sediment);
   sediment_next_ = sediment_;
-  take(manning_, s.manning);
-  take(hardness_, s.hardness);
-  take(rain_factor_, s.rain_factor);
+  // the parameters the terrain classes write are held per cell from the start
+  take_parameter(manning_, s.manning, cell_.terrain_class.set_manning != 0);
+  take_parameter(hardness_, s.hardness, cell_.terrain_class.set_hardness != 0);
+  take_parameter(rain_factor_, s.rain_factor, false);
+  set_param_pitches(cell_, pitch(manning_), pitch(hardness_), pitch(rain_factor_));
   // The fields that start at zero: value-initialised, so their pages are taken when a step
   // first writes them, after the terrain's own arrays are freed (stagger.hpp).
   bed_residual_ = Field(n);
@@ -114,6 +116,26 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   fields_.bind(*this, [cells] { return Field(cells); });
   run_boundary();
   exchange_halo({"bed", "water_depth", "sediment"});  // the corners after the ghost rows
+}
+
+template <class Real>
+void CpuBackend<Real>::take_parameter(Field& dst, CellParameter& src, bool per_cell) {
+  if (!src.is_uniform()) {
+    dst.assign(src.cells.begin(), src.cells.end());
+    std::vector<double>().swap(src.cells);
+    return;
+  }
+  dst.assign(static_cast<std::size_t>(W_), static_cast<Real>(src.uniform));
+  if (per_cell) make_per_cell(dst);
+}
+
+template <class Real>
+void CpuBackend<Real>::make_per_cell(Field& f) {
+  if (!uniform(f)) return;
+  Field all(static_cast<std::size_t>(W_) * static_cast<std::size_t>(H_));
+  for (int y = 0; y < H_; ++y) std::copy(f.begin(), f.end(), all.begin() + at(0, y));
+  f.swap(all);
+  set_param_pitches(cell_, pitch(manning_), pitch(hardness_), pitch(rain_factor_));
 }
 
 template <class Real>
@@ -237,10 +259,11 @@ void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
   for (const std::string& name : names) {
     Field* f = name == "depth_flow"      ? &depth_next_
                : name == "thermal_share" ? &thermal_share_
-                                         : field_storage(field_info(name).id);
+                                         : fields_.get(field_info(name).id);
     if (!f)
       throw Error(ExitCode::internal,
                   fmt::format("halo exchange: field '{}' has no storage", name));
+    if (uniform(*f)) continue;  // a uniform parameter: every row holds its one row
     fields.push_back(f->data());
   }
   exchange_fields(fields);

@@ -212,8 +212,34 @@ class CpuBackend final : public Backend {
   }
   /// A per-cell field: each array at its own offset modulo 4 KiB (stagger.hpp).
   using Field = std::vector<Real, StaggeredAllocator<Real>>;
+  // Uniform parameters (docs/architecture.md): Manning n, hardness and the rain factor are
+  // each held as one row of W copies where the run gives one value for every cell (no raster,
+  // noise or class sets it), as an array of the padded raster otherwise; the cell functions
+  // that read them take the pitch, W or 0 (param_index, common/compat.h), from their
+  // parameter structs (set_param_pitches).
+  /// Whether `f` is a parameter held as one row.
+  bool uniform(const Field& f) const {
+    return f.size() == static_cast<std::size_t>(W_);
+  }
+  /// The values per row of `f` (its pitch): 0 for a uniform parameter, W otherwise.
+  int pitch(const Field& f) const {
+    return uniform(f) ? 0 : W_;
+  }
+  /// The index in `f` of padded cell p.
+  std::size_t param_at(const Field& f, std::size_t p) const {
+    return uniform(f) ? p % W_ : p;
+  }
+  /// A parameter from the padded state: one row where uniform, else every cell's value.
+  void take_parameter(Field& dst, CellParameter& src, bool per_cell);
+  /// Field `f` (a uniform parameter) as an array of every cell (before anything writes it),
+  /// and the pitches updated.
+  void make_per_cell(Field& f);
+  /// The storage of field `id` to write or bind: a uniform parameter is first made an array
+  /// of every cell (make_per_cell).
   Field* field_storage(FieldId id) {
-    return fields_.get(id);
+    Field* f = fields_.get(id);
+    if (f && uniform(*f)) make_per_cell(*f);
+    return f;
   }
   friend class FieldRegistry<Field>;
   /// Field `id` (stored in `src`, from field_storage) at padded cell `p`, as field() gives
@@ -221,14 +247,14 @@ class CpuBackend final : public Backend {
   /// shear stress from the depth, the velocities and Manning n (in double, as OpenCL's host).
   double value_at(FieldId id, const Field* src, std::size_t p) const {
     if (id == FieldId::shear_stress)
-      return cell::bed_shear_stress<double>(depth_[p], velocity_x_[p], velocity_y_[p], manning_[p],
-                                            params_.flow.water_density, params_.flow.gravity,
-                                            params_.numerics.velocity_min_depth);
+      return cell::bed_shear_stress<double>(
+          depth_[p], velocity_x_[p], velocity_y_[p], manning_[param_at(manning_, p)],
+          params_.flow.water_density, params_.flow.gravity, params_.numerics.velocity_min_depth);
     // the bed and the erosion include the bed's residual (exact in double)
     const double lo = static_cast<double>(bed_residual_[p]);
     return !src ? (static_cast<double>(bed0_[p]) - static_cast<double>(bed_[p])) - lo
            : id == FieldId::bed ? static_cast<double>(bed_[p]) + lo
-                                : static_cast<double>((*src)[p]);
+                                : static_cast<double>((*src)[param_at(*src, p)]);
   }
 
   Params params_;
@@ -263,7 +289,7 @@ class CpuBackend final : public Backend {
   // shallow-water scheme: local inertial and pipes update flux_ in place (flow_blocks)
   std::array<Field, 4> flux_, flux_next_;
   Field velocity_x_, velocity_y_;
-  Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;
+  Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;  // parameters: uniform()
   Field stage_depth_;  // shallow water, second order: the depth after Heun's first stage
   // Every field's storage by FieldId: the members above, and an array (zeros) for any other
   // field of ERODEM_FIELDS (field_registry.hpp).

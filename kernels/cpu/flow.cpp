@@ -43,6 +43,7 @@ template <class Real>
 struct InertialParams {
   Real dt, gravity, theta, dry_depth;
   bool periodic_x = false;  // boundary.periodic_x: the faces across the seam (face_x_row)
+  int manning_pitch = 0;    // values per row of the Manning n array (param_index, compat.h)
 };
 
 /// Unit discharges (m^2/s) of the faces south of padded row j (0 <= j <= H - 2), all x.
@@ -73,7 +74,9 @@ void face_y_row(int j, int W, int H, const int* __restrict k_up, const int* __re
   const Real* __restrict qd = has_down ? q_down : q;
   const Real* __restrict b_a = bed + row, * __restrict b_b = bed + row + W;
   const Real* __restrict d_a = depth + row, * __restrict d_b = depth + row + W;
-  const Real* __restrict n_a = manning + row, * __restrict n_b = manning + row + W;
+  const std::ptrdiff_t n_row = static_cast<std::ptrdiff_t>(j) * p.manning_pitch;
+  const Real* __restrict n_a = manning + n_row, * __restrict n_b =
+                                                    manning + n_row + p.manning_pitch;
   const Real width = cell::face_y_width(dx, j), dist = cell::centre_distance_y(dy, j);
   const Real dt = p.dt, g = p.gravity, theta = p.theta, dry = p.dry_depth;
   ERODEM_IVDEP
@@ -94,7 +97,8 @@ void face_x_row(int y, int W, const int* __restrict k, const Real* __restrict be
                 Real* __restrict out) {
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
   const Real* __restrict fl = f_left + row, * __restrict fr = f_right + row;
-  const Real* __restrict b = bed + row, * __restrict d = depth + row, * __restrict n = manning + row;
+  const Real* __restrict b = bed + row, * __restrict d = depth + row;
+  const Real* __restrict n = manning + static_cast<std::ptrdiff_t>(y) * p.manning_pitch;
   const Real width = dy[y], dist = dx[y];
   const Real dt = p.dt, g = p.gravity, theta = p.theta, dry = p.dry_depth;
   for (int x = 0; x < W - 1; ++x) q[x] = cell::face_unit_discharge(fr[x], fl[x + 1], width);
@@ -444,7 +448,7 @@ void shallow_water_rows(const SwStage<Real>& st, int y0, int y1) {
     const SwFaceRef<Real>&north = face_y[(y + 1) % 2], &south = face_y[(y + 2) % 2];
     const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
     const int* __restrict k = row_of(y).kind;
-    const Real* __restrict h = d + row, * __restrict qxr = st.q_x + row, * __restrict qyr = st.q_y + row, * __restrict n = st.manning + row;
+    const Real* __restrict h = d + row, * __restrict qxr = st.q_x + row, * __restrict qyr = st.q_y + row, * __restrict n = st.manning + static_cast<std::ptrdiff_t>(y) * st.params.manning_pitch;
     Real* __restrict o_l = st.out_left + row, * __restrict o_r = st.out_right + row, * __restrict o_t = st.out_top + row, * __restrict o_b = st.out_bottom + row, * __restrict qx_out = st.q_x_new + row, * __restrict qy_out = st.q_y_new + row;
     // face lengths: x-faces the row's dy; y-faces the mean dx of their two rows (the rows
     // beyond the raster: the nearest face's, as shallow_water_cell clamps)
@@ -552,7 +556,7 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
     });
     return;
   }
-  const InertialParams<Real> p{dt, g, f.theta, f.dry_depth, periodic_};
+  const InertialParams<Real> p{dt, g, f.theta, f.dry_depth, periodic_, f.manning_pitch};
   const Real* manning = manning_.data();
   // for_row_blocks' blocks, with a barrier all threads meet (flow_blocks' comment above)
 #pragma omp parallel num_threads(threads_)

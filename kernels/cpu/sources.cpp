@@ -16,11 +16,13 @@ void CpuBackend<Real>::sources_row(int y, Real dt, Real rate) {
   if (rate != Real(0)) {
     const Kind* kind = kind_.data();
     const Real* factor = rain_factor_.data();
+    const int pitch = this->pitch(rain_factor_);
     Real* depth = depth_.data();
     const int W = W_;
     const Real step = dt, r = rate;  // locals: stores to Real arrays could alias members
     ERODEM_IVDEP
-    for (int x = 1; x < W - 1; ++x) cell::rain_sweep_cell(x, y, W, kind, depth, factor, step, r);
+    for (int x = 1; x < W - 1; ++x)
+      cell::rain_sweep_cell(x, y, W, kind, depth, factor, pitch, step, r);
   }
   const auto first =
       std::lower_bound(point_rows_.begin(), point_rows_.end(), std::pair<int, std::size_t>{y, 0});

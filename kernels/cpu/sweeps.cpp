@@ -98,7 +98,14 @@ typename CpuBackend<Real>::GenericRows CpuBackend<Real>::cell_rows(const SweepIn
       fields[k] = static_cast<void*>(depth);
       continue;
     }
-    Field* f = name == "rain_factor" ? &rain_factor_ : field_storage(field_info(name).id);
+    // The parameters as held, one row where uniform: their cell functions read them at
+    // param_index with the pitch of their parameter struct. (The terrain classes write Manning
+    // n and hardness only where class_tables says so; the constructor holds those per cell.)
+    const FieldId id = field_info(name).id;
+    Field* f = id == FieldId::rain_factor ? &rain_factor_
+               : id == FieldId::manning_n ? &manning_
+               : id == FieldId::hardness  ? &hardness_
+                                          : field_storage(id);
     if (!f)
       throw Error(ExitCode::internal,
                   fmt::format("sweep '{}': field '{}' has no storage", sweep.name, name));

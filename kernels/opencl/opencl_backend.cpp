@@ -66,6 +66,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   periodic_ = state.periodic_x;
   tails_ = sweeps_tails(params, periodic_);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
+  set_param_pitches(cell_, W_, W_, W_);  // a value per cell of every parameter
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
   cl_int err = CL_SUCCESS;
@@ -85,6 +86,11 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     std::vector<double>().swap(v);
     return r;
   };
+  // a parameter per cell (OpenCL keeps every one so: set_param_pitches above)
+  auto per_cell = [this, &to_real](CellParameter& v) {
+    if (!v.is_uniform()) return to_real(v.cells);
+    return std::vector<Real>(n_, static_cast<Real>(v.uniform));
+  };
   auto release = [](std::vector<Real>& v) { std::vector<Real>().swap(v); };
   const std::vector<Real> dx = to_real(state.dx), dy = to_real(state.dy),
                           area = to_real(state.area);
@@ -92,8 +98,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   const std::vector<cl_uchar> kind(state.kind.begin(), state.kind.end());
   std::vector<std::uint8_t>().swap(state.kind);
   std::vector<Real> bed_r = to_real(state.bed), depth_r = to_real(state.depth),
-                    sediment_r = to_real(state.sediment), manning_r = to_real(state.manning),
-                    hardness_r = to_real(state.hardness), rain_r = to_real(state.rain_factor);
+                    sediment_r = to_real(state.sediment), manning_r = per_cell(state.manning),
+                    hardness_r = per_cell(state.hardness), rain_r = per_cell(state.rain_factor);
   const std::vector<Real> zeros(n_, Real(0));
 
   // ---- the device state ----

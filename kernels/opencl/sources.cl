@@ -10,7 +10,7 @@ __kernel void sources_rain(int W, int H, __global const uchar* restrict kind,
                            real dt, real rate) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
-  rain_sweep_cell(x, y, W, kind, depth, rain_factor, dt, rate);
+  rain_sweep_cell(x, y, W, kind, depth, rain_factor, W, dt, rate); /* a value per cell */
 }
 
 /* Point and line inflows, one work-item adding them in order (a cell may appear twice):

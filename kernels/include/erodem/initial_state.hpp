@@ -10,6 +10,16 @@
 
 namespace erodem {
 
+/// A cell parameter of the padded raster (Manning n, hardness, the rain factor): a raster with
+/// its halo, or, where the run gives none, one value everywhere (`cells` empty), which the
+/// backends may hold as a constant instead of an array (docs/architecture.md "Uniform
+/// parameters").
+struct CellParameter {
+  std::vector<double> cells;  ///< a value per padded cell, or empty: `uniform` everywhere
+  double uniform = 0.0;
+  bool is_uniform() const { return cells.empty(); }
+};
+
 /// The padded raster (W = nx + 2 by H = ny + 2, one ghost cell around the DEM; see
 /// kernels/common/compat.h) of a run's initial state, in double. Backends round it to their
 /// precision once, so every backend starts from the same numbers.
@@ -20,7 +30,7 @@ struct PaddedState {
   std::vector<double> bed, depth;    ///< m; ghosts as the boundary kinds set them
   /// m of solid: 0, but sea nodata cells hold boundary.sediment_concentration of their depth
   std::vector<double> sediment;
-  std::vector<double> manning, hardness, rain_factor;  ///< rasters or the scalar parameter
+  CellParameter manning, hardness, rain_factor;  ///< rasters or the scalar parameters
   /// boundary.periodic_x (boundary_codes.hpp periodic_x): the west ghost column holds the
   /// last DEM column and the east ghost column the first, kinds and every field, so the faces
   /// across the seam are computed as inside the grid (the backends keep the copies up to date,
