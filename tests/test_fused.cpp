@@ -186,7 +186,11 @@ INSTANTIATE_TEST_SUITE_P(
 // give the bits of one thread, fused or not. Bound: 0 differing values; a unit discharge
 // read after the neighbouring block wrote its row changes that face's discharge, and the
 // depths and outflows beside it, from the next step on.
-TEST(InPlaceFlow, EveryBlockSizeGivesTheBitsOfOneThread) {
+// The CPU loops that write a field over itself (the local-inertial and pipes outflows, flow.cpp;
+// the bed by erosion and thermal collapse, the sediment by conservative transport,
+// rows_in_place) give every thread count the bits of one thread: each block of rows takes or
+// keeps what its neighbours' rows need of its own before a barrier.
+TEST(InPlace, EveryBlockSizeGivesTheBitsOfOneThread) {
   const Target target{"cpu", Precision::float32};
   for (const FlowScheme flow : {FlowScheme::local_inertial, FlowScheme::pipes})
     for (const bool fused : {false, true}) {
@@ -200,8 +204,8 @@ TEST(InPlaceFlow, EveryBlockSizeGivesTheBitsOfOneThread) {
         std::size_t total = 0;
         for (const auto& f : field_table()) total += differing(many.field(f.id), one.field(f.id));
         std::printf(
-            "[in-place flow] %s%s, %d threads against 1: %zu field values differ (bound "
-            "0)\n",
+            "[in-place] %s%s, erosion, transport, thermal, %d threads against 1: %zu field "
+            "values differ (bound 0)\n",
             flow == FlowScheme::pipes ? "pipes" : "local inertial", fused ? ", fused" : "", threads,
             total);
         EXPECT_EQ(total, 0u) << threads << " threads";

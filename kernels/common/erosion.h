@@ -167,26 +167,27 @@ ERODEM_FN real erosion_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kin
  * backends' sweeps (the CPU loop of kernels/cpu/erosion.cpp, the work-item of
  * kernels/opencl/erosion.cl): every cell computes (in the first and last column on
  * neighbours across the row's ends, inside the buffer) and the active ones (1 <= x <= W - 2,
- * kind active) keep the result: the new bed into bed_out, the new residual and sediment in
- * place; the others keep theirs. Writes the volume eroded and the volume deposited (m^3; 0
- * for other cells) through *eroded and *deposited. Every load is unconditional (the row's
- * area too: under `active`, PoCL made it a gather and left the kernel scalar), so loops over
- * x vectorise. */
+ * kind active) keep the result: the new bed through *bed_new (the kernel stores it in a second
+ * buffer, the CPU loop in a row it writes back once no row reads the old bed there), the new
+ * residual and sediment in place; the others keep theirs. Writes the volume eroded and the volume
+ * deposited (m^3; 0 for other cells) through *eroded and *deposited. Every load is unconditional
+ * (the row's area too: under `active`, PoCL made it a gather and left the kernel scalar), so loops
+ * over x vectorise. */
 ERODEM_FN void erosion_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                                  GLOBAL const real* bed, GLOBAL real* bed_out,
-                                  GLOBAL real* bed_residual, GLOBAL real* sediment,
-                                  GLOBAL const real* depth, GLOBAL const real* velocity_x,
-                                  GLOBAL const real* velocity_y, GLOBAL const real* hardness,
-                                  GLOBAL const real* dx, GLOBAL const real* dy,
-                                  GLOBAL const real* area, real dt, ERODEM_P(ErosionParams) p,
-                                  real* eroded, real* deposited) {
+                                  GLOBAL const real* bed, GLOBAL real* bed_residual,
+                                  GLOBAL real* sediment, GLOBAL const real* depth,
+                                  GLOBAL const real* velocity_x, GLOBAL const real* velocity_y,
+                                  GLOBAL const real* hardness, GLOBAL const real* dx,
+                                  GLOBAL const real* dy, GLOBAL const real* area, real dt,
+                                  ERODEM_P(ErosionParams) p, real* bed_new, real* eroded,
+                                  real* deposited) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   const real b = bed[i], lo = bed_residual[i], s = sediment[i], cell_area = area[y];
   real lo_new, s_new, moved;
   const real b_new = erosion_cell(x, y, W, kind, bed, bed_residual, sediment, depth, velocity_x,
                                   velocity_y, hardness, dx, dy, dt, p, &lo_new, &s_new, &moved);
-  bed_out[i] = active ? b_new : b;
+  *bed_new = active ? b_new : b;
   bed_residual[i] = active ? lo_new : lo;
   sediment[i] = active ? s_new : s;
   const real volume = moved * cell_area;
@@ -373,16 +374,19 @@ ERODEM_FN real sediment_cell(int x, int y, int W, GLOBAL const erodem_kind_t* ki
 
 /* The physical erosion sweep's work for padded cell (x, y) of a row 1 <= y <= H - 2 (the CPU
  * loop of kernels/cpu/erosion.cpp, the kernel erosion_physical of kernels/opencl/erosion.cl):
- * the active cells keep sediment_cell's results, the others theirs. Writes the volumes (m^3 of
+ * the active cells keep sediment_cell's results, the others theirs: the new bed through
+ * *bed_new (as erosion_sweep_cell), the rest in place. Writes the volumes (m^3 of
  * solid; 0 for other cells) eroded, deposited and taken from the bedrock, and the bed's bulk
  * change minus the solid moved (m^3) through the pointers. Branch-free. */
-ERODEM_FN void sediment_sweep_cell(
-    int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
-    GLOBAL real* bed_out, GLOBAL real* bed_residual, GLOBAL real* sediment, GLOBAL real* soil,
-    GLOBAL const real* depth, GLOBAL const real* velocity_x, GLOBAL const real* velocity_y,
-    GLOBAL const real* manning, GLOBAL const real* hardness, GLOBAL const real* dx,
-    GLOBAL const real* dy, GLOBAL const real* area, real dt, ERODEM_P(SedimentParams) p,
-    real* eroded, real* deposited, real* eroded_rock, real* bulking) {
+ERODEM_FN void sediment_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
+                                   GLOBAL const real* bed, GLOBAL real* bed_residual,
+                                   GLOBAL real* sediment, GLOBAL real* soil,
+                                   GLOBAL const real* depth, GLOBAL const real* velocity_x,
+                                   GLOBAL const real* velocity_y, GLOBAL const real* manning,
+                                   GLOBAL const real* hardness, GLOBAL const real* dx,
+                                   GLOBAL const real* dy, GLOBAL const real* area, real dt,
+                                   ERODEM_P(SedimentParams) p, real* bed_new, real* eroded,
+                                   real* deposited, real* eroded_rock, real* bulking) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   const real b = bed[i], lo = bed_residual[i], s = sediment[i], l = soil[i], cell_area = area[y];
@@ -390,7 +394,7 @@ ERODEM_FN void sediment_sweep_cell(
   const real b_new = sediment_cell(x, y, W, kind, bed, bed_residual, sediment, soil, depth,
                                    velocity_x, velocity_y, manning, hardness, dx, dy, dt, p,
                                    &lo_new, &s_new, &l_new, &moved, &rock, &bulk);
-  bed_out[i] = active ? b_new : b;
+  *bed_new = active ? b_new : b;
   bed_residual[i] = active ? lo_new : lo;
   sediment[i] = active ? s_new : s;
   soil[i] = active ? l_new : l;

@@ -125,9 +125,10 @@ ERODEM_FN real thermal_apply_cell(int x, int y, int W, GLOBAL const erodem_kind_
 /* The two sweeps of slope collapse for padded cell (x, y) of a row 1 <= y <= H - 2, the
  * bodies of both backends' loops (kernels/cpu/thermal.cpp, kernels/opencl/thermal.cl): every
  * cell computes, the active ones (1 <= x <= W - 2, kind active) keep the result, branch-free.
- * Pass 1 writes the share (0 for other cells); pass 2 writes the new bed into bed_out and the
- * residual in place (others keep theirs) and the volume the cell gave (m^3; 0 for others)
- * through *moved. */
+ * Pass 1 writes the share (0 for other cells); pass 2 writes the new bed through *bed_new (as
+ * erosion_sweep_cell: a second buffer, or a row the CPU writes back once no row reads the old
+ * bed there) and the residual in place (others keep theirs) and the volume the cell gave (m^3;
+ * 0 for others) through *moved. */
 ERODEM_FN void thermal_share_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                         GLOBAL const real* bed, GLOBAL const real* wetness,
                                         GLOBAL const real* talus, GLOBAL const real* dx,
@@ -139,19 +140,18 @@ ERODEM_FN void thermal_share_sweep_cell(int x, int y, int W, GLOBAL const erodem
 }
 
 ERODEM_FN void thermal_apply_sweep_cell(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
-                                        GLOBAL const real* bed, GLOBAL real* bed_out,
-                                        GLOBAL real* bed_residual, GLOBAL const real* wetness,
-                                        GLOBAL const real* talus, GLOBAL const real* share,
-                                        GLOBAL const real* dx, GLOBAL const real* dy,
-                                        GLOBAL const real* area, ERODEM_P(ThermalParams) p,
-                                        real* moved) {
+                                        GLOBAL const real* bed, GLOBAL real* bed_residual,
+                                        GLOBAL const real* wetness, GLOBAL const real* talus,
+                                        GLOBAL const real* share, GLOBAL const real* dx,
+                                        GLOBAL const real* dy, GLOBAL const real* area,
+                                        ERODEM_P(ThermalParams) p, real* bed_new, real* moved) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   const real b_old = bed[i], lo_old = bed_residual[i]; /* unconditional loads */
   real lo_new, gave;
   const real b = thermal_apply_cell(x, y, W, kind, bed, bed_residual, wetness, talus, share, dx, dy,
                                     area, p, &lo_new, &gave);
-  bed_out[i] = active ? b : b_old;
+  *bed_new = active ? b : b_old;
   bed_residual[i] = active ? lo_new : lo_old;
   *moved = active ? gave : (real)0;
 }

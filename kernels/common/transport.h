@@ -108,21 +108,22 @@ ERODEM_FN real transport_semi_lagrangian_cell(int x, int y, int W, int H,
 
 /* The conservative transport sweep for padded cell (x, y) of a row 1 <= y <= H - 2, the body
  * of both backends' loops (kernels/cpu/transport.cpp, kernels/opencl/transport.cl): active
- * cells (1 <= x <= W - 2, kind active) write their new sediment into sediment_out, others
- * their old one. Writes through *carried the volume carried out of the domain and through
- * *given the volume the cell gave (m^3; 0 for others). Branch-free. */
+ * cells (1 <= x <= W - 2, kind active) write their new sediment through *sediment_new (the
+ * kernel stores it in a second buffer, the CPU loop in a row it writes back once no row reads
+ * the old sediment there), others their old one. Writes through *carried the volume carried out of
+ * the domain and through *given the volume the cell gave (m^3; 0 for others). Branch-free. */
 ERODEM_FN void transport_conservative_sweep_cell(
     int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* sediment,
-    GLOBAL real* sediment_out, GLOBAL const real* depth_flow, GLOBAL const real* f_left,
-    GLOBAL const real* f_right, GLOBAL const real* f_top, GLOBAL const real* f_bottom,
-    GLOBAL const real* area, real dt, real* carried, real* given) {
+    GLOBAL const real* depth_flow, GLOBAL const real* f_left, GLOBAL const real* f_right,
+    GLOBAL const real* f_top, GLOBAL const real* f_bottom, GLOBAL const real* area, real dt,
+    real* sediment_new, real* carried, real* given) {
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
   real gone, gave;
   const real s_new = transport_conservative_cell(x, y, W, kind, sediment, depth_flow, f_left,
                                                  f_right, f_top, f_bottom, area, dt, &gone, &gave);
   const real s_old = sediment[i]; /* an unconditional load: if-convertible */
-  sediment_out[i] = active ? s_new : s_old;
+  *sediment_new = active ? s_new : s_old;
   *carried = active ? gone : (real)0;
   *given = active ? gave : (real)0;
 }

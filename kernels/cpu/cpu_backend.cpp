@@ -86,13 +86,14 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   take(dy_, s.dy);
   take(area_, s.area);
   take(bed_, s.bed);
-  bed_next_ = bed_;
   bed0_ = bed_;
   take(depth_, s.depth);
   depth_next_ = depth_;
   wetness_ = depth_;
   take(sediment_, s.sediment);
-  sediment_next_ = sediment_;
+  if (process_info(Process::transport).enabled(params) &&
+      params.transport.scheme == TransportScheme::semi_lagrangian)
+    sediment_next_ = sediment_;
   // the parameters the terrain classes write are held per cell from the start
   take_parameter(manning_, s.manning, cell_.terrain_class.set_manning != 0);
   take_parameter(hardness_, s.hardness, cell_.terrain_class.set_hardness != 0);
@@ -487,6 +488,7 @@ void CpuBackend<Real>::set_field_rows(FieldId id, int row0, int row1,
                 fmt::format("field '{}' is derived and cannot be set", field_info(id).name));
   // Fields kept in two buffers get both, so the next step starts from the new values.
   Field* twin = fields_.twin(id);
+  if (twin && twin->empty()) twin = nullptr;  // a field updated in place (bed_next_)
   // the DEM rows the padded raster holds (a band's own and halo rows in an MPI run)
   for (int y = 0; y < H_; ++y) {
     const int r = y + row0_ - 1;

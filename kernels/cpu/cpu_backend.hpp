@@ -6,11 +6,13 @@
 // cpu_v3, cpu_v4; see cpu/isa_prelude.hpp, force-included); cpu/dispatch.cpp chooses.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cell_params.hpp"
@@ -185,6 +187,40 @@ class CpuBackend final : public Backend {
       if (y0 < y1) f(y0, y1);
     }
   }
+  /// Runs row(y, out) for the interior padded rows 1 .. H - 2 on the backend's threads, each
+  /// over its block of rows top to bottom, where row y computes the new values of one field
+  /// into `out` (W values; columns 1 .. W - 2) from the old values of rows y - 1 .. y + 1 of
+  /// `field`, and writes them into `field` once no row reads row y's old values: row y - 1
+  /// as soon as row y is computed, each block's first and last rows (which the neighbouring
+  /// blocks read) after every thread has computed its block. The bits of the same loop into a
+  /// second buffer swapped in, without that buffer (the bed's and the sediment's: 8 B per cell
+  /// of a float32 run; docs/performance.md "Resident memory per cell").
+  template <class RowFn>
+  void rows_in_place(Real* field, const RowFn& row) const {
+    const int W = W_, H = H_;
+#pragma omp parallel num_threads(threads_)
+    {
+      const std::pair<int, int> block = thread_row_block(H - 2);
+      const int y0 = block.first + 1, y1 = block.second + 1;
+      const auto rows = row_scratch(3 * W);
+      Real *first = rows.get(), *prev = first + W, *cur = prev + W;
+      const auto write_back = [&](int y, const Real* r) {
+        std::copy(r + 1, r + W - 1, field + static_cast<std::size_t>(y) * W + 1);
+      };
+      for (int y = y0; y < y1; ++y) {
+        row(y, cur);
+        if (y == y0) {
+          std::swap(first, cur);  // the block's first row waits for the barrier
+          continue;
+        }
+        if (y - 1 > y0) write_back(y - 1, prev);
+        std::swap(prev, cur);
+      }
+#pragma omp barrier
+      if (y0 < y1) write_back(y0, first);
+      if (y1 - 1 > y0) write_back(y1 - 1, prev);
+    }
+  }
   /// Sums per-row partial sums (one per padded row) in row order (deterministic for any
   /// thread count): in an MPI run, those of the rows of every rank in global row order.
   double sum_rows(const std::vector<double>& rows) const;
@@ -281,6 +317,10 @@ class CpuBackend final : public Backend {
   std::vector<Real> dx_, dy_, area_;  // per padded row
   // The bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is only
   // read and written at its own cell, so one buffer.
+  // bed_next_ stays empty: erosion and thermal collapse update the bed in place
+  // (rows_in_place); sediment_next_ holds the semi-Lagrangian transport's new sediment (the
+  // conservative one updates it in place). FieldRegistry binds them as the twins of the bed
+  // and the sediment, which set_field skips while empty.
   Field bed_, bed_next_, bed0_, bed_residual_;
   Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the water update
                               // started from (used by conservative transport)

@@ -18,7 +18,7 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
   // The talus slopes are read only where the classes set them (by_class); otherwise any
   // array of the grid's size stands in, so that no field of zeros is made for them (4 B/cell).
   const Real* talus = cell_.thermal.by_class ? field_storage(FieldId::talus_slope)->data() : wet;
-  Real *share = thermal_share_.data(), *bed_out = bed_next_.data(), *bed_lo = bed_residual_.data();
+  Real *share = thermal_share_.data(), *bed_lo = bed_residual_.data();
   const cell_params::ThermalParams<Real> params = cell_.thermal;
   const int W = W_;
   for_rows(1, H_ - 1, [=](int y) {
@@ -30,18 +30,18 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
       cell::thermal_share_sweep_cell(x, y, W, kind, bed, wet, talus, dx, dy, area, share, step, p);
   });
   exchange_halo({"thermal_share"});  // the apply pass reads the neighbours' shares
-  for_rows(1, H_ - 1, [=](int y) {
+  // the new bed in place (rows_in_place): each cell reads its neighbours' old bed
+  rows_in_place(bed_.data(), [=](int y, Real* bed_new) {
     const cell_params::ThermalParams<Real> p = params;
     const auto given_row = row_scratch(W);
     Real* given = given_row.get();
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
-      cell::thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_lo, wet, talus, share, dx, dy,
-                                     area, p, given + x);
+      cell::thermal_apply_sweep_cell(x, y, W, kind, bed, bed_lo, wet, talus, share, dx, dy, area, p,
+                                     bed_new + x, given + x);
     row_sums_a_[y] = sum_row(given, static_cast<std::size_t>(W));
   });
   tally.thermal_moved += sum_rows(row_sums_a_);
-  std::swap(bed_, bed_next_);
 }
 
 template void CpuBackend<float>::run_thermal(float, StepTally&);

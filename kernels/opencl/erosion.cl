@@ -18,9 +18,12 @@ __kernel void erosion(int W, int H, __global const uchar* restrict kind,
   __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real eroded = 0, deposited = 0;
-  if (!ERODEM_PAST_ROW(x, W))
-    erosion_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, sediment, depth, velocity_x,
-                       velocity_y, hardness, dx, dy, area, dt, p, &eroded, &deposited);
+  if (!ERODEM_PAST_ROW(x, W)) {
+    real b;
+    erosion_sweep_cell(x, y, W, kind, bed, bed_residual, sediment, depth, velocity_x, velocity_y,
+                       hardness, dx, dy, area, dt, p, &b, &eroded, &deposited);
+    bed_out[x + y * W] = b;
+  }
   const int g = cell_group_index();
   cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
                   partials + ERODEM_TALLY_ERODED * stride + g,
@@ -45,10 +48,13 @@ __kernel void erosion_physical(
   __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real eroded = 0, deposited = 0, rock = 0, bulking = 0;
-  if (!ERODEM_PAST_ROW(x, W))
-    sediment_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, sediment, soil, depth,
-                        velocity_x, velocity_y, manning, hardness, dx, dy, area, dt, p, &eroded,
-                        &deposited, &rock, &bulking);
+  if (!ERODEM_PAST_ROW(x, W)) {
+    real b;
+    sediment_sweep_cell(x, y, W, kind, bed, bed_residual, sediment, soil, depth, velocity_x,
+                        velocity_y, manning, hardness, dx, dy, area, dt, p, &b, &eroded, &deposited,
+                        &rock, &bulking);
+    bed_out[x + y * W] = b;
+  }
   const int g = cell_group_index();
   cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
                   partials + ERODEM_TALLY_ERODED * stride + g,

@@ -32,9 +32,12 @@ __kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
   __local acc_t s_lanes[ERODEM_TALLY_LANES];
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real moved = 0;
-  if (!ERODEM_PAST_ROW(x, W))
-    thermal_apply_sweep_cell(x, y, W, kind, bed, bed_out, bed_residual, wetness, talus, share, dx,
-                             dy, area, p, &moved);
+  if (!ERODEM_PAST_ROW(x, W)) {
+    real b;
+    thermal_apply_sweep_cell(x, y, W, kind, bed, bed_residual, wetness, talus, share, dx, dy, area,
+                             p, &b, &moved);
+    bed_out[x + y * W] = b;
+  }
   cell_group_sum(s_sum, s_lanes, moved,
                  partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index());
 }

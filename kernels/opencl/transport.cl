@@ -18,9 +18,12 @@ __kernel void transport_conservative(
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   real given = 0;
   real carried; /* edge_tallies sums it over the cells beside ghosts (unused here) */
-  if (!ERODEM_PAST_ROW(x, W))
-    transport_conservative_sweep_cell(x, y, W, kind, sediment, sediment_out, depth_flow, f_left,
-                                      f_right, f_top, f_bottom, area, dt, &carried, &given);
+  if (!ERODEM_PAST_ROW(x, W)) {
+    real s;
+    transport_conservative_sweep_cell(x, y, W, kind, sediment, depth_flow, f_left, f_right, f_top,
+                                      f_bottom, area, dt, &s, &carried, &given);
+    sediment_out[x + y * W] = s;
+  }
   cell_group_sum(s_sum, s_lanes, given,
                  partials + ERODEM_TALLY_SEDIMENT_EXCHANGED * stride + cell_group_index());
 }
