@@ -88,8 +88,11 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   *given = active ? dt * outflow : (real)0;
   depth_out[i] = active ? d_new : d_old;
 
-  /* net outflow through faces shared with ghosts */
-  *exchange = active ? water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom) : (real)0;
+  /* net outflow through faces shared with ghosts; computed on every cell and selected (the
+   * neighbours' kinds loaded unconditionally: under `active`, GCC 12 could not if-convert
+   * those loads and left the CPU loop scalar) */
+  const real ghost_exchange = water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom);
+  *exchange = active ? ghost_exchange : (real)0;
 
   const real d_mean = (real)0.5 * (d_old + d_new);
   /* the flow depths of the four faces, from the depths this update starts from: those the flow

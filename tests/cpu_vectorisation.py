@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+"""erodem — every cell loop of the CPU reference vectorises (ctest CpuVectorisation).
+
+The cell loops of kernels/cpu/*.cpp are the loops marked ERODEM_IVDEP. A loop the compiler
+leaves scalar runs several times slower and no result shows it: on 2026-11-28 the water
+update's loop had been scalar for a day (a conditional load GCC could not if-convert: 15.4 ms
+against 4.2 ms at 1024², docs/performance.md "The water update's loop vectorises again").
+
+This compiles each CPU source of the x86-64-v3 build (erodem_cpu_v3: AVX2, what
+cpu/dispatch.cpp runs on this project's machines and most x86 CPUs since 2013) again with its
+own command from compile_commands.json and GCC's vectoriser report
+(-fopt-info-vec-all), and fails for every marked loop the report calls "couldn't vectorize
+loop" in any of its instantiations, or never "loop vectorized". Printed: each loop and what
+the report says. Known exceptions (below) are reported, not failed. (The baseline build,
+x86-64-v2, also leaves thermal collapse's two loops scalar: SSE4.2 has no masked loads for
+their conditional ones; measured 2026-11-28, not checked here.)
+
+Exit 77 (skipped) for a build without compile_commands.json, with sanitizers (their
+instrumentation changes what vectorises) or with another compiler than GCC.
+Usage: cpu_vectorisation.py BUILD_DIR
+"""
+import json
+import os
+import re
+import shlex
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+
+# (file, the loop's first line): why it may stay scalar. The generic sweep's loop is one
+# template for every generic cell function; infiltration's and the terrain classes' cell
+# functions hold control flow GCC does not if-convert (they run only with those processes on).
+KNOWN_SCALAR = {
+    ("sweeps.cpp", "for (int x = 1; x < W - 1; ++x)"):
+    "the generic loop: infiltration_sweep_cell and terrain_class_sweep_cell stay scalar",
+}
+
+
+def marked_loops(path):
+    """Line numbers (1-based) and text of the loops right after an ERODEM_IVDEP line."""
+    lines = open(path, encoding="utf-8").read().split("\n")
+    out = []
+    for k, line in enumerate(lines[:-1]):
+        if line.strip() == "ERODEM_IVDEP" and lines[k + 1].lstrip().startswith("for"):
+            out.append((k + 2, lines[k + 1].strip()))
+    return out
+
+
+def report(entry, tmp):
+    """GCC's vectoriser report for one compile_commands entry, as a list of lines."""
+    args = shlex.split(entry["command"])
+    out = os.path.join(tmp, os.path.basename(entry["file"]) + ".vec")
+    # drop the object and dependency outputs; compile to nothing
+    cleaned, skip = [], False
+    for a in args:
+        if skip:
+            skip = False
+            continue
+        if a in ("-o", "-MF", "-MT"):
+            skip = True
+            continue
+        if a == "-MD":
+            continue
+        cleaned.append(a)
+    cleaned += ["-o", os.devnull, "-fopt-info-vec-all=" + out]
+    subprocess.run(cleaned, cwd=entry["directory"], check=True)
+    return open(out, encoding="utf-8").read().split("\n")
+
+
+def main():
+    build = sys.argv[1]
+    db_path = os.path.join(build, "compile_commands.json")
+    if not os.path.exists(db_path):
+        print(f"{db_path} not found (CMAKE_EXPORT_COMPILE_COMMANDS): skipped")
+        return 77
+    db = json.load(open(db_path, encoding="utf-8"))
+    entries = [e for e in db
+               if "/kernels/cpu/" in e["file"] and "erodem_cpu_v3.dir" in e["command"]
+               and e["file"].endswith(".cpp")]
+    if not entries:
+        print("no erodem_cpu_v3 sources in compile_commands.json (not x86-64): skipped")
+        return 77
+    if any("-fsanitize" in e["command"] for e in entries):
+        print("a sanitizer build (its instrumentation changes what vectorises): skipped")
+        return 77
+    compiler = shlex.split(entries[0]["command"])[0]
+    version = subprocess.run([compiler, "--version"], capture_output=True, text=True).stdout
+    if "clang" in version.lower() or not ("GCC" in version or "g++" in version or "c++" in compiler):
+        print(f"{compiler} is not GCC (the report's wording is GCC's): skipped")
+        return 77
+    failed = checked = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 2) as pool:
+            reports = list(pool.map(lambda e: report(e, tmp), entries))
+        for entry, rep in zip(entries, reports):
+            name = os.path.basename(entry["file"])
+            for line_no, text in marked_loops(entry["file"]):
+                at = re.compile(re.escape(f"{name}:{line_no}:") + r"\d+: ")
+                here = [r for r in rep if at.search(r)]
+                vectorised = sum("optimized: loop vectorized" in r for r in here)
+                scalar = sum("missed: couldn't vectorize loop" in r for r in here)
+                checked += 1
+                known = KNOWN_SCALAR.get((name, text))
+                verdict = "ok" if vectorised and not scalar else ("known" if known else "FAIL")
+                print(f"{name}:{line_no}: {vectorised} instantiation(s) vectorised, {scalar} left "
+                      f"scalar: {verdict}" + (f" ({known})" if verdict == "known" else ""))
+                if verdict == "FAIL":
+                    failed += 1
+                    for r in here:
+                        if "missed: not vectorized" in r:
+                            print("    " + r.split(": ", 1)[-1])
+    print(f"cpu vectorisation: {checked} cell loops, {failed} left scalar (bound 0)")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
