@@ -15,8 +15,9 @@ the report says. Known exceptions (below) are reported, not failed. (The baselin
 x86-64-v2, also leaves thermal collapse's two loops scalar: SSE4.2 has no masked loads for
 their conditional ones; measured 2026-11-28, not checked here.)
 
-Exit 77 (skipped) for a build without compile_commands.json, with sanitizers (their
-instrumentation changes what vectorises) or with another compiler than GCC.
+Exit 77 (skipped) for a build without compile_commands.json, not optimised (-O2/-O3: the
+Release build), with sanitizers (their instrumentation changes what vectorises) or with
+another compiler than GCC.
 Usage: cpu_vectorisation.py BUILD_DIR
 """
 import json
@@ -28,12 +29,14 @@ import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
-# (file, the loop's first line): why it may stay scalar. The generic sweep's loop is one
-# template for every generic cell function; infiltration's and the terrain classes' cell
-# functions hold control flow GCC does not if-convert (they run only with those processes on).
+# (file, the loop's first line): how many of its instantiations may stay scalar, and why. The
+# generic sweep's loop is one template for every generic cell function; infiltration's and the
+# terrain classes' cell functions hold control flow GCC does not if-convert (they run only with
+# those processes on): 2 functions, in float and double. Any further scalar instantiation (the
+# snow pack's, evaporation's, ...) fails.
 KNOWN_SCALAR = {
     ("sweeps.cpp", "for (int x = 1; x < W - 1; ++x)"):
-    "the generic loop: infiltration_sweep_cell and terrain_class_sweep_cell stay scalar",
+    (4, "the generic loop: infiltration_sweep_cell and terrain_class_sweep_cell stay scalar"),
 }
 
 
@@ -84,6 +87,9 @@ def main():
     if any("-fsanitize" in e["command"] for e in entries):
         print("a sanitizer build (its instrumentation changes what vectorises): skipped")
         return 77
+    if not all(re.search(r"(^|\s)-O[23](\s|$)", e["command"]) for e in entries):
+        print("not an optimised build (-O2/-O3: CMAKE_BUILD_TYPE=Release): skipped")
+        return 77
     compiler = shlex.split(entries[0]["command"])[0]
     version = subprocess.run([compiler, "--version"], capture_output=True, text=True).stdout
     if "clang" in version.lower() or not ("GCC" in version or "g++" in version or "c++" in compiler):
@@ -101,10 +107,12 @@ def main():
                 vectorised = sum("optimized: loop vectorized" in r for r in here)
                 scalar = sum("missed: couldn't vectorize loop" in r for r in here)
                 checked += 1
-                known = KNOWN_SCALAR.get((name, text))
-                verdict = "ok" if vectorised and not scalar else ("known" if known else "FAIL")
+                allowed, why = KNOWN_SCALAR.get((name, text), (0, ""))
+                verdict = ("FAIL" if not vectorised or scalar > allowed else
+                           "known" if scalar else "ok")
                 print(f"{name}:{line_no}: {vectorised} instantiation(s) vectorised, {scalar} left "
-                      f"scalar: {verdict}" + (f" ({known})" if verdict == "known" else ""))
+                      f"scalar (allowed {allowed}): {verdict}" +
+                      (f" ({why})" if verdict == "known" else ""))
                 if verdict == "FAIL":
                     failed += 1
                     for r in here:

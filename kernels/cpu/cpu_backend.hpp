@@ -253,7 +253,8 @@ class CpuBackend final : public Backend {
   // noise or class sets it), as an array of the padded raster otherwise; the cell functions
   // that read them take the pitch, W or 0 (param_index, common/compat.h), from their
   // parameter structs (set_param_pitches).
-  /// Whether `f` is a parameter held as one row.
+  /// Whether `f` is a parameter held as one row (every other field holds W x H_ values, and
+  /// H_ >= 3: the padded raster, or a band with its halo rows).
   bool uniform(const Field& f) const {
     return f.size() == static_cast<std::size_t>(W_);
   }
