@@ -19,11 +19,14 @@ ERODEM_BEGIN_NAMESPACE
 
 /* The talus slope of cell j from its wetness (m, the running mean of its depth): the wet one
  * above the threshold (MODEL.md step 6: wet or soft ground stands less steep), else the dry
- * one, its class's (talus_slope, read only with by_class) or tan_talus. The giver's slope sets
- * each transfer. */
+ * one, its class's (talus_slope, used only with by_class) or tan_talus. The giver's slope sets
+ * each transfer. `talus` is an array of the grid's size either way (the backends pass another
+ * field where the classes set no slopes), loaded unconditionally: under by_class, GCC's
+ * x86-64-v2 build (no masked loads) left thermal collapse's loops scalar. */
 ERODEM_FN real cell_tan_talus(GLOBAL const real* wetness, GLOBAL const real* talus, int j,
                               ERODEM_P(ThermalParams) p) {
-  const real dry = p.by_class ? talus[j] : p.tan_talus;
+  const real class_slope = talus[j];
+  const real dry = p.by_class ? class_slope : p.tan_talus;
   return wetness[j] > p.wet_threshold ? p.tan_wet : dry;
 }
 
