@@ -98,7 +98,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   take_parameter(manning_, s.manning, cell_.terrain_class.set_manning != 0);
   take_parameter(hardness_, s.hardness, cell_.terrain_class.set_hardness != 0);
   take_parameter(rain_factor_, s.rain_factor, false);
-  set_param_pitches(cell_, pitch(manning_), pitch(hardness_), pitch(rain_factor_));
+  update_param_pitches();
   // The fields that start at zero: value-initialised, so their pages are taken when a step
   // first writes them, after the terrain's own arrays are freed (stagger.hpp).
   bed_residual_ = Field(n);
@@ -136,7 +136,7 @@ void CpuBackend<Real>::make_per_cell(Field& f) {
   Field all(static_cast<std::size_t>(W_) * static_cast<std::size_t>(H_));
   for (int y = 0; y < H_; ++y) std::copy(f.begin(), f.end(), all.begin() + at(0, y));
   f.swap(all);
-  set_param_pitches(cell_, pitch(manning_), pitch(hardness_), pitch(rain_factor_));
+  update_param_pitches();
 }
 
 template <class Real>

@@ -271,6 +271,10 @@ class CpuBackend final : public Backend {
   /// Field `f` (a uniform parameter) as an array of every cell (before anything writes it),
   /// and the pitches updated.
   void make_per_cell(Field& f);
+  /// The parameter structs' pitches from how the three parameters are held now.
+  void update_param_pitches() {
+    set_param_pitches(cell_, pitch(manning_), pitch(hardness_), pitch(rain_factor_));
+  }
   /// The storage of field `id` to write or bind: a uniform parameter is first made an array
   /// of every cell (make_per_cell).
   Field* field_storage(FieldId id) {
