@@ -426,7 +426,71 @@ TEST_P(BackendContract, RunOutsideAStepIsAnError) {
   EXPECT_THROW(be.end_step(), Error);
 }
 
+// The OpenCL backend's device buffers (Backend::device_bytes, docs/performance.md "Resident
+// memory"): a 256^2 fBm terrain, 3 steps, float32, Manning n, the hardness and the rain factor
+// given as one value each. The default erosion configuration (local inertial, Mei's erosion,
+// conservative transport, thermal collapse) holds the kinds (1 B) and 19 fields of 4 B per
+// cell: bed, its second buffer, the initial bed, the bed residual, depth, depth_next, wetness,
+// sediment, its second buffer, four outflows, the two face fields, two velocities, the
+// thermal share and the soil: 77 B. Until 2026-11-28 it also held the outflows' second
+// buffers (16 B) and the three parameters per cell (12 B): 105 B. Water only (no erosion, no
+// thermal collapse) it needs neither second buffer of the bed and the sediment nor the soil:
+// 16 fields, 65 B. Measured on PoCL 80.8 and 68.4: about 3.5 B per cell at this size do not
+// grow with the cells (each field buffer is 4 KiB longer for its offset, stagger.hpp; the
+// reductions' partials; the kinds' list of edge cells). The bounds, 84 and 70 B per cell,
+// fail with any one field more (+4 B), with the parameters per cell (+12) or with the
+// outflows' second buffers (+16). A parameter set through set_field (Manning n here) is then
+// held per cell: +4 B, and the fields read back the same bits as before.
+class OpenClMemory : public TargetTest {};
+
+TEST_P(OpenClMemory, TheStateOnceAndUniformParametersAsOneRow) {
+  for (const bool erosion : {true, false}) {
+    Params p;
+    p.dem.synthetic = "fbm";
+    p.dem.size = 256;
+    p.dem.seed = 1;
+    p.dem.relief = 200.0;
+    p.dem.cell_size = 10.0;
+    p.time.adaptive = false;
+    p.time.dt = 0.5;
+    p.initial.water_depth.value = 0.2;
+    p.rain.rate = 20e-3 / 3600;
+    p.erosion.enabled = erosion;
+    p.thermal.enabled = erosion;
+    p.numerics.precision = target().precision;
+    validate(p, "opencl_memory");
+    Simulation sim = io::make_simulation(p, target().backend);
+    sim.step(3);
+    const double cells = static_cast<double>(sim.grid().cells());
+    const double per_cell = static_cast<double>(sim.backend().device_bytes()) / cells;
+    const double bound = erosion ? 84.0 : 70.0;
+    const auto depth = sim.field(FieldId::water_depth);
+    const auto manning = sim.field(FieldId::manning_n);
+    sim.backend().set_field(FieldId::manning_n, manning);
+    const double after_set = static_cast<double>(sim.backend().device_bytes()) / cells;
+    std::size_t differ = 0;
+    const auto manning_again = sim.field(FieldId::manning_n);
+    const auto depth_again = sim.field(FieldId::water_depth);
+    for (std::size_t i = 0; i < manning.size(); ++i)
+      differ += !same_bits(manning[i], manning_again[i]) || !same_bits(depth[i], depth_again[i]);
+    std::printf(
+        "[opencl memory] %s, 256^2, 3 steps: device buffers %.1f B per cell (bound %.0f); after "
+        "set_field(manning_n) %.1f (+%.2f, bounds 4.06 and 4.13: now per cell); values read back "
+        "that differ %zu (bound 0)\n",
+        erosion ? "local inertial + erosion + transport + thermal" : "local inertial, water only",
+        per_cell, bound, after_set, after_set - per_cell, differ);
+    EXPECT_LE(per_cell, bound);
+    // one buffer of the padded grid (258^2 x 4 B: 4.06 B per DEM cell) and, where the device
+    // takes the staggered offsets, 4 KiB more (4.13)
+    EXPECT_GE(after_set - per_cell, 4.06);
+    EXPECT_LE(after_set - per_cell, 4.13);
+    EXPECT_EQ(differ, 0u);
+  }
+}
+
 ERODEM_INSTANTIATE_TARGETS(BackendContract);
+ERODEM_INSTANTIATE_OPENCL_TARGETS(OpenClMemory);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(OpenClMemory);  // a build without OpenCL
 
 }  // namespace
 }  // namespace erodem::test

@@ -480,7 +480,7 @@ TEST_P(RasterParameters, HardnessRasterZeroKeepsItsBed) {
 }
 
 TEST_P(RasterParameters, AConstantRasterGivesTheBitsOfItsUniformValue) {
-  // The CPU reference holds a parameter given as one value as one row and reads it at
+  // Both backends hold a parameter given as one value as one row and read it at
   // param_index(x, y, 0) (docs/architecture.md "Uniform parameters"); a raster, even of one
   // value everywhere, is held per cell and read at pitch W. Two runs of a storm on a bumpy
   // 48 x 40 grid (5 cm of water, rain 100 mm/h on a snow pack at 2 degC, erosion, thermal

@@ -150,8 +150,8 @@ inline float erodem_bits_float(unsigned int b) {
 ERODEM_BEGIN_NAMESPACE
 /* The index of padded cell (x, y) in a cell parameter array (hardness, Manning n, the rain
  * factor) of `pitch` values per row: W when the array holds a value per cell, 0 when the
- * parameter is uniform and the array one row of W copies of it (the CPU reference then keeps
- * W values, not W H: docs/architecture.md "Uniform parameters"). The pitch is a member of
+ * parameter is uniform and the array one row of W copies of it (both backends then keep W
+ * values, not W H: docs/architecture.md "Uniform parameters"). The pitch is a member of
  * the reading process's parameter struct, set by the backend that holds the array. */
 ERODEM_INLINE int param_index(int x, int y, int pitch) {
   return x + y * pitch;

@@ -21,9 +21,7 @@ ERODEM_PARAMS_BEGIN(FlowParams)
   real pipe_length;  /* pipes: the pipe length l (m); 0 = the cell size */
   int periodic_x;    /* boundary.periodic_x: the second-order shallow water's cells two columns
                         off wrap around the seam (shallow_water_muscl_cell) */
-  int manning_pitch; /* values per row of the Manning n array (param_index, compat.h), read so
-                        by the CPU reference's flow loops; the OpenCL flow kernels read it at
-                        cell indices (OpenCL keeps a value per cell: pitch W) */
+  int manning_pitch; /* values per row of the Manning n array (param_index, compat.h) */
 ERODEM_PARAMS_END(FlowParams)
 
 ERODEM_BEGIN_NAMESPACE
@@ -269,19 +267,20 @@ ERODEM_FN real local_inertial_face(int open, int up_open, int down_open, real q,
  * pass): out_ab, out_ba are the outflow fields towards b and back (f_right, f_left or
  * f_bottom, f_top); `up` is the cell before a and `down` the cell after b in the same
  * direction (any index inside the raster where up_open / down_open is 0); width_up, width,
- * width_down the widths of the faces up-a, a-b, b-down and dist the distance a-b (m). */
+ * width_down the widths of the faces up-a, a-b, b-down and dist the distance a-b (m); n_a, n_b
+ * Manning's n of a and b (s/m^(1/3)). */
 ERODEM_FN real local_inertial_face_at(int a, int b, int up, int down, int up_open, int down_open,
                                       real width_up, real width, real width_down, real dist,
                                       GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
-                                      GLOBAL const real* depth, GLOBAL const real* manning,
+                                      GLOBAL const real* depth, real n_a, real n_b,
                                       GLOBAL const real* out_ab, GLOBAL const real* out_ba, real dt,
                                       real gravity, real theta, real dry_depth) {
   return local_inertial_face(face_open(kind[a], kind[b]), up_open, down_open,
                              face_unit_discharge(out_ab[a], out_ba[b], width),
                              face_unit_discharge(out_ab[up], out_ba[a], width_up),
                              face_unit_discharge(out_ab[b], out_ba[down], width_down), depth[a],
-                             depth[b], bed[a], bed[b], manning[a], manning[b], width, dist, dt,
-                             gravity, theta, dry_depth);
+                             depth[b], bed[a], bed[b], n_a, n_b, width, dist, dt, gravity, theta,
+                             dry_depth);
 }
 
 /* Discharge (m^3/s) across the face between padded cells (x, y) and (x + 1, y), positive
@@ -291,35 +290,39 @@ ERODEM_FN real local_inertial_face_at(int a, int b, int up, int down, int up_ope
  * edge columns by x. */
 ERODEM_FN real local_inertial_face_x_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                               GLOBAL const real* bed, GLOBAL const real* depth,
-                                              GLOBAL const real* manning, GLOBAL const real* dx,
-                                              GLOBAL const real* dy, GLOBAL const real* f_left,
-                                              GLOBAL const real* f_right, real dt, real gravity,
-                                              real theta, real dry_depth) {
+                                              GLOBAL const real* manning, int manning_pitch,
+                                              GLOBAL const real* dx, GLOBAL const real* dy,
+                                              GLOBAL const real* f_left, GLOBAL const real* f_right,
+                                              real dt, real gravity, real theta, real dry_depth) {
   const real width = dy[y];
   const int a = x + y * W; /* a - 1 >= 0 and a + 2 < W * H */
   return local_inertial_face_at(
       a, a + 1, a - 1, a + 2, (x >= 1) & (kind[a - 1] != ERODEM_CELL_WALL),
       (x + 2 <= W - 1) & (kind[a + 2] != ERODEM_CELL_WALL), width, width, width, dx[y], kind, bed,
-      depth, manning, f_right, f_left, dt, gravity, theta, dry_depth);
+      depth, manning[param_index(x, y, manning_pitch)],
+      manning[param_index(x + 1, y, manning_pitch)], f_right, f_left, dt, gravity, theta,
+      dry_depth);
 }
 
 /* The same for any row 0 <= y <= H - 1: rows 0 and H - 1 clamp their indices. */
 ERODEM_FN real local_inertial_face_x(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
                                      GLOBAL const real* bed, GLOBAL const real* depth,
-                                     GLOBAL const real* manning, GLOBAL const real* dx,
-                                     GLOBAL const real* dy, GLOBAL const real* f_left,
-                                     GLOBAL const real* f_right, real dt, real gravity, real theta,
-                                     real dry_depth) {
+                                     GLOBAL const real* manning, int manning_pitch,
+                                     GLOBAL const real* dx, GLOBAL const real* dy,
+                                     GLOBAL const real* f_left, GLOBAL const real* f_right, real dt,
+                                     real gravity, real theta, real dry_depth) {
   if (y >= 1 && y <= H - 2)
-    return local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_left,
-                                          f_right, dt, gravity, theta, dry_depth);
+    return local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, manning_pitch, dx, dy,
+                                          f_left, f_right, dt, gravity, theta, dry_depth);
   const real width = dy[y];
   const int xc = x <= W - 2 ? x : W - 2;
   const int a = xc + y * W;
   return local_inertial_face_at(a, a + 1, xc >= 1 ? a - 1 : a, xc + 2 <= W - 1 ? a + 2 : a + 1,
                                 kind_at(kind, xc - 1, y, W, H) != ERODEM_CELL_WALL,
                                 kind_at(kind, xc + 2, y, W, H) != ERODEM_CELL_WALL, width, width,
-                                width, dx[y], kind, bed, depth, manning, f_right, f_left, dt,
+                                width, dx[y], kind, bed, depth,
+                                manning[param_index(xc, y, manning_pitch)],
+                                manning[param_index(xc + 1, y, manning_pitch)], f_right, f_left, dt,
                                 gravity, theta, dry_depth);
 }
 
@@ -330,55 +333,58 @@ ERODEM_FN real local_inertial_face_x(int x, int y, int W, int H, GLOBAL const er
  * it, east of column W - 2 and east of ghost column 0. */
 ERODEM_FN real local_inertial_seam_x(int y, int W, GLOBAL const erodem_kind_t* kind,
                                      GLOBAL const real* bed, GLOBAL const real* depth,
-                                     GLOBAL const real* manning, GLOBAL const real* dx,
-                                     GLOBAL const real* dy, GLOBAL const real* f_left,
-                                     GLOBAL const real* f_right, real dt, real gravity, real theta,
-                                     real dry_depth) {
+                                     GLOBAL const real* manning, int manning_pitch,
+                                     GLOBAL const real* dx, GLOBAL const real* dy,
+                                     GLOBAL const real* f_left, GLOBAL const real* f_right, real dt,
+                                     real gravity, real theta, real dry_depth) {
   const int a = W - 2 + y * W, down = 2 + y * W;
   const real width = dy[y];
   return local_inertial_face_at(a, a + 1, a - 1, down, kind[a - 1] != ERODEM_CELL_WALL,
                                 kind[down] != ERODEM_CELL_WALL, width, width, width, dx[y], kind,
-                                bed, depth, manning, f_right, f_left, dt, gravity, theta,
-                                dry_depth);
+                                bed, depth, manning[param_index(W - 2, y, manning_pitch)],
+                                manning[param_index(W - 1, y, manning_pitch)], f_right, f_left, dt,
+                                gravity, theta, dry_depth);
 }
 
 /* Discharge (m^3/s) across the face between padded cells (x, y) and (x, y + 1), positive
  * southwards, in a row 1 <= y <= H - 3 (every index inside the raster: no clamping). */
 ERODEM_FN real local_inertial_face_y_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                               GLOBAL const real* bed, GLOBAL const real* depth,
-                                              GLOBAL const real* manning, GLOBAL const real* dx,
-                                              GLOBAL const real* dy, GLOBAL const real* f_top,
-                                              GLOBAL const real* f_bottom, real dt, real gravity,
-                                              real theta, real dry_depth) {
+                                              GLOBAL const real* manning, int manning_pitch,
+                                              GLOBAL const real* dx, GLOBAL const real* dy,
+                                              GLOBAL const real* f_top, GLOBAL const real* f_bottom,
+                                              real dt, real gravity, real theta, real dry_depth) {
   const int a = x + y * W; /* a - W >= 0 and a + 2 W < W * H */
-  return local_inertial_face_at(a, a + W, a - W, a + 2 * W, kind[a - W] != ERODEM_CELL_WALL,
-                                kind[a + 2 * W] != ERODEM_CELL_WALL, face_y_width(dx, y - 1),
-                                face_y_width(dx, y), face_y_width(dx, y + 1),
-                                centre_distance_y(dy, y), kind, bed, depth, manning, f_bottom,
-                                f_top, dt, gravity, theta, dry_depth);
+  return local_inertial_face_at(
+      a, a + W, a - W, a + 2 * W, kind[a - W] != ERODEM_CELL_WALL,
+      kind[a + 2 * W] != ERODEM_CELL_WALL, face_y_width(dx, y - 1), face_y_width(dx, y),
+      face_y_width(dx, y + 1), centre_distance_y(dy, y), kind, bed, depth,
+      manning[param_index(x, y, manning_pitch)], manning[param_index(x, y + 1, manning_pitch)],
+      f_bottom, f_top, dt, gravity, theta, dry_depth);
 }
 
 /* The same for any row 0 <= y <= H - 1 (any value for y = H - 1: no such face); rows 0,
  * H - 2 and H - 1 clamp their indices. */
 ERODEM_FN real local_inertial_face_y(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
                                      GLOBAL const real* bed, GLOBAL const real* depth,
-                                     GLOBAL const real* manning, GLOBAL const real* dx,
-                                     GLOBAL const real* dy, GLOBAL const real* f_top,
-                                     GLOBAL const real* f_bottom, real dt, real gravity, real theta,
-                                     real dry_depth) {
+                                     GLOBAL const real* manning, int manning_pitch,
+                                     GLOBAL const real* dx, GLOBAL const real* dy,
+                                     GLOBAL const real* f_top, GLOBAL const real* f_bottom, real dt,
+                                     real gravity, real theta, real dry_depth) {
   if (y >= 1 && y <= H - 3)
-    return local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_top,
-                                          f_bottom, dt, gravity, theta, dry_depth);
+    return local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, manning_pitch, dx, dy,
+                                          f_top, f_bottom, dt, gravity, theta, dry_depth);
   const int yc = y <= H - 2 ? y : H - 2;
   const int a = x + yc * W;
   const int y_up = yc >= 1 ? yc - 1 : yc;           /* clamped: unused at the edge */
   const int y_down = yc + 2 <= H - 1 ? yc + 1 : yc; /* clamped: unused at the edge */
-  return local_inertial_face_at(a, a + W, x + y_up * W, x + (y_down + 1) * W,
-                                kind_at(kind, x, yc - 1, W, H) != ERODEM_CELL_WALL,
-                                kind_at(kind, x, yc + 2, W, H) != ERODEM_CELL_WALL,
-                                face_y_width(dx, y_up), face_y_width(dx, yc),
-                                face_y_width(dx, y_down), centre_distance_y(dy, yc), kind, bed,
-                                depth, manning, f_bottom, f_top, dt, gravity, theta, dry_depth);
+  return local_inertial_face_at(
+      a, a + W, x + y_up * W, x + (y_down + 1) * W,
+      kind_at(kind, x, yc - 1, W, H) != ERODEM_CELL_WALL,
+      kind_at(kind, x, yc + 2, W, H) != ERODEM_CELL_WALL, face_y_width(dx, y_up),
+      face_y_width(dx, yc), face_y_width(dx, y_down), centre_distance_y(dy, yc), kind, bed, depth,
+      manning[param_index(x, yc, manning_pitch)], manning[param_index(x, yc + 1, manning_pitch)],
+      f_bottom, f_top, dt, gravity, theta, dry_depth);
 }
 
 /* The four face discharges around a cell of kind k (m^3/s; q_left, q_top positive into the

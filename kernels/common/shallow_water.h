@@ -314,7 +314,8 @@ ERODEM_INLINE int sw_south_face_row(int y, int H) {
  * kinds k_* and indices i_* (west, east, north, south) and the rows y_n, y_s of its north and
  * south faces (the faces between rows y_n and y_n + 1, y_s and y_s + 1), from the state at the
  * start of the step: depth, bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n
- * (s m^-1/3), the rows' dx, dy (m) and cell areas (m^2); dt (s); p.gravity (m/s^2) and
+ * (s m^-1/3; the cell's at index i_manning: param_index), the rows' dx, dy (m) and cell areas
+ * (m^2); dt (s); p.gravity (m/s^2) and
  * p.dry_depth (m: velocities are desingularised below it). Writes the cell's outflows (m^3/s)
  * and unit discharges into the second buffers. Each cell computes the four faces around it
  * (every face twice over the grid, by the same function with the same arguments, so both sides
@@ -323,7 +324,7 @@ ERODEM_INLINE int sw_south_face_row(int y, int H) {
 ERODEM_FN_INLINED void shallow_water_cell_at(
     int i, int y, int k_w, int k_e, int k_n, int k_s, int i_w, int i_e, int i_n, int i_s, int y_n,
     int y_s, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed, GLOBAL const real* depth,
-    GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* manning,
+    GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* manning, int i_manning,
     GLOBAL const real* dx, GLOBAL const real* dy, GLOBAL const real* area, real dt,
     ERODEM_P(FlowParams) p, GLOBAL real* out_left, GLOBAL real* out_right, GLOBAL real* out_top,
     GLOBAL real* out_bottom, GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
@@ -348,9 +349,9 @@ ERODEM_FN_INLINED void shallow_water_cell_at(
       sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
               sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps);
   /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
-  const ERODEM_S(SwCell) c =
-      shallow_water_cell_update(k, h, q_x[i], q_y[i], manning[i], dy[y], face_y_width(dx, y_n),
-                                face_y_width(dx, y_s), area[y], dt, p, e, w, s, nf);
+  const ERODEM_S(SwCell) c = shallow_water_cell_update(
+      k, h, q_x[i], q_y[i], manning[i_manning], dy[y], face_y_width(dx, y_n), face_y_width(dx, y_s),
+      area[y], dt, p, e, w, s, nf);
   shallow_water_stage_store(i, 0, c, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
@@ -528,9 +529,9 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell(
   const ERODEM_S(SwFace) fs = sw_face_y2(c, sy_c, s1, sw_slopes_y(c, s1, s2, eps), g, eps);
   const ERODEM_S(SwFace) fn = sw_face_y2(n1, sw_slopes_y(n2, n1, c, eps), c, sy_c, g, eps);
   const int y_n = sw_north_face_row(y), y_s = sw_south_face_row(y, H);
-  const ERODEM_S(SwCell) r =
-      shallow_water_cell_update(c.k, c.h, q_x[i], q_y[i], manning[i], dy[y], face_y_width(dx, y_n),
-                                face_y_width(dx, y_s), area[y], dt, p, fe, fw, fs, fn);
+  const ERODEM_S(SwCell) r = shallow_water_cell_update(
+      c.k, c.h, q_x[i], q_y[i], manning[param_index(x, y, p.manning_pitch)], dy[y],
+      face_y_width(dx, y_n), face_y_width(dx, y_s), area[y], dt, p, fe, fw, fs, fn);
   shallow_water_stage_store(i, combine, r, out_left, out_right, out_top, out_bottom, q_x_new,
                             q_y_new);
 }
@@ -551,8 +552,8 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
                         kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H),
                         x >= 1 ? i - 1 : i, x + 1 < W ? i + 1 : i, y >= 1 ? i - W : i,
                         y + 1 < H ? i + W : i, sw_north_face_row(y), sw_south_face_row(y, H), kind,
-                        bed, depth, q_x, q_y, manning, dx, dy, area, dt, p, out_left, out_right,
-                        out_top, out_bottom, q_x_new, q_y_new);
+                        bed, depth, q_x, q_y, manning, param_index(x, y, p.manning_pitch), dx, dy,
+                        area, dt, p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* The velocity of padded cell (x, y) from its unit discharges and its depth after the water

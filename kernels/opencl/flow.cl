@@ -1,5 +1,8 @@
 /* erodem OpenCL — flow process: kernels/common/flow.h over every padded cell (ghosts give
- * water too), as the CPU loop of kernels/cpu/flow.cpp; the host swaps the flux buffers. */
+ * water too), as the CPU loop of kernels/cpu/flow.cpp. Local inertial's cell pass writes the
+ * outflows in place (it reads only the faces); pipes and shallow water write second buffers,
+ * which the host then swaps. Manning n is read at param_index with p.manning_pitch (one row
+ * where uniform). */
 #pragma OPENCL FP_CONTRACT OFF
 #include "flow.h"
 #include "shallow_water.h"
@@ -55,10 +58,10 @@ __kernel void flow_local_inertial_faces(
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   const int i = x + y * W;
-  const real qx = local_inertial_face_x(x, y, W, H, kind, bed, depth, manning, dx, dy, f_left,
-                                        f_right, dt, p.gravity, p.theta, p.dry_depth);
-  const real qy = local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, dx, dy, f_top,
-                                        f_bottom, dt, p.gravity, p.theta, p.dry_depth);
+  const real qx = local_inertial_face_x(x, y, W, H, kind, bed, depth, manning, p.manning_pitch, dx,
+                                        dy, f_left, f_right, dt, p.gravity, p.theta, p.dry_depth);
+  const real qy = local_inertial_face_y(x, y, W, H, kind, bed, depth, manning, p.manning_pitch, dx,
+                                        dy, f_top, f_bottom, dt, p.gravity, p.theta, p.dry_depth);
   face_x[i] = x < W - 1 ? qx : (real)0;
   face_y[i] = y < H - 1 ? qy : (real)0;
 }
@@ -77,8 +80,9 @@ __kernel void flow_local_inertial_faces_x_interior(
     __global real* restrict face_x, __global real* restrict face_y, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
-  const real qx = local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_left,
-                                                 f_right, dt, p.gravity, p.theta, p.dry_depth);
+  const real qx =
+      local_inertial_face_x_interior(x, y, W, kind, bed, depth, manning, p.manning_pitch, dx, dy,
+                                     f_left, f_right, dt, p.gravity, p.theta, p.dry_depth);
   face_x[x + y * W] = x < W - 1 ? qx : (real)0;
 }
 
@@ -92,8 +96,8 @@ __kernel void flow_local_inertial_faces_y_interior(
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   face_y[x + y * W] =
-      local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, dx, dy, f_top, f_bottom,
-                                     dt, p.gravity, p.theta, p.dry_depth);
+      local_inertial_face_y_interior(x, y, W, kind, bed, depth, manning, p.manning_pitch, dx, dy,
+                                     f_top, f_bottom, dt, p.gravity, p.theta, p.dry_depth);
 }
 
 /* boundary.periodic_x: the faces across the seam after the face pass, one work-item per padded
@@ -106,8 +110,8 @@ __kernel void flow_local_inertial_seam_x(
     __global real* restrict face_x, real dt, FlowParams p) {
   const int y = (int)get_global_id(0);
   if (y >= H) return;
-  const real q = local_inertial_seam_x(y, W, kind, bed, depth, manning, dx, dy, f_left, f_right, dt,
-                                       p.gravity, p.theta, p.dry_depth);
+  const real q = local_inertial_seam_x(y, W, kind, bed, depth, manning, p.manning_pitch, dx, dy,
+                                       f_left, f_right, dt, p.gravity, p.theta, p.dry_depth);
   face_x[W - 2 + y * W] = q;
   face_x[y * W] = q;
 }

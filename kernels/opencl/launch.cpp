@@ -61,10 +61,14 @@ void OpenClBackend::run_generic(const SweepInfo& sweep, Process process, Real dt
   set_arg(k, i++, cl_int{H_});
   for (const FieldUse& u : sweep.uses) {
     const std::string name = u.field;
-    // the grid inputs outside the field table (kind, the rain factor, the per-row cell
-    // sizes), then the fields
+    // the grid inputs outside the field table (kind, the per-row cell sizes), the parameters
+    // as held (one row where uniform: their cell functions read them at param_index with the
+    // pitch of their parameter struct; the terrain classes, which write Manning n and the
+    // hardness, have them per cell from the start), then the fields
     const Buffer* b = name == "kind"          ? &kind_
                       : name == "rain_factor" ? &rain_factor_
+                      : name == "manning_n"   ? &manning_
+                      : name == "hardness"    ? &hardness_
                       : name == "dx"          ? &dx_
                       : name == "dy"          ? &dy_
                                               : field_buffer(field_info(name).id);

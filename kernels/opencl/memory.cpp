@@ -54,6 +54,61 @@ Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
   return b;
 }
 
+Buffer OpenClBackend::zero_field() {
+  Buffer b = make_buffer(n_ * sizeof(Real));
+  const Real zero = 0;
+  check(clEnqueueFillBuffer(queue_.get(), b.get(), &zero, sizeof zero, 0, n_ * sizeof(Real), 0,
+                            nullptr, nullptr),
+        "clEnqueueFillBuffer");
+  return b;
+}
+
+Buffer& OpenClBackend::made(Buffer& b, const Buffer* like) {
+  if (b) return b;
+  if (!like) {
+    b = zero_field();
+    return b;
+  }
+  b = make_buffer(n_ * sizeof(Real));
+  check(clEnqueueCopyBuffer(queue_.get(), like->get(), b.get(), 0, 0, n_ * sizeof(Real), 0, nullptr,
+                            nullptr),
+        "clEnqueueCopyBuffer");
+  return b;
+}
+
+const OpenClBackend::Real* OpenClBackend::uniform_value(const Buffer& b) const {
+  for (const auto& [buffer, value] : uniform_)
+    if (buffer == &b) return &value;
+  return nullptr;
+}
+
+void OpenClBackend::take_parameter(Buffer& dst, CellParameter& src, bool per_cell) {
+  if (!src.is_uniform()) {
+    const std::vector<Real> v(src.cells.begin(), src.cells.end());
+    std::vector<double>().swap(src.cells);
+    dst = upload(v);
+    return;
+  }
+  const Real value = static_cast<Real>(src.uniform);
+  dst = upload(std::vector<Real>(static_cast<std::size_t>(W_), value));
+  uniform_.emplace_back(&dst, value);
+  if (per_cell) make_per_cell(dst);
+}
+
+void OpenClBackend::make_per_cell(Buffer& b) {
+  const Real* value = uniform_value(b);
+  if (!value) return;
+  // the same bits as the CPU reference's copies of its row (the pattern is the float's bits)
+  Buffer all = make_buffer(n_ * sizeof(Real));
+  check(clEnqueueFillBuffer(queue_.get(), all.get(), value, sizeof(Real), 0, n_ * sizeof(Real), 0,
+                            nullptr, nullptr),
+        "clEnqueueFillBuffer");
+  b = std::move(all);
+  uniform_.erase(
+      std::find_if(uniform_.begin(), uniform_.end(), [&](const auto& u) { return u.first == &b; }));
+  update_param_pitches();
+}
+
 void OpenClBackend::read(const Buffer& b, std::size_t bytes, void* dst, bool blocking) {
   check(clEnqueueReadBuffer(queue_.get(), b.get(), blocking ? CL_TRUE : CL_FALSE, 0, bytes, dst, 0,
                             nullptr, profile_event("read")),
@@ -136,6 +191,10 @@ std::vector<double> OpenClBackend::field_rows(FieldId id, int row0, int row1) co
   std::vector<float> raw;
   raw.reserve(parts.size() * n);
   for (const Buffer* b : parts) {
+    if (const Real* value = uniform_value(*b)) {  // a parameter held as one row
+      raw.insert(raw.end(), n, *value);
+      continue;
+    }
     const auto v = read_interior(queue_.get(), b->get(), nx_, row0, row1);
     raw.insert(raw.end(), v.begin(), v.end());
   }
@@ -149,6 +208,10 @@ void OpenClBackend::enqueue_gather(const Buffer& cells, std::size_t n,
   std::vector<const Buffer*> parts;
   for (const FieldId id : fields)
     for (const Buffer* b : field_parts(id)) parts.push_back(b);
+  // gather_cells reads at cell indices: a parameter held as one row is read from a stand-in
+  // (the depth) and its value put in by compose_gathered
+  for (const Buffer*& b : parts)
+    if (uniform(*b)) b = &depth_;
   // gather_cells takes up to kGatherParts parts a launch
   cl_kernel k = kernel("gather_cells");
   for (std::size_t first = 0; first < parts.size(); first += kGatherParts) {
@@ -167,11 +230,25 @@ void OpenClBackend::enqueue_gather(const Buffer& cells, std::size_t n,
 std::vector<double> OpenClBackend::compose_gathered(const std::vector<FieldId>& fields,
                                                     const std::vector<float>& raw,
                                                     std::size_t n) const {
+  // the parameters held as one row: their value where gather_cells read a stand-in
+  auto* self = const_cast<OpenClBackend*>(this);
+  std::vector<float> filled;
+  const float* values = raw.data();
+  std::size_t part = 0;
+  for (const FieldId id : fields)
+    for (const Buffer* b : self->field_parts(id)) {
+      if (const Real* value = uniform_value(*b)) {
+        if (filled.empty()) filled = raw;
+        std::fill_n(filled.begin() + static_cast<std::ptrdiff_t>(part * n), n, *value);
+        values = filled.data();
+      }
+      ++part;
+    }
   std::vector<double> out;
   out.reserve(fields.size() * n);
-  std::size_t part = 0;
+  part = 0;
   for (const FieldId id : fields) {
-    for (std::size_t j = 0; j < n; ++j) out.push_back(compose(id, raw.data() + part * n + j, n));
+    for (std::size_t j = 0; j < n; ++j) out.push_back(compose(id, values + part * n + j, n));
     part += part_count({id});
   }
   return out;
@@ -228,8 +305,10 @@ void OpenClBackend::set_field_rows(FieldId id, int row0, int row1,
   if (!dst)
     throw Error(ExitCode::usage,
                 fmt::format("field '{}' is derived and cannot be set", field_info(id).name));
-  // Fields kept in two buffers get both, so the next step starts from the new values.
+  // Fields kept in two buffers get both, so the next step starts from the new values (a
+  // second buffer not made yet is made later as a copy: made()).
   Buffer* twin = fields_.twin(id);
+  if (twin && !*twin) twin = nullptr;
   const std::vector<float> v(values.begin(), values.end());
   write_interior(queue_.get(), dst->get(), nx_, row0, row1, v);
   if (twin) write_interior(queue_.get(), twin->get(), nx_, row0, row1, v);

@@ -66,7 +66,6 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   periodic_ = state.periodic_x;
   tails_ = sweeps_tails(params, periodic_);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
-  set_param_pitches(cell_, W_, W_, W_);  // a value per cell of every parameter
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
   cl_int err = CL_SUCCESS;
@@ -79,64 +78,53 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 
   // ---- the host state: the same padded state the CPU reference starts from ----
   // Each float64 array rounded to Real and freed at once, and each Real copy freed after its
-  // last upload (in the order the buffers are made: their offsets, stagger.hpp): the setup
-  // holds about half the padded state beside the device buffers instead of all of it.
+  // last upload: the setup holds one array of Reals beside the device buffers.
   auto to_real = [](std::vector<double>& v) {
     std::vector<Real> r(v.begin(), v.end());
     std::vector<double>().swap(v);
     return r;
   };
-  // a parameter per cell (OpenCL keeps every one so: set_param_pitches above)
-  auto per_cell = [this, &to_real](CellParameter& v) {
-    if (!v.is_uniform()) return to_real(v.cells);
-    return std::vector<Real>(n_, static_cast<Real>(v.uniform));
-  };
-  auto release = [](std::vector<Real>& v) { std::vector<Real>().swap(v); };
   const std::vector<Real> dx = to_real(state.dx), dy = to_real(state.dy),
                           area = to_real(state.area);
   area_host_.assign(area.begin(), area.end());
   const std::vector<cl_uchar> kind(state.kind.begin(), state.kind.end());
   std::vector<std::uint8_t>().swap(state.kind);
-  std::vector<Real> bed_r = to_real(state.bed), depth_r = to_real(state.depth),
-                    sediment_r = to_real(state.sediment), manning_r = per_cell(state.manning),
-                    hardness_r = per_cell(state.hardness), rain_r = per_cell(state.rain_factor);
-  const std::vector<Real> zeros(n_, Real(0));
 
   // ---- the device state ----
+  // Only what every run reads is made here; the second buffers a run may not need are made on
+  // first use (made()), the fields of zeros by clEnqueueFillBuffer (zero_field()).
   kind_ = upload(kind);
   dx_ = upload(dx);
   dy_ = upload(dy);
   area_ = upload(area);
-  bed_ = upload(bed_r);
-  bed_next_ = upload(bed_r);
-  bed0_ = upload(bed_r);
-  release(bed_r);
-  bed_residual_ = upload(zeros);
-  depth_ = upload(depth_r);
-  depth_next_ = upload(depth_r);
-  sediment_ = upload(sediment_r);
-  sediment_next_ = upload(sediment_r);
-  release(sediment_r);
-  for (int k = 0; k < 4; ++k) {
-    flux_[k] = upload(zeros);
-    flux_next_[k] = upload(zeros);
+  {
+    std::vector<Real> bed_r = to_real(state.bed);
+    bed_ = upload(bed_r);
+    bed0_ = upload(bed_r);
   }
-  face_x_ = upload(zeros);
-  face_y_ = upload(zeros);
-  velocity_x_ = upload(zeros);
-  velocity_y_ = upload(zeros);
-  thermal_share_ = upload(zeros);
+  bed_residual_ = zero_field();
+  {
+    std::vector<Real> depth_r = to_real(state.depth);
+    depth_ = upload(depth_r);
+    depth_next_ = upload(depth_r);
+    wetness_ = upload(depth_r);
+  }
+  {
+    std::vector<Real> sediment_r = to_real(state.sediment);
+    sediment_ = upload(sediment_r);
+  }
+  for (int k = 0; k < 4; ++k) flux_[k] = zero_field();
+  velocity_x_ = zero_field();
+  velocity_y_ = zero_field();
+  thermal_share_ = zero_field();
   if (params_.flow.scheme == FlowScheme::shallow_water && params_.flow.order == 2)
-    stage_depth_ = upload(zeros);
-  wetness_ = upload(depth_r);
-  release(depth_r);
-  manning_ = upload(manning_r);
-  release(manning_r);
-  hardness_ = upload(hardness_r);
-  release(hardness_r);
-  rain_factor_ = upload(rain_r);
-  release(rain_r);
-  fields_.bind(*this, [this] { return upload(std::vector<Real>(n_, Real(0))); });
+    stage_depth_ = zero_field();
+  // the parameters the terrain classes write are held per cell from the start
+  take_parameter(manning_, state.manning, cell_.terrain_class.set_manning != 0);
+  take_parameter(hardness_, state.hardness, cell_.terrain_class.set_hardness != 0);
+  take_parameter(rain_factor_, state.rain_factor, false);
+  update_param_pitches();
+  fields_.bind(*this, [this] { return zero_field(); });
 
   // Reductions: a power of two of at most 256 work-items per group, fitting every reduction
   // kernel; a fixed number of groups for this grid, so the sums do not depend on timing.
@@ -282,6 +270,8 @@ void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
     const Buffer* b = name == "depth_flow"      ? &depth_next_
                       : name == "thermal_share" ? &thermal_share_
                       : name == "rain_factor"   ? &rain_factor_
+                      : name == "manning_n"     ? &manning_
+                      : name == "hardness"      ? &hardness_
                                                 : field_buffer(field_info(name).id);
     if (!b)
       throw Error(ExitCode::internal, fmt::format("halo exchange: field '{}' has no buffer", name));
@@ -290,7 +280,7 @@ void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
 }
 
 void OpenClBackend::exchange_halo(const Buffer& b) {
-  if (!periodic_) return;
+  if (!periodic_ || uniform(b)) return;  // one row: the same value on both sides of the seam
   cl_kernel k = kernel("halo_periodic_x");
   set_args(k, cl_int{W_}, cl_int{H_}, b);
   const std::size_t global = static_cast<std::size_t>(H_);
@@ -352,7 +342,8 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   const Real rate = static_cast<Real>(in.rain_rate);
   if (rate != Real(0)) {
     cl_kernel k = kernel("sources_rain");
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, rain_factor_, dt, rate);
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, depth_, rain_factor_, cl_int{pitch(rain_factor_)},
+             dt, rate);
     launch_interior(k);
   }
   if (in.points.empty()) return;
@@ -403,6 +394,8 @@ void OpenClBackend::run_sources(const StepInputs& in) {
 }
 
 void OpenClBackend::run_flow(Real dt) {
+  if (params_.flow.scheme != FlowScheme::local_inertial)
+    for (Buffer& b : flux_next_) made(b);  // the outflows' second buffers (pipes, shallow water)
   if (params_.flow.scheme == FlowScheme::shallow_water) {
     Buffer &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Buffer &qx_next = *fields_.twin(FieldId::momentum_x),
@@ -454,7 +447,10 @@ void OpenClBackend::run_flow(Real dt) {
   } else {
     // Each face once (face pass), then split into the cells' outflows (cell pass); the
     // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
-    // edge rows by the general ones. H >= 3.
+    // edge rows by the general ones. H >= 3. The cell pass reads only the faces and its own
+    // cell, so it writes the outflows in place: no second buffers (16 B per cell).
+    made(face_x_);
+    made(face_y_);
     for (const char* name : {"flow_local_inertial_faces_x_interior",
                              "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
@@ -474,10 +470,11 @@ void OpenClBackend::run_flow(Real dt) {
     }
     for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_,
-               flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], dt);
+               flux_[0], flux_[1], flux_[2], flux_[3], dt);
     launch_rows(kernel("flow_local_inertial_split_interior"), 1, H_ - 1);
     launch_rows(kernel("flow_local_inertial_split"), 0, 1);
     launch_rows(kernel("flow_local_inertial_split"), H_ - 1, H_);
+    return;
   }
   std::swap(flux_, flux_next_);
 }
@@ -498,6 +495,7 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
+  made(bed_next_, &bed_);  // rows 0 and H - 1, which the kernels do not write, hold the bed
   if (params_.erosion.law == ErosionLaw::physical) {
     cl_kernel k = kernel("erosion_physical");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_,
@@ -520,6 +518,7 @@ void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_transport(Real dt, StepTally& tally) {
+  made(sediment_next_, &sediment_);  // as the bed's (run_erosion)
   if (params_.transport.scheme == TransportScheme::conservative) {
     cl_kernel k = kernel("transport_conservative");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
@@ -543,6 +542,7 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
+  made(bed_next_, &bed_);  // as in run_erosion
   cl_kernel share = kernel("thermal_share");
   // The talus slopes are read only where the classes set them (by_class); otherwise any
   // buffer of the grid's size stands in, so that no field of zeros is made for them (4 B/cell).

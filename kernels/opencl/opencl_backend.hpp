@@ -23,6 +23,7 @@
 #include "erodem/backend.hpp"
 #include "erodem/backends.hpp"
 #include "erodem/grid.hpp"
+#include "erodem/initial_state.hpp"
 #include "erodem/params.hpp"
 #include "erodem/process.hpp"
 #include "field_registry.hpp"
@@ -229,7 +230,42 @@ class OpenClBackend final : public Backend {
   void deliver_tallies();
   /// Reads and delivers the pending tallies now (blocking).
   void flush_tallies();
-  Buffer* field_buffer(FieldId id) { return fields_.get(id); }
+  /// A buffer of `n_` Reals of zeros (clEnqueueFillBuffer: no array of zeros on the host).
+  Buffer zero_field();
+  /// `b` made on first use, for the second buffers a run may never need (the outflows' with
+  /// local inertial, the bed's without erosion and thermal collapse, ...): a buffer of n_
+  /// Reals, a copy of `like` where given (what the cells a kernel leaves untouched must hold),
+  /// else zeros. Returns `b`.
+  Buffer& made(Buffer& b, const Buffer* like = nullptr);
+
+  // Uniform parameters (docs/architecture.md), held as on the CPU reference: Manning n, the
+  // hardness and the rain factor are each one row of W values where the run gives one value
+  // for every cell (no raster, noise or terrain class sets it), else a buffer of every cell.
+  // The kernels read them at param_index (common/compat.h) with the pitches of their parameter
+  // structs (set_param_pitches), W or 0.
+  /// The value of the parameter in `b` where it is held as one row; nullptr otherwise (every
+  /// other buffer).
+  const Real* uniform_value(const Buffer& b) const;
+  bool uniform(const Buffer& b) const { return uniform_value(b) != nullptr; }
+  /// The values per row of parameter `b`: 0 for one row, W otherwise.
+  int pitch(const Buffer& b) const { return uniform(b) ? 0 : W_; }
+  /// Parameter `dst` from the padded state: one row where uniform (unless `per_cell`: the
+  /// terrain classes write it), else every cell's value; its array freed.
+  void take_parameter(Buffer& dst, CellParameter& src, bool per_cell);
+  /// Parameter `b` (one row) as a buffer of every cell, before anything writes it, and the
+  /// pitches updated; nothing for any other buffer.
+  void make_per_cell(Buffer& b);
+  /// The parameter structs' pitches from how the three parameters are held now.
+  void update_param_pitches() {
+    set_param_pitches(cell_, pitch(manning_), pitch(hardness_), pitch(rain_factor_));
+  }
+  /// The buffer of field `id` to write or bind: a uniform parameter is first made a buffer of
+  /// every cell (make_per_cell).
+  Buffer* field_buffer(FieldId id) {
+    Buffer* b = fields_.get(id);
+    if (b && uniform(*b)) make_per_cell(*b);
+    return b;
+  }
   friend class FieldRegistry<Buffer>;
   /// The buffers field `id` is composed from, as field() composes them (compose): the bed
   /// and its residual; the initial bed, the bed and its residual for the erosion; depth,
@@ -292,6 +328,8 @@ class OpenClBackend final : public Backend {
   Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   Buffer stage_depth_;  // shallow water, second order: the depth after Heun's first stage
+  // The parameters held as one row (uniform_value): their buffers (members above) and values.
+  std::vector<std::pair<const Buffer*, Real>> uniform_;
   // Every field's buffer by FieldId: the members above, and a buffer (zeros) for any other
   // field of ERODEM_FIELDS (field_registry.hpp).
   FieldRegistry<Buffer> fields_;

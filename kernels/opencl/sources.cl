@@ -4,13 +4,13 @@
 #include "sources.h"
 
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch); ghosts keep their
- * depth. */
+ * depth. factor_pitch: values per row of rain_factor (W, or 0 for one row: param_index). */
 __kernel void sources_rain(int W, int H, __global const uchar* restrict kind,
                            __global real* restrict depth, __global const real* restrict rain_factor,
-                           real dt, real rate) {
+                           int factor_pitch, real dt, real rate) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
-  rain_sweep_cell(x, y, W, kind, depth, rain_factor, W, dt, rate); /* a value per cell */
+  rain_sweep_cell(x, y, W, kind, depth, rain_factor, factor_pitch, dt, rate);
 }
 
 /* Point and line inflows, one work-item adding them in order (a cell may appear twice):
