@@ -435,17 +435,29 @@ TEST_P(BackendContract, RunOutsideAStepIsAnError) {
 // thermal share and the soil: 77 B. Until 2026-11-28 it also held the outflows' second
 // buffers (16 B) and the three parameters per cell (12 B): 105 B. Water only (no erosion, no
 // thermal collapse) it needs neither second buffer of the bed and the sediment nor the soil:
-// 16 fields, 65 B. Measured on PoCL 80.8 and 68.4: about 3.5 B per cell at this size do not
-// grow with the cells (each field buffer is 4 KiB longer for its offset, stagger.hpp; the
-// reductions' partials; the kinds' list of edge cells). The bounds, 84 and 70 B per cell,
+// 16 fields, 65 B; the pipes, which write their outflows in place too and need no face fields,
+// 14 fields, 57 B. Measured on PoCL 80.8, 68.4 and 60.1: about 3.5 B per cell at this size do
+// not grow with the cells (each field buffer is 4 KiB longer for its offset, stagger.hpp; the
+// reductions' partials; the kinds' list of edge cells). The bounds, 84, 70 and 62 B per cell,
 // fail with any one field more (+4 B), with the parameters per cell (+12) or with the
 // outflows' second buffers (+16). A parameter set through set_field (Manning n here) is then
 // held per cell: +4 B, and the fields read back the same bits as before.
 class OpenClMemory : public TargetTest {};
 
 TEST_P(OpenClMemory, TheStateOnceAndUniformParametersAsOneRow) {
-  for (const bool erosion : {true, false}) {
+  struct Case {
+    FlowScheme flow;
+    bool erosion;
+    double bound;  // B per cell
+    const char* label;
+  };
+  for (const Case& c : {Case{FlowScheme::local_inertial, true, 84.0,
+                             "local inertial + erosion + transport + thermal"},
+                        Case{FlowScheme::local_inertial, false, 70.0, "local inertial, water only"},
+                        Case{FlowScheme::pipes, false, 62.0, "pipes, water only"}}) {
+    const bool erosion = c.erosion;
     Params p;
+    p.flow.scheme = c.flow;
     p.dem.synthetic = "fbm";
     p.dem.size = 256;
     p.dem.seed = 1;
@@ -463,7 +475,7 @@ TEST_P(OpenClMemory, TheStateOnceAndUniformParametersAsOneRow) {
     sim.step(3);
     const double cells = static_cast<double>(sim.grid().cells());
     const double per_cell = static_cast<double>(sim.backend().device_bytes()) / cells;
-    const double bound = erosion ? 84.0 : 70.0;
+    const double bound = c.bound;
     const auto depth = sim.field(FieldId::water_depth);
     const auto manning = sim.field(FieldId::manning_n);
     sim.backend().set_field(FieldId::manning_n, manning);
@@ -477,8 +489,7 @@ TEST_P(OpenClMemory, TheStateOnceAndUniformParametersAsOneRow) {
         "[opencl memory] %s, 256^2, 3 steps: device buffers %.1f B per cell (bound %.0f); after "
         "set_field(manning_n) %.1f (+%.2f, bounds 4.06 and 4.13: now per cell); values read back "
         "that differ %zu (bound 0)\n",
-        erosion ? "local inertial + erosion + transport + thermal" : "local inertial, water only",
-        per_cell, bound, after_set, after_set - per_cell, differ);
+        c.label, per_cell, bound, after_set, after_set - per_cell, differ);
     EXPECT_LE(per_cell, bound);
     // one buffer of the padded grid (258^2 x 4 B: 4.06 B per DEM cell) and, where the device
     // takes the staggered offsets, 4 KiB more (4.13)

@@ -1,23 +1,25 @@
 /* erodem OpenCL — flow process: kernels/common/flow.h over every padded cell (ghosts give
  * water too), as the CPU loop of kernels/cpu/flow.cpp. Local inertial's cell pass writes the
- * outflows in place (it reads only the faces); pipes and shallow water write second buffers,
- * which the host then swaps. Manning n is read at param_index with p.manning_pitch (one row
- * where uniform). */
+ * outflows in place (it reads only the faces), as do the pipes (each cell reads only its own);
+ * shallow water writes second buffers, which the host then swaps. Manning n is read at param_index
+ * with p.manning_pitch (one row where uniform). */
 #pragma OPENCL FP_CONTRACT OFF
 #include "flow.h"
 #include "shallow_water.h"
 
 /* One work-item per padded cell (where the global size is rounded up, the work-items past
  * the raster stop); the host runs flow_pipes_interior on rows 1 .. H - 2 and this one on rows
- * 0 and H - 1. */
+ * 0 and H - 1. A cell reads only its own previous outflows f_* and writes its new ones out_*:
+ * the host binds the same buffers to both (the outflows in place, as on the CPU), so neither
+ * is restrict. */
 __kernel void flow_pipes(int W, int H, __global const uchar* restrict kind,
                          __global const real* restrict bed, __global const real* restrict depth,
                          __global const real* restrict dx, __global const real* restrict dy,
-                         __global const real* restrict area, __global const real* restrict f_left,
-                         __global const real* restrict f_right, __global const real* restrict f_top,
-                         __global const real* restrict f_bottom, __global real* restrict out_left,
-                         __global real* restrict out_right, __global real* restrict out_top,
-                         __global real* restrict out_bottom, real dt, FlowParams p) {
+                         __global const real* restrict area, __global const real* f_left,
+                         __global const real* f_right, __global const real* f_top,
+                         __global const real* f_bottom, __global real* out_left,
+                         __global real* out_right, __global real* out_top,
+                         __global real* out_bottom, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   flow_pipes_cell(x, y, W, H, kind, bed, depth, dx, dy, area, f_left, f_right, f_top, f_bottom,
@@ -30,10 +32,9 @@ __kernel void flow_pipes_interior(
     int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
     __global const real* restrict depth, __global const real* restrict dx,
     __global const real* restrict dy, __global const real* restrict area,
-    __global const real* restrict f_left, __global const real* restrict f_right,
-    __global const real* restrict f_top, __global const real* restrict f_bottom,
-    __global real* restrict out_left, __global real* restrict out_right,
-    __global real* restrict out_top, __global real* restrict out_bottom, real dt, FlowParams p) {
+    __global const real* f_left, __global const real* f_right, __global const real* f_top,
+    __global const real* f_bottom, __global real* out_left, __global real* out_right,
+    __global real* out_top, __global real* out_bottom, real dt, FlowParams p) {
   const int x = (int)get_global_id(0), y = (int)get_global_id(1);
   if (ERODEM_PAST_ROW(x, W)) return;
   real lx, lt, lb;

@@ -394,9 +394,8 @@ void OpenClBackend::run_sources(const StepInputs& in) {
 }
 
 void OpenClBackend::run_flow(Real dt) {
-  if (params_.flow.scheme != FlowScheme::local_inertial)
-    for (Buffer& b : flux_next_) made(b);  // the outflows' second buffers (pipes, shallow water)
   if (params_.flow.scheme == FlowScheme::shallow_water) {
+    for (Buffer& b : flux_next_) made(b);  // the outflows' second buffers
     Buffer &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Buffer &qx_next = *fields_.twin(FieldId::momentum_x),
            &qy_next = *fields_.twin(FieldId::momentum_y);
@@ -437,46 +436,45 @@ void OpenClBackend::run_flow(Real dt) {
   }
   if (params_.flow.scheme == FlowScheme::pipes) {
     // The interior rows by a kernel without clamping, the first and last row by the general one.
+    // A cell reads only its own previous outflows: they are written in place (flow_pipes).
     for (const char* name : {"flow_pipes_interior", "flow_pipes"})
       set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, dx_, dy_, area_, flux_[0],
-               flux_[1], flux_[2], flux_[3], flux_next_[0], flux_next_[1], flux_next_[2],
-               flux_next_[3], dt, cell_.flow);
+               flux_[1], flux_[2], flux_[3], flux_[0], flux_[1], flux_[2], flux_[3], dt,
+               cell_.flow);
     launch_interior(kernel("flow_pipes_interior"));
     launch_rows(kernel("flow_pipes"), 0, 1);
     launch_rows(kernel("flow_pipes"), H_ - 1, H_);
-  } else {
-    // Each face once (face pass), then split into the cells' outflows (cell pass); the
-    // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
-    // edge rows by the general ones. H >= 3. The cell pass reads only the faces and its own
-    // cell, so it writes the outflows in place: no second buffers (16 B per cell).
-    made(face_x_);
-    made(face_y_);
-    for (const char* name : {"flow_local_inertial_faces_x_interior",
-                             "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
-      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
-               flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, cell_.flow);
-    launch_rows(kernel("flow_local_inertial_faces_x_interior"), 1, H_ - 2);
-    launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
-    launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
-    launch_rows(kernel("flow_local_inertial_faces"), H_ - 2, H_);
-    if (periodic_) {
-      cl_kernel seam = kernel("flow_local_inertial_seam_x");
-      set_args(seam, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_, flux_[0],
-               flux_[1], face_x_, dt, cell_.flow);
-      const std::size_t rows = static_cast<std::size_t>(H_);
-      check(clEnqueueNDRangeKernel(queue_.get(), seam, 1, nullptr, &rows, nullptr, 0, nullptr,
-                                   profile_event(seam)),
-            "clEnqueueNDRangeKernel(flow_local_inertial_seam_x)");
-    }
-    for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
-      set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_,
-               flux_[0], flux_[1], flux_[2], flux_[3], dt);
-    launch_rows(kernel("flow_local_inertial_split_interior"), 1, H_ - 1);
-    launch_rows(kernel("flow_local_inertial_split"), 0, 1);
-    launch_rows(kernel("flow_local_inertial_split"), H_ - 1, H_);
     return;
   }
-  std::swap(flux_, flux_next_);
+  // Each face once (face pass), then split into the cells' outflows (cell pass); the
+  // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
+  // edge rows by the general ones. H >= 3. The cell pass reads only the faces and its own
+  // cell, so it writes the outflows in place: no second buffers (16 B per cell).
+  made(face_x_);
+  made(face_y_);
+  for (const char* name : {"flow_local_inertial_faces_x_interior",
+                           "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
+    set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
+             flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, cell_.flow);
+  launch_rows(kernel("flow_local_inertial_faces_x_interior"), 1, H_ - 2);
+  launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
+  launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
+  launch_rows(kernel("flow_local_inertial_faces"), H_ - 2, H_);
+  if (periodic_) {
+    cl_kernel seam = kernel("flow_local_inertial_seam_x");
+    set_args(seam, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_, flux_[0],
+             flux_[1], face_x_, dt, cell_.flow);
+    const std::size_t rows = static_cast<std::size_t>(H_);
+    check(clEnqueueNDRangeKernel(queue_.get(), seam, 1, nullptr, &rows, nullptr, 0, nullptr,
+                                 profile_event(seam)),
+          "clEnqueueNDRangeKernel(flow_local_inertial_seam_x)");
+  }
+  for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
+    set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_, flux_[0],
+             flux_[1], flux_[2], flux_[3], dt);
+  launch_rows(kernel("flow_local_inertial_split_interior"), 1, H_ - 1);
+  launch_rows(kernel("flow_local_inertial_split"), 0, 1);
+  launch_rows(kernel("flow_local_inertial_split"), H_ - 1, H_);
 }
 
 void OpenClBackend::run_water(Real dt, StepTally& tally) {

@@ -10,10 +10,11 @@
  * depends on timing.
  *
  * The kernels' pointer parameters are `restrict`: the host never binds one buffer to two
- * parameters of a kernel (a field a kernel writes while it reads the neighbours is double
- * buffered; the in-place updates touch only their own cell). Without it LLVM reloads the
- * per-row values in every iteration of PoCL's work-item loop, since a store might have changed
- * them (local-inertial face pass at 4096^2: 61 -> 53 ms). Evaporation alone keeps plain
+ * restrict parameters of a kernel (a field a kernel writes while it reads the neighbours is
+ * double buffered; the in-place updates touch only their own cell; the pipes, which read their
+ * old outflows and write the new ones in place, take both as plain pointers). Without it LLVM
+ * reloads the per-row values in every iteration of PoCL's work-item loop, since a store might have
+ * changed them (local-inertial face pass at 4096^2: 61 -> 53 ms). Evaporation keeps plain
  * pointers: there `restrict` made PoCL's code slower (6.3 -> 8.4 ms). */
 #pragma OPENCL FP_CONTRACT OFF
 #ifdef ERODEM_HAVE_FP64
