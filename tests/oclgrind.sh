@@ -26,10 +26,14 @@
 # exit 0, every field of every snapshot bit-identical to the CPU reference; see
 # docs/testing.md for the time.
 # Exit 77 (skipped) without oclgrind or without the OpenCL backend.
+# Since 2026-11-28 it runs the scenario three times: as above, and without the terrain classes
+# (Manning n and the hardness uniform: one row on both backends) with local inertial and with
+# the pipes. With a one-row Manning n of W values (not W + 1) the second run reports 2,240
+# invalid reads (the face pass reads column x + 1 of the last column too).
 # Usage: oclgrind.sh path/to/erodem [STEPS [SIZE]]: the scenario above by default (200 steps of
-# 48 x 48, about 5 minutes of CPU time); ctest runs its fast version, 40 steps of 32 x 32 with
-# the same processes and the cooling at the same fraction of the run (under a minute), so the
-# suite stays within its 30 minutes.
+# 48 x 48, about 5 minutes of CPU time per run); ctest runs its fast version, 40 steps of
+# 32 x 32 with the same processes and the cooling at the same fraction of the run (about a
+# minute per run), so the suite stays within its 30 minutes.
 set -euo pipefail
 erodem=$1
 steps=${2:-200}
@@ -47,6 +51,25 @@ if ! "$erodem" devices --json 2>/dev/null | grep -q '"opencl_built": *true'; the
 fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+status=0
+# One run of the scenario under Oclgrind and the CPU reference: run_case NAME SCHEME CLASSES
+# (flow.scheme; terrain_classes.enabled). With the classes on, Manning n and the hardness are
+# held per cell; with them off they are uniform, one row on both backends (architecture.md
+# "Uniform parameters"), which the kernels read at param_index with pitch 0.
+run_case() {
+local name=$1 scheme=$2 classes=$3 classes_toml=""
+if [[ $classes == true ]]; then
+  classes_toml='[terrain_classes]
+enabled = true
+interval = 5
+water_wetness = "5 cm"
+mud_wetness = "5 mm"
+rock_slope = 0.4
+grass.manning_n = 0.04
+rock.talus_angle = 32.0
+mud.erodibility = 0.8'
+fi
+echo "== $name: flow.scheme = $scheme, terrain_classes.enabled = $classes"
 cat >"$work/scenario.toml" <<EOF
 [dem]
 synthetic = "valley"
@@ -65,7 +88,7 @@ cfl = 0.7
 dt_max = "1 s"
 
 [flow]
-scheme = "local_inertial"
+scheme = "$scheme"
 
 [rain]
 rate = "100 mm/h"
@@ -96,15 +119,7 @@ slide_angle = 20.0
 [infiltration]
 enabled = true
 
-[terrain_classes]
-enabled = true
-interval = 5
-water_wetness = "5 cm"
-mud_wetness = "5 mm"
-rock_slope = 0.4
-grass.manning_n = 0.04
-rock.talus_angle = 32.0
-mud.erodibility = 0.8
+$classes_toml
 
 [numerics]
 wetness_time = "60 s"
@@ -126,7 +141,7 @@ EOF
 # choice or work-group size of the caller's would change what is checked.
 export ERODEM_OPENCL_DEVICE="Oclgrind:"
 unset ERODEM_OPENCL_WG
-status=0
+rm -f "$work/oclgrind.log" "$work/opencl.h5" "$work/cpu.h5"
 start=$(date +%s%N)
 set +e
 oclgrind --data-races --log "$work/oclgrind.log" \
@@ -158,7 +173,8 @@ if ((rc == 0)); then
     {
       echo "FAILED: the CPU reference run failed:"
       tail -20 "$work/cpu.out"
-      exit 1
+      status=1
+      return
     }
   echo "OpenCL on Oclgrind against the CPU reference (float32), every snapshot, bound: bit-identical"
   if ! "$erodem" compare "$work/opencl.h5" "$work/cpu.h5" --tol 0; then
@@ -166,4 +182,11 @@ if ((rc == 0)); then
     status=1
   fi
 fi
+}
+run_case "every process, terrain classes" local_inertial true
+# The parameters uniform (one row, pitch 0): the local-inertial face pass reads Manning n at
+# column x + 1 for every x (the padded row's last column too), and the pipes write their
+# outflows in place (a data race between work-items would show here).
+run_case "uniform parameters" local_inertial false
+run_case "uniform parameters, pipes" pipes false
 exit $status

@@ -287,7 +287,9 @@ ERODEM_FN real local_inertial_face_at(int a, int b, int up, int down, int up_ope
  * eastwards, in a row 1 <= y <= H - 2, for 0 <= x <= W - 2 (any value for x = W - 1: no such
  * face). Every index it reads lies inside the raster in these rows, so it reads without
  * clamping (consecutive loads across x, which OpenCL CPU compilers vectorise), masking the
- * edge columns by x. */
+ * edge columns by x. Manning n at param_index(x + 1, y, manning_pitch): for x = W - 1 and a
+ * uniform Manning n (pitch 0) that is index W, so a one-row array holds W + 1 values
+ * (OpenClBackend::take_parameter). */
 ERODEM_FN real local_inertial_face_x_interior(int x, int y, int W, GLOBAL const erodem_kind_t* kind,
                                               GLOBAL const real* bed, GLOBAL const real* depth,
                                               GLOBAL const real* manning, int manning_pitch,

@@ -90,7 +90,9 @@ void OpenClBackend::take_parameter(Buffer& dst, CellParameter& src, bool per_cel
     return;
   }
   const Real value = static_cast<Real>(src.uniform);
-  dst = upload(std::vector<Real>(static_cast<std::size_t>(W_), value));
+  // W + 1 values: the local-inertial face pass reads the Manning n of column x + 1 for every x,
+  // the last column's (x = W - 1, whose face it discards) included (flow.h)
+  dst = upload(std::vector<Real>(static_cast<std::size_t>(W_) + 1, value));
   uniform_.emplace_back(&dst, value);
   if (per_cell) make_per_cell(dst);
 }
