@@ -102,11 +102,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   // The fields that start at zero: value-initialised, so their pages are taken when a step
   // first writes them, after the terrain's own arrays are freed (stagger.hpp).
   bed_residual_ = Field(n);
-  const bool flux_twins = params.flow.scheme == FlowScheme::shallow_water;
-  for (int k = 0; k < 4; ++k) {
-    flux_[k] = Field(n);
-    if (flux_twins) flux_next_[k] = Field(n);
-  }
+  for (int k = 0; k < 4; ++k) flux_[k] = Field(n);  // every scheme writes them in place
   velocity_x_ = Field(n);
   velocity_y_ = Field(n);
   thermal_share_ = Field(n);

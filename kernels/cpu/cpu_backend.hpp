@@ -128,7 +128,7 @@ class CpuBackend final : public Backend {
     return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1 - row0_);
   }
   /// Local inertial or pipes: the new outflows of every padded row over the old ones in
-  /// flux_ (in place: flux_next_ is the shallow-water scheme's only), each thread walking its
+  /// flux_ (in place, as the shallow-water scheme's too), each thread walking its
   /// block [y0, y1) of for_row_blocks top to bottom and calling after_row(y, y0, y1) once row
   /// y's outflows are stored (kernels/cpu/flow.cpp).
   template <class AfterRow>
@@ -330,9 +330,9 @@ class CpuBackend final : public Backend {
   Field depth_, depth_next_;  // after `water`, depth_next_ holds the depth the water update
                               // started from (used by conservative transport)
   Field sediment_, sediment_next_;
-  // left, right, top, bottom (m^3/s); flux_next_ (the second buffers) only with the
-  // shallow-water scheme: local inertial and pipes update flux_ in place (flow_blocks)
-  std::array<Field, 4> flux_, flux_next_;
+  // left, right, top, bottom (m^3/s), updated in place by every scheme (local inertial and
+  // pipes: flow_blocks; shallow water reads none of the previous step's)
+  std::array<Field, 4> flux_;
   Field velocity_x_, velocity_y_;
   Field hardness_, manning_, wetness_, rain_factor_, thermal_share_;  // parameters: uniform()
   Field stage_depth_;  // shallow water, second order: the depth after Heun's first stage

@@ -474,16 +474,20 @@ void CpuBackend<Real>::run_flow(Real dt) {
   const cell_params::FlowParams<Real> f = cell_.flow;
   const Kind* kind = kind_.data();
   const Real *b = bed_.data(), *d = depth_.data();
-  Real *ol = flux_next_[0].data(), *orr = flux_next_[1].data(), *ot = flux_next_[2].data(),
-       *ob = flux_next_[3].data();
+  // The outflows in place for every scheme: no scheme reads the previous step's outflows of a
+  // cell other than its own (local inertial, pipes: flow_blocks), and the shallow-water scheme
+  // reads none of them (the second order's second stage reads its own cell's first-stage
+  // outflows and averages into them).
+  Real *ol = flux_[0].data(), *orr = flux_[1].data(), *ot = flux_[2].data(), *ob = flux_[3].data();
   const Real *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const int W = W_, H = H_;
   if (params_.flow.scheme == FlowScheme::shallow_water) {
-    // Every padded cell: its four faces, its outflows and (active) its new unit discharges
-    // into the second buffers. First order: one stage, the buffers swapped. Second order
-    // (Heun): the first stage into the second buffers, the depth it leaves, and the second stage
-    // from that depth and those unit discharges, averaged into the outflows of the first and
-    // the unit discharges at the start of the step (which stay the current ones).
+    // Every padded cell: its four faces, its outflows (in place) and (active) its new unit
+    // discharges into the second buffers. First order: one stage, the buffers swapped. Second
+    // order (Heun): the first stage into the outflows and the second buffers, the depth it
+    // leaves, and the second stage from that depth and those unit discharges, averaged into the
+    // outflows of the first and the unit discharges at the start of the step (which stay the
+    // current ones).
     Field &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Field &qx_next = *fields_.twin(FieldId::momentum_x),
           &qy_next = *fields_.twin(FieldId::momentum_y);
@@ -512,7 +516,6 @@ void CpuBackend<Real>::run_flow(Real dt) {
       std::swap(qx, qx_next);
       std::swap(qy, qy_next);
     }
-    std::swap(flux_, flux_next_);
     return;
   }
   flow_blocks(dt, [](int, int, int) {});  // in place

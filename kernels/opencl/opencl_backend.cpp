@@ -395,43 +395,40 @@ void OpenClBackend::run_sources(const StepInputs& in) {
 
 void OpenClBackend::run_flow(Real dt) {
   if (params_.flow.scheme == FlowScheme::shallow_water) {
-    for (Buffer& b : flux_next_) made(b);  // the outflows' second buffers
+    // The outflows in place: the scheme reads none of the previous step's (the second order's
+    // second stage reads its own cell's first-stage outflows and averages into them).
     Buffer &qx = *fields_.get(FieldId::momentum_x), &qy = *fields_.get(FieldId::momentum_y);
     Buffer &qx_next = *fields_.twin(FieldId::momentum_x),
            &qy_next = *fields_.twin(FieldId::momentum_y);
     if (params_.flow.order == 2) {
-      // Heun (shallow_water.h): the first stage into the second buffers, the depth it leaves,
-      // the second stage from there averaged into the first's outflows and the unit discharges
-      // at the start of the step, which stay the current ones
+      // Heun (shallow_water.h): the first stage into the outflows and the unit discharges'
+      // second buffers, the depth it leaves, the second stage from there averaged into the
+      // first's outflows and the unit discharges at the start of the step, which stay the
+      // current ones
       cl_kernel k = kernel("flow_shallow_water_muscl");
       set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_,
-               dt, cell_.flow, cl_int{0}, flux_next_[0], flux_next_[1], flux_next_[2],
-               flux_next_[3], qx_next, qy_next);
+               dt, cell_.flow, cl_int{0}, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
       launch_rows(k, 0, H_);
       // the halo of the first stage before the depth and the second stage read it
-      for (const Buffer* b :
-           {&flux_next_[0], &flux_next_[1], &flux_next_[2], &flux_next_[3], &qx_next, &qy_next})
+      for (const Buffer* b : {&flux_[0], &flux_[1], &flux_[2], &flux_[3], &qx_next, &qy_next})
         exchange_halo(*b);
       cl_kernel s = kernel("flow_shallow_water_stage_depth");
-      set_args(s, cl_int{W_}, cl_int{H_}, kind_, depth_, flux_next_[0], flux_next_[1],
-               flux_next_[2], flux_next_[3], area_, dt, stage_depth_);
+      set_args(s, cl_int{W_}, cl_int{H_}, kind_, depth_, flux_[0], flux_[1], flux_[2], flux_[3],
+               area_, dt, stage_depth_);
       launch_rows(s, 0, H_);
       exchange_halo(stage_depth_);
       set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, stage_depth_, qx_next, qy_next, manning_,
-               dx_, dy_, area_, dt, cell_.flow, cl_int{1}, flux_next_[0], flux_next_[1],
-               flux_next_[2], flux_next_[3], qx, qy);
+               dx_, dy_, area_, dt, cell_.flow, cl_int{1}, flux_[0], flux_[1], flux_[2], flux_[3],
+               qx, qy);
       launch_rows(k, 0, H_);
-      std::swap(flux_, flux_next_);
       return;
     }
     cl_kernel k = kernel("flow_shallow_water");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_, dt,
-             cell_.flow, flux_next_[0], flux_next_[1], flux_next_[2], flux_next_[3], qx_next,
-             qy_next);
+             cell_.flow, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
     launch_rows(k, 0, H_);
     std::swap(qx, qx_next);
     std::swap(qy, qy_next);
-    std::swap(flux_, flux_next_);
     return;
   }
   if (params_.flow.scheme == FlowScheme::pipes) {

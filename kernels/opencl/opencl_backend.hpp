@@ -324,8 +324,8 @@ class OpenClBackend final : public Backend {
   // the bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is read and
   // written at its own cell only, so one buffer
   Buffer bed_, bed_next_, bed0_, bed_residual_, depth_, depth_next_, sediment_, sediment_next_;
-  std::array<Buffer, 4> flux_, flux_next_;
-  Buffer face_x_, face_y_;  // local inertial: discharge (m^3/s) east / south of each cell
+  std::array<Buffer, 4> flux_;  // the outflows, updated in place by every scheme
+  Buffer face_x_, face_y_;      // local inertial: discharge (m^3/s) east / south of each cell
   Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
   Buffer stage_depth_;  // shallow water, second order: the depth after Heun's first stage
   // The parameters held as one row (uniform_value): their buffers (members above) and values.
