@@ -54,10 +54,10 @@ Buffer OpenClBackend::make_buffer(std::size_t bytes, const void* data) {
   return b;
 }
 
-Buffer OpenClBackend::zero_field() {
+Buffer OpenClBackend::filled_field(Real value) {
   Buffer b = make_buffer(n_ * sizeof(Real));
-  const Real zero = 0;
-  check(clEnqueueFillBuffer(queue_.get(), b.get(), &zero, sizeof zero, 0, n_ * sizeof(Real), 0,
+  // the pattern is the float's bits: the same bits in every cell
+  check(clEnqueueFillBuffer(queue_.get(), b.get(), &value, sizeof value, 0, n_ * sizeof(Real), 0,
                             nullptr, nullptr),
         "clEnqueueFillBuffer");
   return b;
@@ -100,12 +100,7 @@ void OpenClBackend::take_parameter(Buffer& dst, CellParameter& src, bool per_cel
 void OpenClBackend::make_per_cell(Buffer& b) {
   const Real* value = uniform_value(b);
   if (!value) return;
-  // the same bits as the CPU reference's copies of its row (the pattern is the float's bits)
-  Buffer all = make_buffer(n_ * sizeof(Real));
-  check(clEnqueueFillBuffer(queue_.get(), all.get(), value, sizeof(Real), 0, n_ * sizeof(Real), 0,
-                            nullptr, nullptr),
-        "clEnqueueFillBuffer");
-  b = std::move(all);
+  b = filled_field(*value);  // the same bits as the CPU reference's copies of its row
   uniform_.erase(
       std::find_if(uniform_.begin(), uniform_.end(), [&](const auto& u) { return u.first == &b; }));
   update_param_pitches();

@@ -230,10 +230,13 @@ class OpenClBackend final : public Backend {
   void deliver_tallies();
   /// Reads and delivers the pending tallies now (blocking).
   void flush_tallies();
-  /// A buffer of `n_` Reals of zeros (clEnqueueFillBuffer: no array of zeros on the host).
-  Buffer zero_field();
-  /// `b` made on first use, for the second buffers a run may never need (the outflows' with
-  /// local inertial, the bed's without erosion and thermal collapse, ...): a buffer of n_
+  /// A buffer of `n_` Reals, each `value` (clEnqueueFillBuffer: no host array).
+  Buffer filled_field(Real value);
+  /// A buffer of `n_` Reals of zeros.
+  Buffer zero_field() { return filled_field(Real(0)); }
+  /// `b` made on first use, for the buffers a run may never need (the bed's and the sediment's
+  /// second buffers without erosion, thermal collapse or transport; the face fields without
+  /// local inertial): a buffer of n_
   /// Reals, a copy of `like` where given (what the cells a kernel leaves untouched must hold),
   /// else zeros. Returns `b`.
   Buffer& made(Buffer& b, const Buffer* like = nullptr);
