@@ -77,20 +77,6 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& te
                                       const Params& params) {
   std::unique_ptr<Backend> b;
   std::string reason = "--backend " + name;
-  if (const int ranks = parallel::size(); ranks > 1 && name != "cpu") {
-    // MPI (docs/mpi.md): the bands run on the CPU reference only, for now
-    if (name == "opencl")
-      throw Error(ExitCode::usage,
-                  fmt::format("--backend opencl: not supported under MPI with more than one rank "
-                              "yet ({} ranks); use --backend cpu",
-                              ranks));
-    if (name == "auto") {
-      b = make_cpu_backend(terrain, params);
-      b->set_choice_reason(fmt::format(
-          "auto: {} MPI ranks run the CPU reference (OpenCL under MPI: not yet)", ranks));
-      return b;
-    }
-  }
   if (name == "cpu") {
     b = make_cpu_backend(terrain, params);
   } else if (name == "opencl") {

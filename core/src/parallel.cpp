@@ -102,6 +102,13 @@ int local_size() {
   return 1;
 }
 
+int local_rank() {
+  if (size() <= 1) return 0;
+  for (const char* name : {"OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID"})
+    if (const char* v = std::getenv(name); v && std::atoi(v) >= 0 && *v) return std::atoi(v);
+  return 0;
+}
+
 Band band(int ny, int r, int n) {
   const long rows = ny;
   return {static_cast<int>(rows * r / n), static_cast<int>(rows * (r + 1) / n)};

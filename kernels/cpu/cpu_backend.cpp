@@ -11,6 +11,7 @@
 #include <omp.h>
 #endif
 
+#include "band_rows.hpp"
 #include "common/sections.h"
 #include "common/stats.h"
 #include "erodem/backends.hpp"
@@ -30,36 +31,15 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       ny_(terrain.grid.ny),
       W_(terrain.grid.nx + 2),
       H_(terrain.grid.ny + 2) {
-  int y0 = 0, y1 = H_;  // the padded rows this backend holds: all of them, or a band's
-  if (const int ranks = parallel::size(); ranks > 1) {
-    // A band of rows of an MPI run (docs/mpi.md): its rows, halo_rows_ rows of each
-    // neighbouring band, and the grid's ghost row where the band meets the edge.
-    halo_rows_ = params.flow.scheme == FlowScheme::pipes ? 1 : 2;
-    if (process_info(Process::transport).enabled(params) &&
-        params.transport.scheme == TransportScheme::semi_lagrangian)
-      throw Error(ExitCode::config,
-                  "transport.scheme = \"semi_lagrangian\": not supported under MPI with more "
-                  "than one rank (its departure points may lie beyond the halo of " +
-                      std::to_string(halo_rows_) +
-                      " rows); use transport.scheme = \"conservative\" or run one process");
-    const int r = parallel::rank();
-    const parallel::Band band = parallel::band(ny_, r, ranks);
-    if (band.row1 - band.row0 < halo_rows_)
-      throw Error(ExitCode::usage,
-                  fmt::format("mpirun -np {}: the grid's {} rows give rank {} {} rows, and each "
-                              "rank needs at least {} (the halo); run fewer ranks",
-                              ranks, ny_, r, band.row1 - band.row0, halo_rows_));
-    y0 = r == 0 ? 0 : band.row0 + 1 - halo_rows_;
-    y1 = r == ranks - 1 ? ny_ + 2 : band.row1 + 1 + halo_rows_;
-    banded_ = true;
-    row0_ = y0;
-    H_ = y1 - y0;
-    own0_ = band.row0 + 1 - y0;
-    own1_ = band.row1 + 1 - y0;
-  } else {
-    own1_ = H_ - 1;
-  }
-  PaddedState s = build_padded_state(terrain, params, y0, y1);
+  // the padded rows this backend holds: all of them, or a band's (band_rows.hpp)
+  const BandRows band = band_rows(params, ny_);
+  banded_ = band.banded;
+  halo_rows_ = band.halo;
+  row0_ = band.row0;
+  H_ = band.rows;
+  own0_ = band.own0;
+  own1_ = band.own1;
+  PaddedState s = build_padded_state(terrain, params, row0_, row0_ + H_);
   periodic_ = s.periodic_x;
   tails_ = sweeps_tails(params, periodic_ || banded_);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
@@ -166,11 +146,7 @@ std::vector<double> CpuBackend<Real>::gather_cells(const std::vector<std::int64_
   for (const std::int64_t cell : cells)
     if (owns(cell)) mine.push_back(value(padded(cell)));
   if (!banded_) return mine;
-  std::vector<int> owner;
-  owner.reserve(cells.size());
-  for (const std::int64_t cell : cells)
-    owner.push_back(parallel::owner_of_row(ny_, static_cast<int>(cell / nx_), parallel::size()));
-  return parallel::gather_owned(owner, mine);
+  return parallel::gather_owned(cell_owners(cells, nx_, ny_), mine);
 }
 
 template <class Real>
@@ -319,15 +295,13 @@ StepResult CpuBackend<Real>::end_step() {
 template <class Real>
 void CpuBackend<Real>::set_faces(const std::vector<Face>& faces) {
   face_codes_ = padded_faces(faces, nx_, ny_);
-  // MPI: a face belongs to the band of the cell west or north of it (the north ghost row's
-  // faces to the first band); its far cell is then in the band or its halo. Others': -1.
-  face_owner_.assign(faces.size(), 0);
-  const int ranks = parallel::size(), rank = parallel::rank();
+  // MPI: the faces this band owns (face_owners: their far cells are in the band or its
+  // halo); others' -1
+  face_owner_ = face_owners(faces, ny_);
+  const int rank = parallel::rank();
   if (banded_)
-    for (std::size_t j = 0; j < faces.size(); ++j) {
-      face_owner_[j] = parallel::owner_of_row(ny_, std::max(faces[j].row, 0), ranks);
+    for (std::size_t j = 0; j < faces.size(); ++j)
       face_codes_[j] = face_owner_[j] == rank ? face_codes_[j] - 2 * row0_ * W_ : -1;
-    }
   face_water_.assign(face_codes_.size(), 0.0);
   face_sediment_.assign(face_codes_.size(), 0.0);
 }

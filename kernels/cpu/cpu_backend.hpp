@@ -307,10 +307,7 @@ class CpuBackend final : public Backend {
   // One process: row0_ 0, own0_ 1, own1_ H_ - 1.
   bool banded_ = false;
   int row0_ = 0, own0_ = 1, own1_ = 0;
-  // The rows of halo a band holds on either side of its own: 2, as the local-inertial and
-  // shallow-water faces read the cells (and faces) beyond the face's two cells; 1 with pipes,
-  // whose sweeps read the four neighbours only (tests/mpi.sh: a halo of 1 row changes the
-  // local-inertial and shallow-water results, and not the pipes').
+  // The rows of halo a band holds on either side of its own (BandRows::halo, band_rows.hpp).
   int halo_rows_ = 1;
   std::vector<Real> halo_buffer_;  // exchange_fields: send up, receive up, send/receive down
   int threads_;

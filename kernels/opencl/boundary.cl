@@ -4,17 +4,22 @@
 #include "boundary.h"
 
 /* One work-item per halo cell, corners excluded: ids [0, W-2) the north row, then the south
- * row, the west column and the east column (the cells the CPU loops visit). */
+ * row, the west column and the east column (the cells the CPU loops visit). The north and
+ * south rows only where they are the grid's ghost rows (`north`, `south`): in a band of an MPI
+ * run they may be halo rows, which the neighbouring band gives. */
 __kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
                             __global real* restrict bed, __global real* restrict depth,
-                            __global real* restrict sediment, BoundaryParams p) {
+                            __global real* restrict sediment, BoundaryParams p, int north,
+                            int south) {
   const int id = (int)get_global_id(0);
   const int nxi = W - 2, nyi = H - 2;
   int x, y;
   if (id < nxi) {
+    if (!north) return;
     x = 1 + id;
     y = 0;
   } else if (id < 2 * nxi) {
+    if (!south) return;
     x = 1 + id - nxi;
     y = H - 1;
   } else if (id < 2 * nxi + nyi) {

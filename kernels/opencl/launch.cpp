@@ -92,7 +92,19 @@ void OpenClBackend::run_generic(const SweepInfo& sweep, Process process, Real dt
 }
 
 void OpenClBackend::launch_interior(cl_kernel k) {
-  launch_rows(k, 1, H_ - 1);
+  if (!band_.banded) {
+    launch_rows(k, 1, H_ - 1);
+    return;
+  }
+  // A band of an MPI run: its halo rows are computed too (as the CPU reference's), but only
+  // its own rows are tallied. A cell kernel writes its group's tally partial at the group's
+  // index in the launch (cell_group_index, reduce.cl), so the own rows, launched last, write
+  // over the partials of the halo rows' launches: a band has at least band_.halo own rows,
+  // and each halo launch at most band_.halo - 1 rows (the raster's first and last rows are
+  // not interior).
+  launch_rows(k, 1, band_.own0);
+  launch_rows(k, band_.own1, H_ - 1);
+  launch_rows(k, band_.own0, band_.own1);
 }
 
 void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1, std::size_t row_group) {

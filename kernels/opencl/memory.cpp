@@ -11,6 +11,7 @@
 #include "common/erosion.h"
 #include "erodem/error.hpp"
 #include "erodem/fields.hpp"
+#include "erodem/parallel.hpp"
 #include "opencl/launch.hpp"
 #include "opencl/opencl_backend.hpp"
 #include "stagger.hpp"
@@ -180,7 +181,26 @@ std::vector<double> OpenClBackend::field(FieldId id) const {
 }
 
 std::vector<double> OpenClBackend::field_rows(FieldId id, int row0, int row1) const {
+  // this rank's rows of [row0, row1), then every rank's in row order
+  OwnRows own = own_field_rows(id, row0, row1);
+  if (band_.banded) return parallel::allgather(own.values);
+  return std::move(own.values);
+}
+
+OwnRows OpenClBackend::own_field_rows(FieldId id, int row0, int row1) const {
   check_row_range(id, row0, row1, nx_, ny_);
+  // the rows of [row0, row1) this rank owns (all of them in one process; DEM row r is raster
+  // row r + 1 - band_.row0)
+  const int r0 = std::max(row0, band_.own0 - 1 + band_.row0),
+            r1 = std::min(row1, band_.own1 - 1 + band_.row0);
+  OwnRows out;
+  out.row0 = r1 > r0 ? r0 : row0;
+  out.row1 = r1 > r0 ? r1 : row0;
+  out.values = read_rows(id, out.row0, out.row1);
+  return out;
+}
+
+std::vector<double> OpenClBackend::read_rows(FieldId id, int row0, int row1) const {
   const std::size_t n = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(row1 - row0);
   if (fields_.reads_zeros(id)) return std::vector<double>(n);  // without a buffer of zeros
   auto* self = const_cast<OpenClBackend*>(this);
@@ -192,7 +212,7 @@ std::vector<double> OpenClBackend::field_rows(FieldId id, int row0, int row1) co
       raw.insert(raw.end(), n, *value);
       continue;
     }
-    const auto v = read_interior(queue_.get(), b->get(), nx_, row0, row1);
+    const auto v = read_interior(queue_.get(), b->get(), nx_, row0 - band_.row0, row1 - band_.row0);
     raw.insert(raw.end(), v.begin(), v.end());
   }
   std::vector<double> out(n);
@@ -251,27 +271,34 @@ std::vector<double> OpenClBackend::compose_gathered(const std::vector<FieldId>& 
   return out;
 }
 
-namespace {
-
-/// The padded indices of DEM cells (row-major (ny, nx)) of a grid nx wide.
-std::vector<cl_int> padded_cells(const std::vector<std::int64_t>& cells, int nx) {
+std::vector<cl_int> OpenClBackend::owned_padded_cells(const std::vector<std::int64_t>& cells,
+                                                      std::vector<int>& owner) const {
+  owner = cell_owners(cells, nx_, ny_);
   std::vector<cl_int> out;
-  out.reserve(cells.size());
-  for (const std::int64_t cell : cells)
-    out.push_back(static_cast<cl_int>((cell % nx + 1) + (cell / nx + 1) * (nx + 2)));
+  for (std::size_t j = 0; j < cells.size(); ++j)
+    if (owner[j] == parallel::rank())
+      out.push_back(static_cast<cl_int>(band_.padded(cells[j], nx_)));
   return out;
 }
 
-}  // namespace
+std::vector<double> OpenClBackend::gather_items(const std::vector<int>& owner, std::size_t repeat,
+                                                const std::vector<double>& mine) const {
+  if (!band_.banded) return mine;
+  std::vector<int> all;
+  all.reserve(owner.size() * repeat);
+  for (std::size_t k = 0; k < repeat; ++k) all.insert(all.end(), owner.begin(), owner.end());
+  return parallel::gather_owned(all, mine);
+}
 
 void OpenClBackend::set_probes(const std::vector<std::int64_t>& cells,
                                const std::vector<FieldId>& fields) {
   check_cells(cells, nx_, ny_, "probes");
   probe_fields_ = fields;
-  probe_count_ = cells.size();
-  if (cells.empty() || fields.empty()) return;
-  probe_cells_ = upload(padded_cells(cells, nx_));
-  probe_out_ = make_buffer(part_count(fields) * cells.size() * sizeof(float));
+  const std::vector<cl_int> mine = owned_padded_cells(cells, probe_owner_);
+  probe_count_ = mine.size();
+  if (mine.empty() || fields.empty()) return;
+  probe_cells_ = upload(mine);
+  probe_out_ = make_buffer(part_count(fields) * mine.size() * sizeof(float));
 }
 
 std::vector<double> OpenClBackend::sample(const std::vector<std::int64_t>& cells,
@@ -279,12 +306,18 @@ std::vector<double> OpenClBackend::sample(const std::vector<std::int64_t>& cells
   check_cells(cells, nx_, ny_, "sample");
   if (cells.empty()) return {};
   auto* self = const_cast<OpenClBackend*>(this);
-  const Buffer where = self->upload(padded_cells(cells, nx_));
-  const Buffer out = self->make_buffer(part_count({id}) * cells.size() * sizeof(float));
-  self->enqueue_gather(where, cells.size(), {id}, out);
-  std::vector<float> raw(part_count({id}) * cells.size());
-  self->read(out, raw.size() * sizeof(float), raw.data(), true);
-  return compose_gathered({id}, raw, cells.size());
+  std::vector<int> owner;
+  const std::vector<cl_int> mine = owned_padded_cells(cells, owner);
+  std::vector<double> values;
+  if (!mine.empty()) {
+    const Buffer where = self->upload(mine);
+    const Buffer out = self->make_buffer(part_count({id}) * mine.size() * sizeof(float));
+    self->enqueue_gather(where, mine.size(), {id}, out);
+    std::vector<float> raw(part_count({id}) * mine.size());
+    self->read(out, raw.size() * sizeof(float), raw.data(), true);
+    values = compose_gathered({id}, raw, mine.size());
+  }
+  return gather_items(owner, 1, values);
 }
 
 void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
@@ -306,19 +339,26 @@ void OpenClBackend::set_field_rows(FieldId id, int row0, int row1,
   // second buffer not made yet is made later as a copy: made()).
   Buffer* twin = fields_.twin(id);
   if (twin && !*twin) twin = nullptr;
-  const std::vector<float> v(values.begin(), values.end());
-  write_interior(queue_.get(), dst->get(), nx_, row0, row1, v);
-  if (twin) write_interior(queue_.get(), twin->get(), nx_, row0, row1, v);
+  // the DEM rows of [row0, row1) the raster holds (a band's own and halo rows in an MPI run:
+  // DEM row r is raster row r + 1 - band_.row0), so no exchange between ranks is needed
+  const int r0 = std::max(row0, band_.row0 - 1), r1 = std::min(row1, band_.row0 - 1 + H_);
+  if (r1 <= r0) return;
+  const auto first = values.begin() + static_cast<std::ptrdiff_t>(r0 - row0) * nx_;
+  const std::vector<double> held(first, first + static_cast<std::ptrdiff_t>(r1 - r0) * nx_);
+  const std::vector<float> v(held.begin(), held.end());
+  const int y0 = r0 - band_.row0, y1 = r1 - band_.row0;  // write_interior's rows
+  write_interior(queue_.get(), dst->get(), nx_, y0, y1, v);
+  if (twin) write_interior(queue_.get(), twin->get(), nx_, y0, y1, v);
   if (id == FieldId::bed) {
     // a bed keeps what float cannot hold in its residual (set bed_residual after the bed)
     std::vector<float> lo(v.size());
     for (std::size_t i = 0; i < v.size(); ++i)
-      lo[i] = static_cast<float>(values[i] - static_cast<double>(v[i]));
-    write_interior(queue_.get(), bed_residual_.get(), nx_, row0, row1, lo);
-    exchange_halo(bed_residual_);
+      lo[i] = static_cast<float>(held[i] - static_cast<double>(v[i]));
+    write_interior(queue_.get(), bed_residual_.get(), nx_, y0, y1, lo);
+    copy_periodic_columns(bed_residual_);
   }
-  exchange_halo(*dst);
-  if (twin) exchange_halo(*twin);
+  copy_periodic_columns(*dst);
+  if (twin) copy_periodic_columns(*twin);
 }
 
 }  // namespace erodem::opencl

@@ -16,6 +16,7 @@
 #include "common/compat.h"
 #include "erodem/error.hpp"
 #include "erodem/initial_state.hpp"
+#include "erodem/parallel.hpp"
 #include "erodem/process.hpp"
 #include "opencl/launch.hpp"
 #include "stats_merge.hpp"
@@ -57,14 +58,17 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                 "runs on the cpu backend: --backend cpu)");
   const auto& g = terrain.grid;
   g.validate();
+  // the padded rows this backend holds: all of them, or a band's (band_rows.hpp)
+  band_ = band_rows(params, ny_);
+  H_ = band_.rows;
   n_ = static_cast<std::size_t>(W_) * H_;
   if (n_ > static_cast<std::size_t>(std::numeric_limits<cl_int>::max()))
     throw Error(ExitCode::data, fmt::format("backend 'opencl': a grid of {} x {} is too large "
                                             "(at most 2^31 padded cells)",
                                             nx_, ny_));
-  PaddedState state = build_padded_state(terrain, params);
+  PaddedState state = build_padded_state(terrain, params, band_.row0, band_.row0 + H_);
   periodic_ = state.periodic_x;
-  tails_ = sweeps_tails(params, periodic_);
+  tails_ = sweeps_tails(params, periodic_ || band_.banded);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
   rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
@@ -185,9 +189,10 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   row_sums_ = make_buffer(static_cast<std::size_t>(H_ - 2) * kStatsRowValues * acc_size_);
   row_cells_ = make_buffer(static_cast<std::size_t>(H_ - 2) * 3 * sizeof(cl_long));
   // The active cells beside a ghost, row-major: the only ones with a water exchange or a
-  // sediment outflow through the domain's faces (edges.cl). The kinds never change.
+  // sediment outflow through the domain's faces (edges.cl); of the own rows in a band of an
+  // MPI run. The kinds never change.
   std::vector<cl_int> edges;
-  for (int y = 1; y < H_ - 1; ++y)
+  for (int y = band_.own0; y < band_.own1; ++y)
     for (int x = 1; x < W_ - 1; ++x) {
       const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
       if (kind[i] != ERODEM_CELL_ACTIVE) continue;
@@ -209,7 +214,9 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 }
 
 std::string OpenClBackend::device() const {
-  return rt_->info.label();
+  if (!band_.banded) return rt_->info.label();
+  return fmt::format("{} (a rank), {} MPI ranks in bands of rows, halo {} row{}", rt_->info.label(),
+                     parallel::size(), band_.halo, band_.halo == 1 ? "" : "s");
 }
 
 void OpenClBackend::begin_step(const StepInputs& in) {
@@ -265,7 +272,8 @@ void OpenClBackend::run(Process p) {
 }
 
 void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
-  if (!periodic_) return;
+  if (!periodic_ && !band_.banded) return;
+  std::vector<const Buffer*> buffers;
   for (const std::string& name : names) {
     const Buffer* b = name == "depth_flow"      ? &depth_next_
                       : name == "thermal_share" ? &thermal_share_
@@ -275,11 +283,60 @@ void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
                                                 : field_buffer(field_info(name).id);
     if (!b)
       throw Error(ExitCode::internal, fmt::format("halo exchange: field '{}' has no buffer", name));
-    exchange_halo(*b);
+    buffers.push_back(b);
+  }
+  exchange_buffers(buffers);
+}
+
+void OpenClBackend::exchange_buffers(const std::vector<const Buffer*>& buffers) {
+  std::vector<const Buffer*> held;  // one row: the same value beyond the seam and in every band
+  for (const Buffer* b : buffers)
+    if (!uniform(*b)) held.push_back(b);
+  for (const Buffer* b : held) copy_periodic_columns(*b);
+  if (!band_.banded || held.empty()) return;
+  // whole padded rows (the ghost columns and the corners with them): my first band_.halo own
+  // rows to the band above, my last to the band below; theirs into my halo rows. Every
+  // buffer's rows in one message each way.
+  const int r = parallel::rank(), ranks = parallel::size();
+  const bool up = r > 0, down = r + 1 < ranks;
+  const std::size_t per = static_cast<std::size_t>(band_.halo) * static_cast<std::size_t>(W_);
+  const std::size_t n = per * held.size(), bytes = per * sizeof(Real);
+  if (halo_host_.size() < 4 * n) {
+    check(clFinish(queue_.get()), "clFinish");  // the last exchange's writes read the array
+    halo_host_.resize(4 * n);
+  }
+  Real *send_up = halo_host_.data(), *recv_up = send_up + n, *send_down = recv_up + n,
+       *recv_down = send_down + n;
+  auto offset = [&](int y) { return static_cast<std::size_t>(y) * W_ * sizeof(Real); };
+  for (std::size_t k = 0; k < held.size(); ++k) {
+    const cl_mem b = held[k]->get();
+    if (up)
+      check(clEnqueueReadBuffer(queue_.get(), b, CL_FALSE, offset(band_.own0), bytes,
+                                send_up + k * per, 0, nullptr, profile_event("halo")),
+            "clEnqueueReadBuffer(halo)");
+    if (down)
+      check(clEnqueueReadBuffer(queue_.get(), b, CL_FALSE, offset(band_.own1 - band_.halo), bytes,
+                                send_down + k * per, 0, nullptr, profile_event("halo")),
+            "clEnqueueReadBuffer(halo)");
+  }
+  check(clFinish(queue_.get()), "clFinish");
+  parallel::exchange(up ? send_up : nullptr, up ? recv_up : nullptr, down ? send_down : nullptr,
+                     down ? recv_down : nullptr, n * sizeof(Real));
+  // non-blocking: the queue is in order, and the array stays until the next exchange (above)
+  for (std::size_t k = 0; k < held.size(); ++k) {
+    const cl_mem b = held[k]->get();
+    if (up)
+      check(clEnqueueWriteBuffer(queue_.get(), b, CL_FALSE, offset(band_.own0 - band_.halo), bytes,
+                                 recv_up + k * per, 0, nullptr, profile_event("halo")),
+            "clEnqueueWriteBuffer(halo)");
+    if (down)
+      check(clEnqueueWriteBuffer(queue_.get(), b, CL_FALSE, offset(band_.own1), bytes,
+                                 recv_down + k * per, 0, nullptr, profile_event("halo")),
+            "clEnqueueWriteBuffer(halo)");
   }
 }
 
-void OpenClBackend::exchange_halo(const Buffer& b) {
+void OpenClBackend::copy_periodic_columns(const Buffer& b) {
   if (!periodic_ || uniform(b)) return;  // one row: the same value on both sides of the seam
   cl_kernel k = kernel("halo_periodic_x");
   set_args(k, cl_int{W_}, cl_int{H_}, b);
@@ -295,18 +352,32 @@ StepResult OpenClBackend::end_step() {
   StepResult r;
   r.stats = collect(&r.probes);  // delivers the step's tallies to step_tally_
   r.tally = step_tally_;
-  // the faces' values, read in collect's batch; 0 where the step did not measure them
-  r.face_water.assign(face_count_, 0.0);
-  r.face_sediment.assign(face_count_, 0.0);
-  for (std::size_t j = 0; j < face_count_; ++j) {
-    if (face_water_done_) r.face_water[j] = face_water_raw_[j];
-    if (face_sediment_done_) r.face_sediment[j] = face_sediment_raw_[j];
+  if (band_.banded) {  // every rank's tallies of its own rows, added in rank order
+    r.tally = StepTally{};
+    for (const StepTally& t : parallel::allgather(std::vector<StepTally>{step_tally_})) {
+#define ERODEM_ADD_TALLY(name, zero_if_absent, doc) r.tally.name += t.name;
+      ERODEM_TALLIES(ERODEM_ADD_TALLY)
+#undef ERODEM_ADD_TALLY
+    }
   }
+  // the faces' values, read in collect's batch; 0 where the step did not measure them
+  std::vector<double> water(face_count_, 0.0), sediment(face_count_, 0.0);
+  for (std::size_t j = 0; j < face_count_; ++j) {
+    if (face_water_done_) water[j] = face_water_raw_[j];
+    if (face_sediment_done_) sediment[j] = face_sediment_raw_[j];
+  }
+  r.face_water = gather_items(face_owner_, 1, water);
+  r.face_sediment = gather_items(face_owner_, 1, sediment);
   return r;
 }
 
 void OpenClBackend::set_faces(const std::vector<Face>& faces) {
-  const std::vector<int> codes = padded_faces(faces, nx_, ny_);
+  // the faces this rank owns (all in one process), in the raster's rows
+  face_owner_ = face_owners(faces, ny_);
+  const std::vector<int> all = padded_faces(faces, nx_, ny_);
+  std::vector<int> codes;
+  for (std::size_t j = 0; j < all.size(); ++j)
+    if (face_owner_[j] == parallel::rank()) codes.push_back(band_.face_code(all[j], nx_));
   face_count_ = codes.size();
   if (codes.empty()) return;
   face_codes_ = upload(std::vector<cl_int>(codes.begin(), codes.end()));
@@ -330,7 +401,10 @@ void OpenClBackend::measure_faces(bool sediment) {
 
 void OpenClBackend::run_boundary() {
   cl_kernel k = kernel("boundary_fill");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, cell_.boundary);
+  // the first and last padded rows where they are the grid's ghost rows (in a band of an MPI
+  // run they may be halo rows, which the neighbouring band gives)
+  const cl_int north = band_.row0 == 0, south = band_.row0 + H_ == ny_ + 2;
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, cell_.boundary, north, south);
   const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
                                profile_event(k)),
@@ -351,12 +425,17 @@ void OpenClBackend::run_sources(const StepInputs& in) {
   std::vector<Real> amounts, sediment_amounts;
   bool sediment = false;
   for (const auto& p : in.points) {
-    const int x = static_cast<int>(p.cell % nx_) + 1, y = static_cast<int>(p.cell / nx_) + 1;
+    // in a band of an MPI run, the inflows at the cells the raster holds (its own, and its
+    // halo's, which the next exchange overwrites), as the CPU reference adds them
+    if (!band_.holds(p.cell, nx_)) continue;
+    const int x = static_cast<int>(p.cell % nx_) + 1,
+              y = static_cast<int>(p.cell / nx_) + 1 - band_.row0;
     cells.push_back(x + y * W_);
     amounts.push_back(static_cast<Real>(p.volume / area_host_[y]));
     sediment_amounts.push_back(static_cast<Real>(p.sediment / area_host_[y]));
     sediment = sediment || p.sediment != 0;
   }
+  if (cells.empty()) return;
   if (sediment)  // the sediment's amounts after the water's (sources_points)
     amounts.insert(amounts.end(), sediment_amounts.begin(), sediment_amounts.end());
   // The previous upload (if any) may still read the host vectors.
@@ -410,13 +489,12 @@ void OpenClBackend::run_flow(Real dt) {
                dt, cell_.flow, cl_int{0}, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
       launch_rows(k, 0, H_);
       // the halo of the first stage before the depth and the second stage read it
-      for (const Buffer* b : {&flux_[0], &flux_[1], &flux_[2], &flux_[3], &qx_next, &qy_next})
-        exchange_halo(*b);
+      exchange_buffers({&flux_[0], &flux_[1], &flux_[2], &flux_[3], &qx_next, &qy_next});
       cl_kernel s = kernel("flow_shallow_water_stage_depth");
       set_args(s, cl_int{W_}, cl_int{H_}, kind_, depth_, flux_[0], flux_[1], flux_[2], flux_[3],
                area_, dt, stage_depth_);
       launch_rows(s, 0, H_);
-      exchange_halo(stage_depth_);
+      exchange_buffers({&stage_depth_});
       set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, stage_depth_, qx_next, qy_next, manning_,
                dx_, dy_, area_, dt, cell_.flow, cl_int{1}, flux_[0], flux_[1], flux_[2], flux_[3],
                qx, qy);
@@ -545,7 +623,7 @@ void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, talus, dx_, dy_, area_,
            thermal_share_, dt, cell_.thermal);
   launch_interior(share);
-  exchange_halo(thermal_share_);  // the apply pass reads the neighbours' shares
+  exchange_buffers({&thermal_share_});  // the apply pass reads the neighbours' shares
   cl_kernel apply = kernel("thermal_apply");
   set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, wetness_, talus,
            thermal_share_, dx_, dy_, area_, bed_next_, cell_.thermal, tally_partials_,
@@ -619,8 +697,8 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
            velocity_y_, area_, partial_a_, partial_cells_);
   const int rows = H_ - 2;
   if (stats_local_ == 0)
-    launch_interior(k);  // whole rows: a cell kernel, groups_x_ partials per row
-  else                   // one group of stats_local_ work-items per row: one partial per row
+    launch_rows(k, 1, H_ - 1);  // whole rows: a cell kernel, groups_x_ partials per row
+  else                          // one group of stats_local_ work-items per row: one partial per row
     launch_rows(k, 1, H_ - 1, stats_local_);
   const std::size_t partials_per_row = stats_local_ == 0 ? groups_x_ : 1;
   cl_kernel r = kernel("stats_rows");
@@ -635,7 +713,7 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   if (pending_ & tally_bits()) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
   std::vector<cl_long> cells(static_cast<std::size_t>(rows) * 3);
   read(row_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
-  const bool gather = probes && probe_count_ > 0 && !probe_fields_.empty();
+  const bool gather = probes && probe_count_ > 0 && !probe_fields_.empty();  // (owned ones)
   if (gather) {
     // the probes gathered on the device: a few floats in the step's one batch of reads
     enqueue_gather(probe_cells_, probe_count_, probe_fields_, probe_out_);
@@ -654,31 +732,39 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
   resolve_profile(false);  // the blocking read: every command before it has completed
   deliver_tallies();
-  if (probes)
-    *probes =
+  if (probes && !probe_fields_.empty() && !probe_owner_.empty()) {
+    // (in a band of an MPI run: the owned probes' values, then every probe's from its owner)
+    const std::vector<double> mine =
         gather ? compose_gathered(probe_fields_, probe_raw_, probe_count_) : std::vector<double>();
+    *probes = gather_items(probe_owner_, probe_fields_.size(), mine);
+  } else if (probes) {
+    probes->clear();
+  }
   constexpr std::size_t n = kStatsRowValues;
   const auto sums = acc_values(stats_sums_raw_, static_cast<std::size_t>(rows) * n);
-  // Rows in order, merged as the CPU's (stats_merge.hpp); the speed of the winning cell after.
-  std::vector<RowStats> row_stats(static_cast<std::size_t>(rows));
-  for (std::size_t y = 0; y < row_stats.size(); ++y) {
-    RowStats& row = row_stats[y];
+  // The own rows in order (every rank's in global row order in a band of an MPI run), merged
+  // as the CPU's (stats_merge.hpp). stats_rows numbers the cells from the raster's first row.
+  const std::int64_t first_cell = static_cast<std::int64_t>(band_.row0) * nx_;
+  auto cell = [&](cl_long c) { return c < 0 ? std::int64_t{-1} : first_cell + c; };
+  std::vector<RowStats> row_stats;
+  row_stats.reserve(static_cast<std::size_t>(band_.own1 - band_.own0));
+  for (int yy = band_.own0; yy < band_.own1; ++yy) {
+    const auto y = static_cast<std::size_t>(yy - 1);
+    RowStats row;
     row.water = sums[n * y + 0];
     row.material = sums[n * y + 1];
     row.sediment = sums[n * y + 2];
     row.max_depth = sums[n * y + 3];
     row.max_speed2 = sums[n * y + 4];
-    row.max_depth_cell = cells[3 * y + 0];
-    row.max_speed_cell = cells[3 * y + 1];
-    row.bad_cell = cells[3 * y + 2];
-  }
-  FieldStats st = merge_row_stats(row_stats);
-  if (st.max_speed_cell >= 0) {
+    row.max_depth_cell = cell(cells[3 * y + 0]);
+    row.max_speed_cell = cell(cells[3 * y + 1]);
+    row.bad_cell = cell(cells[3 * y + 2]);
     // hypot on the host, as the CPU reference takes it (stats_rows gives the velocities)
-    const auto y = static_cast<std::size_t>(st.max_speed_cell / nx_);
-    st.max_speed = std::hypot(sums[n * y + 5], sums[n * y + 6]);
+    if (row.max_speed_cell >= 0) row.speed = std::hypot(sums[n * y + 5], sums[n * y + 6]);
+    row_stats.push_back(row);
   }
-  return st;
+  if (band_.banded) row_stats = parallel::allgather(row_stats);
+  return merge_row_stats(row_stats);
 }
 
 }  // namespace opencl

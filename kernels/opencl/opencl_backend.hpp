@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "band_rows.hpp"
 #include "cell_params.hpp"
 #include "erodem/backend.hpp"
 #include "erodem/backends.hpp"
@@ -162,6 +163,7 @@ class OpenClBackend final : public Backend {
   std::vector<KernelTime> kernel_times() const override;
   std::vector<double> field(FieldId id) const override;
   std::vector<double> field_rows(FieldId id, int row0, int row1) const override;
+  OwnRows own_field_rows(FieldId id, int row0, int row1) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
   void set_field_rows(FieldId id, int row0, int row1, const std::vector<double>& values) override;
 
@@ -179,10 +181,17 @@ class OpenClBackend final : public Backend {
   /// the buffers of its uses, the process's parameter struct and the tally partials, over the
   /// DEM rows; the process's tallies deferred (launch.cpp).
   void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
-  /// The halo exchange (process.hpp halo_fields) with boundary.periodic_x: halo_periodic_x
-  /// (boundary.cl) on the buffers of the named fields; nothing otherwise.
+  /// The halo exchange (process.hpp halo_fields) of the named fields (of the field table, or
+  /// the intermediates "depth_flow", "thermal_share"): exchange_buffers on their buffers.
   void exchange_halo(const std::vector<std::string>& names);
-  void exchange_halo(const Buffer& b);
+  /// The halo exchange of padded buffers (W_ x H_ each; a parameter held as one row needs
+  /// none): with boundary.periodic_x their ghost columns (halo_periodic_x, boundary.cl), then
+  /// in a band of an MPI run their band_.halo rows on either side from the neighbouring
+  /// ranks, every buffer's rows in one message each way, as the CPU reference's
+  /// exchange_fields; nothing otherwise.
+  void exchange_buffers(const std::vector<const Buffer*>& buffers);
+  /// halo_periodic_x on `b` with boundary.periodic_x (no exchange between ranks).
+  void copy_periodic_columns(const Buffer& b);
 
   /// A device buffer of `bytes`, filled from `data` where given. A buffer of a field (at
   /// least kStaggerMin bytes) starts at its own offset modulo 4 KiB (stagger_next_): see
@@ -194,7 +203,9 @@ class OpenClBackend final : public Backend {
   }
   cl_kernel kernel(const char* name);
   /// Runs a cell kernel over the padded rows 1 .. H - 2, the rows with DEM cells (what the
-  /// processes but flow touch), in interior_groups_ work-groups of (local_x_, 1).
+  /// processes but flow touch), in interior_groups_ work-groups of (local_x_, 1). In a band
+  /// of an MPI run, the halo rows first and the own rows last, so that the tally partials
+  /// hold the own rows' only (launch.cpp).
   void launch_interior(cl_kernel k);
   /// Runs a cell kernel over the padded rows [y0, y1) only (global offset y0; work-groups of
   /// (local_x_, 1)), or with `row_group` > 0 one work-group of (row_group, 1) per row (a
@@ -217,6 +228,18 @@ class OpenClBackend final : public Backend {
   void resolve_profile(bool wait);
   /// `count` accumulator values (double or float on the device, as read) as doubles.
   std::vector<double> acc_values(const std::vector<unsigned char>& raw, std::size_t count) const;
+  /// DEM rows [row0, row1) of field `id`, which the raster holds, row-major, composed as
+  /// field() gives them.
+  std::vector<double> read_rows(FieldId id, int row0, int row1) const;
+  /// The raster indices of the cells of `cells` (DEM cells) this rank owns, in order, and
+  /// every cell's owner into `owner` (band_rows.hpp cell_owners).
+  std::vector<cl_int> owned_padded_cells(const std::vector<std::int64_t>& cells,
+                                         std::vector<int>& owner) const;
+  /// In a band of an MPI run, each item's value from its owner's `mine` (the values of the
+  /// items this rank owns, in item order), for `repeat` runs of the items (the fields of the
+  /// probes); `mine` in one process.
+  std::vector<double> gather_items(const std::vector<int>& owner, std::size_t repeat,
+                                   const std::vector<double>& mine) const;
 
   // The ledger's tallies stay on the device until end_step() (or a stats() within the step,
   // or a run() that would overwrite them): one read per step instead of one blocking
@@ -302,8 +325,11 @@ class OpenClBackend final : public Backend {
   std::shared_ptr<Runtime> rt_;
   Queue queue_;
   std::vector<std::pair<std::string, Kernel>> kernels_;
-  int nx_, ny_, W_, H_;
-  bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
+  int nx_, ny_, W_, H_;  // the DEM (all of it) and the padded raster (a band's in MPI)
+  // The padded rows held (all; a band's in an MPI run: band_rows.hpp, docs/mpi.md)
+  BandRows band_;
+  std::vector<float> halo_host_;  // exchange_buffers: send up, receive up, send/receive down
+  bool periodic_ = false;         // boundary.periodic_x (PaddedState::periodic_x)
   // By Process: run()'s sweeps and what the halo exchanges after each (process.hpp
   // sweeps_tails), worked out once
   std::vector<SweepsTail> tails_;
@@ -348,16 +374,22 @@ class OpenClBackend final : public Backend {
   StepTally step_tally_;
   bool in_step_ = false;
   // The probes (set_probes): the padded cells on the device, the fields, their gathered parts.
+  // In a band of an MPI run the device gathers the probes this rank owns (probe_count_ of
+  // them) and the owners (probe_owner_) give the others.
   Buffer probe_cells_, probe_out_;
   std::size_t probe_count_ = 0;
+  std::vector<int> probe_owner_;
   std::vector<FieldId> probe_fields_;
   std::vector<float> probe_raw_;
   // The faces of the sections and outlets (set_faces, common/sections.h): their codes on the
   // device, what the step moved through them (section_faces in stats.cl, enqueued before the
   // water update and the transport, read with the step's statistics) and whether this step
   // measured each.
+  // In a band of an MPI run, the device measures the faces this rank owns (face_count_ of
+  // them; face_owner_, band_rows.hpp) and the owners give the others.
   Buffer face_codes_, face_water_out_, face_sediment_out_;
   std::size_t face_count_ = 0;
+  std::vector<int> face_owner_;
   bool face_water_done_ = false, face_sediment_done_ = false;
   std::vector<float> face_water_raw_, face_sediment_raw_;
   /// Enqueues section_faces for the water (sediment = false) or the sediment.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "erodem/error.hpp"
+#include "erodem/parallel.hpp"
 #include "opencl/devices.hpp"
 #include "opencl/launch.hpp"
 #include "opencl/opencl_backend.hpp"
@@ -57,8 +58,11 @@ const DeviceEntry& choose_device(const std::vector<DeviceEntry>& devices,
                                              "'<platform>:<device>'; devices: {}",
                                              selector, describe(devices)));
   }
+  // the first GPU; under MPI each rank of a machine its own, in turn (local_rank)
+  std::vector<const DeviceEntry*> gpus;
   for (const auto& d : devices)
-    if (d.info.gpu()) return d;
+    if (d.info.gpu()) gpus.push_back(&d);
+  if (!gpus.empty()) return *gpus[static_cast<std::size_t>(parallel::local_rank()) % gpus.size()];
   return devices.front();
 }
 

@@ -35,6 +35,10 @@ int size();
 /// The ranks on this machine (the launcher's OMPI_COMM_WORLD_LOCAL_SIZE or MPI_LOCALNRANKS;
 /// 1 where neither says), to share its cores among them.
 int local_size();
+/// This rank's index among the ranks on its machine (the launcher's
+/// OMPI_COMM_WORLD_LOCAL_RANK or MPI_LOCALRANKID; 0 where neither says or without MPI
+/// running), e.g. to give each its own GPU.
+int local_rank();
 
 /// The DEM rows [row0, row1) rank `r` of `n` holds (bands as equal as the rows allow, in rank
 /// order from the north).
