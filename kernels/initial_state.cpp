@@ -140,7 +140,8 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
 
   // Rasters or scalars; halo cells copy the nearest DEM cell (Manning n is read at faces).
   // (A scalar stays one value: CellParameter::is_uniform.)
-  auto raster_or = [&](const std::vector<double>& raster, double scalar) {
+  // (`first_row`: the DEM row of the raster's first row, where it holds only some rows)
+  auto raster_or = [&](const std::vector<double>& raster, double scalar, int first_row = 0) {
     CellParameter out;
     out.uniform = scalar;
     if (raster.empty()) return out;
@@ -148,19 +149,23 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
     for (int y = a; y < b; ++y)
       for (int x = 0; x < W; ++x) {
         const int r = std::clamp(y - 1, 0, ny - 1), c = std::clamp(x - 1, 0, nx - 1);
-        out.cells[at(x, y)] = raster[dem(c, r)];
+        out.cells[at(x, y)] = raster[dem(c, r - first_row)];
       }
     return out;
   };
   s.manning = raster_or(terrain.manning_n, params.flow.manning_n.value);
-  // erosion.hardness = "noise": the noise field stands where a hardness raster would (the
-  // whole grid's: it is scaled to the range of its active cells).
+  // erosion.hardness = "noise": the noise field stands where a hardness raster would, made for
+  // the DEM rows these padded rows read only (scaled to the range of the whole grid's active
+  // cells, which hardness_noise_rows finds a block of rows at a time)
   if (params.erosion.hardness_noise && !terrain.hardness.empty())
     throw config_error("erosion.hardness",
                        "is \"noise\", but the terrain carries a hardness raster; give one");
-  s.hardness = raster_or(
-      params.erosion.hardness_noise ? hardness_noise(terrain, params.erosion) : terrain.hardness,
-      params.erosion.hardness.value);
+  if (params.erosion.hardness_noise) {
+    s.hardness = raster_or(hardness_noise_rows(terrain, params.erosion, r0, r1),
+                           params.erosion.hardness.value, r0);
+  } else {
+    s.hardness = raster_or(terrain.hardness, params.erosion.hardness.value);
+  }
   s.rain_factor = raster_or(terrain.rain_factor, 1.0);
   s.periodic_x = periodic_x(terrain, params);
   if (s.periodic_x && nx < 2)

@@ -217,5 +217,59 @@ TEST(ErodibilityNoise, EveryBackendIsHandedTheSameField) {
               same_bits(ocl, f32) ? "bit for bit" : "NO");
 }
 
+TEST(ErodibilityNoise, RowsAreThoseOfTheWholeFieldHoldingNoWholeField) {
+  // An MPI band builds its hardness noise for its rows only (hardness_noise_rows), the range
+  // of the whole grid's active cells found a block of 256 rows at a time. Reference: the
+  // whole field scaled here, as hardness_noise did before (fbm_field, the range of the active
+  // cells, R = 1 - a (1 - n)). 40 x 600 cells (three blocks), a nodata disc across the first
+  // block boundary, so the range depends on rows of every block; rows taken inside a block,
+  // across both boundaries, at the edges and none. A range taken from the asked rows only
+  // (what a band would see alone) gives other bits: checked below.
+  Terrain t = flat_terrain(40, 600, 10.0);
+  t.mask.assign(t.grid.cells(), 1);
+  for (int r = 0; r < 600; ++r)
+    for (int c = 0; c < 40; ++c)
+      if (std::hypot(c - 20.0, r - 256.0) < 15.0) t.mask[static_cast<std::size_t>(r) * 40 + c] = 0;
+  const Params::Erosion e = noise_erosion(0.4, 150.0, 3);
+  std::vector<double> whole =
+      fbm_field(t.grid, e.noise_scale, e.noise_octaves, static_cast<std::uint64_t>(e.noise_seed));
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::size_t i = 0; i < whole.size(); ++i)
+    if (t.active(i)) lo = std::min(lo, whole[i]), hi = std::max(hi, whole[i]);
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    const double n = t.active(i) ? (whole[i] - lo) / (hi - lo) : 1.0;
+    whole[i] = 1.0 - e.noise_amplitude * (1.0 - std::min(1.0, std::max(0.0, n)));
+  }
+  ASSERT_TRUE(same_bits(hardness_noise(t, e), whole));
+  int differ = 0;
+  for (const auto& [r0, r1] : std::vector<std::pair<int, int>>{
+           {0, 600}, {10, 100}, {200, 300}, {255, 257}, {250, 520}, {599, 600}, {0, 1}, {7, 7}}) {
+    const std::vector<double> rows = hardness_noise_rows(t, e, r0, r1);
+    const std::vector<double> expected(whole.begin() + r0 * 40, whole.begin() + r1 * 40);
+    if (!same_bits(rows, expected)) ++differ;
+    EXPECT_TRUE(same_bits(rows, expected)) << "rows [" << r0 << ", " << r1 << ")";
+    const std::vector<double> fbm = fbm_rows(t.grid, e.noise_scale, e.noise_octaves,
+                                             static_cast<std::uint64_t>(e.noise_seed), r0, r1);
+    const std::vector<double> all =
+        fbm_field(t.grid, e.noise_scale, e.noise_octaves, static_cast<std::uint64_t>(e.noise_seed));
+    EXPECT_TRUE(same_bits(fbm, std::vector<double>(all.begin() + r0 * 40, all.begin() + r1 * 40)))
+        << "fbm rows [" << r0 << ", " << r1 << ")";
+  }
+  std::printf("[hardness noise] rows of the whole field: %d of 8 ranges differ\n", differ);
+  // the range of rows 10 .. 100 alone is narrower than the grid's: other values there
+  double band_lo = INFINITY, band_hi = -INFINITY;
+  const std::vector<double> all =
+      fbm_field(t.grid, e.noise_scale, e.noise_octaves, static_cast<std::uint64_t>(e.noise_seed));
+  for (std::size_t i = 400; i < 4000; ++i)
+    band_lo = std::min(band_lo, all[i]), band_hi = std::max(band_hi, all[i]);
+  std::printf(
+      "[hardness noise] fBm range of the grid's active cells [%.6g, %.6g], of rows 10 .. 100 "
+      "[%.6g, %.6g]\n",
+      lo, hi, band_lo, band_hi);
+  EXPECT_TRUE(band_lo > lo || band_hi < hi);
+  EXPECT_THROW(hardness_noise_rows(t, e, -1, 5), Error);
+  EXPECT_THROW(hardness_noise_rows(t, e, 5, 601), Error);
+}
+
 }  // namespace
 }  // namespace erodem::test

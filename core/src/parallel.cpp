@@ -178,19 +178,22 @@ void exchange(const void* send_up, void* recv_up, const void* send_down, void* r
 #ifdef ERODEM_HAVE_MPI
   const int n = size(), r = rank();
   if (n > 1) {
-    const int up = r > 0 ? r - 1 : MPI_PROC_NULL, down = r + 1 < n ? r + 1 : MPI_PROC_NULL;
     const int count = count_of(bytes);
-    // MPI checks the buffers even where the neighbour is MPI_PROC_NULL: none given, a byte
-    unsigned char none[1];
-    if (!send_up) send_up = none;
-    if (!recv_up) recv_up = none;
-    if (!send_down) send_down = none;
-    if (!recv_down) recv_down = none;
-    // northwards first (my first rows to the rank above, its halo below), then southwards
-    MPI_Sendrecv(send_up, count, MPI_BYTE, up, 1, recv_down, count, MPI_BYTE, down, 1,
-                 MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    MPI_Sendrecv(send_down, count, MPI_BYTE, down, 2, recv_up, count, MPI_BYTE, up, 2,
-                 MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    // Both directions at once (non-blocking): the receives posted first, then the sends, and
+    // one wait for all four, so an exchange costs one message latency, not one per direction
+    // (MPI_Sendrecv northwards, then southwards, before 2026-11-28). Tag 1: rows going north
+    // (my first rows to the rank above, its halo below); tag 2: rows going south.
+    MPI_Request requests[4];
+    int k = 0;
+    if (r > 0) {
+      MPI_Irecv(recv_up, count, MPI_BYTE, r - 1, 2, MPI_COMM_WORLD, &requests[k++]);
+      MPI_Isend(send_up, count, MPI_BYTE, r - 1, 1, MPI_COMM_WORLD, &requests[k++]);
+    }
+    if (r + 1 < n) {
+      MPI_Irecv(recv_down, count, MPI_BYTE, r + 1, 1, MPI_COMM_WORLD, &requests[k++]);
+      MPI_Isend(send_down, count, MPI_BYTE, r + 1, 2, MPI_COMM_WORLD, &requests[k++]);
+    }
+    MPI_Waitall(k, requests, MPI_STATUSES_IGNORE);
     return;
   }
 #endif

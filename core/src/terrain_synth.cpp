@@ -128,21 +128,23 @@ int ilog2(int n) {
 /// is sampled at (ox_o + x(c, r) f_o, oy_o + y(r) f_o) lattice units with f_o = freq0 2^o,
 /// its lattice seed and offsets (ox_o, oy_o) in [0, 1024) drawn from SplitMix64(`stream`).
 /// `ridged` selects the ridged multifractal ((1 - |n|)^2 signals weighted by the previous
-/// octave, after Musgrave) instead of plain fbm.
+/// octave, after Musgrave) instead of plain fbm. Rows [r0, r1) of the ny (all by default),
+/// row-major ((r1 - r0), nx): each point's value is its own, whatever rows are computed.
 template <class X, class Y>
 std::vector<double> perlin_octaves(int nx, int ny, int octaves, double freq0, std::uint64_t stream,
-                                   bool ridged, X x, Y y) {
+                                   bool ridged, X x, Y y, int r0 = 0, int r1 = -1) {
+  if (r1 < 0) r1 = ny;
   SplitMix64 rng(stream);
-  std::vector<double> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 0.0);
+  std::vector<double> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(r1 - r0), 0.0);
   std::vector<double> weight(ridged ? out.size() : 0, 1.0);
   double freq = freq0;
   double amp = 1.0;
   for (int o = 0; o < octaves; ++o) {
     const std::uint64_t oseed = rng.next();
     const double ox = 1024.0 * rng.uniform(), oy = 1024.0 * rng.uniform();
-    for (int r = 0; r < ny; ++r) {
+    for (int r = r0; r < r1; ++r) {
       for (int c = 0; c < nx; ++c) {
-        const std::size_t i = static_cast<std::size_t>(r) * nx + c;
+        const std::size_t i = static_cast<std::size_t>(r - r0) * nx + c;
         const double n = perlin(ox + x(c, r) * freq, oy + y(r) * freq, oseed);
         if (ridged) {
           double s = 1.0 - std::fabs(n);
@@ -371,7 +373,16 @@ std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell
 }
 
 std::vector<double> fbm_field(const Grid& grid, double scale_m, int octaves, std::uint64_t seed) {
+  return fbm_rows(grid, scale_m, octaves, seed, 0, grid.ny);
+}
+
+std::vector<double> fbm_rows(const Grid& grid, double scale_m, int octaves, std::uint64_t seed,
+                             int row0, int row1) {
   grid.validate();
+  if (row0 < 0 || row1 > grid.ny || row1 < row0)
+    throw Error(ExitCode::internal, "fbm field: rows [" + std::to_string(row0) + ", " +
+                                        std::to_string(row1) + ") of a grid of " +
+                                        std::to_string(grid.ny));
   if (!(std::isfinite(scale_m) && scale_m > 0.0))
     throw Error(ExitCode::usage, "fbm field: the scale must be a positive length (m)");
   if (octaves < 1 || octaves > 16)
@@ -393,10 +404,16 @@ std::vector<double> fbm_field(const Grid& grid, double scale_m, int octaves, std
                                      " x " + std::to_string(top) + " m");
   return perlin_octaves(
       grid.nx, grid.ny, octaves, 1.0 / scale_m, seed ^ 0x6A09E667F3BCC909ULL, false,
-      [&](int c, int r) { return (c + 0.5) * grid.dx[r]; }, [&](int r) { return y[r]; });
+      [&](int c, int r) { return (c + 0.5) * grid.dx[r]; }, [&](int r) { return y[r]; }, row0,
+      row1);
 }
 
 std::vector<double> hardness_noise(const Terrain& terrain, const Params::Erosion& erosion) {
+  return hardness_noise_rows(terrain, erosion, 0, terrain.grid.ny);
+}
+
+std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Erosion& erosion,
+                                        int row0, int row1) {
   const double a = erosion.noise_amplitude;
   if (!(std::isfinite(a) && a >= 0.0 && a <= 1.0))
     throw config_error("erosion.noise_amplitude", "must be in [0, 1] (1)");
@@ -407,17 +424,37 @@ std::vector<double> hardness_noise(const Terrain& terrain, const Params::Erosion
                        "must be between 1 and 16, got " + std::to_string(erosion.noise_octaves));
   // The seed is an int in the configuration; its two's-complement bits seed the PRNG.
   const auto seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(erosion.noise_seed));
-  std::vector<double> r = fbm_field(terrain.grid, erosion.noise_scale, erosion.noise_octaves, seed);
+  // The range of the whole grid's active cells, a block of rows at a time (the rows asked
+  // for kept as they pass), so that a band of rows holds no field of the whole grid.
+  const Grid& g = terrain.grid;
+  if (row0 < 0 || row1 > g.ny || row1 < row0)
+    throw Error(ExitCode::internal, "hardness noise: rows [" + std::to_string(row0) + ", " +
+                                        std::to_string(row1) + ") of a grid of " +
+                                        std::to_string(g.ny));
+  const auto nx = static_cast<std::size_t>(g.nx);
+  std::vector<double> r;
+  r.reserve(nx * static_cast<std::size_t>(std::max(row1 - row0, 0)));
+  constexpr int kBlockRows = 256;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    if (!terrain.active(i)) continue;
-    lo = std::min(lo, r[i]);
-    hi = std::max(hi, r[i]);
+  for (int b0 = 0; b0 < g.ny; b0 += kBlockRows) {
+    const int b1 = std::min(g.ny, b0 + kBlockRows);
+    const std::vector<double> block =
+        fbm_rows(g, erosion.noise_scale, erosion.noise_octaves, seed, b0, b1);
+    for (std::size_t k = 0; k < block.size(); ++k) {
+      if (!terrain.active(static_cast<std::size_t>(b0) * nx + k)) continue;
+      lo = std::min(lo, block[k]);
+      hi = std::max(hi, block[k]);
+    }
+    const int k0 = std::max(b0, row0), k1 = std::min(b1, row1);
+    if (k1 > k0)
+      r.insert(r.end(), block.begin() + static_cast<std::ptrdiff_t>(k0 - b0) * g.nx,
+               block.begin() + static_cast<std::ptrdiff_t>(k1 - b0) * g.nx);
   }
   const double range = hi - lo;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    const double n = terrain.active(i) && range > 0.0 ? (r[i] - lo) / range : 1.0;
-    r[i] = 1.0 - a * (1.0 - std::min(1.0, std::max(0.0, n)));
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    const std::size_t i = static_cast<std::size_t>(row0) * nx + k;
+    const double n = terrain.active(i) && range > 0.0 ? (r[k] - lo) / range : 1.0;
+    r[k] = 1.0 - a * (1.0 - std::min(1.0, std::max(0.0, n)));
   }
   return r;
 }

@@ -76,10 +76,10 @@ std::string root_string(const std::string& text);
 /// Collective (in one process: `mine`).
 std::vector<double> gather_owned(const std::vector<int>& owner, const std::vector<double>& mine);
 
-/// The halo exchange of a band: sends `bytes` at `send_up` to rank - 1 and at `send_down` to
-/// rank + 1, receiving into `recv_down` from rank + 1 and into `recv_up` from rank - 1 (none
-/// beyond the first and last rank; null buffers where there is none). Collective among
-/// neighbours.
+/// The halo exchange of a band (non-blocking, both directions at once): sends `bytes` at
+/// `send_up` to rank - 1 and at `send_down` to rank + 1, receiving into `recv_down` from
+/// rank + 1 and into `recv_up` from rank - 1 (none beyond the first and last rank; null
+/// buffers where there is none). Collective among neighbours.
 void exchange(const void* send_up, void* recv_up, const void* send_down, void* recv_down,
               std::size_t bytes);
 

@@ -76,6 +76,12 @@ std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell
 /// small that the last octave spans more than 2^40 wavelengths of the grid.
 std::vector<double> fbm_field(const Grid& grid, double scale_m, int octaves, std::uint64_t seed);
 
+/// Rows [row0, row1) of fbm_field (row-major ((row1 - row0), nx)): those rows of the whole
+/// field bit for bit, without computing the others. Throws Error(internal) for rows off the
+/// grid, and as fbm_field.
+std::vector<double> fbm_rows(const Grid& grid, double scale_m, int octaves, std::uint64_t seed,
+                             int row0, int row1);
+
 /// The erodibility R of `erosion.hardness = "noise"` on `terrain`'s grid: n = fbm_field(grid,
 /// erosion.noise_scale, erosion.noise_octaves, erosion.noise_seed) mapped linearly onto [0, 1]
 /// over the active cells (their minimum to 0, their maximum to 1), and R = 1 - a (1 - n) with
@@ -84,6 +90,12 @@ std::vector<double> fbm_field(const Grid& grid, double scale_m, int octaves, std
 /// host; the backends round it like a hardness raster, so every backend sees the same values.
 /// Throws erodem::Error(ExitCode::config) naming the key for an out-of-range noise setting.
 std::vector<double> hardness_noise(const Terrain& terrain, const Params::Erosion& erosion);
+
+/// Rows [row0, row1) of hardness_noise (row-major ((row1 - row0), nx)), bit for bit, holding
+/// no field of the whole grid: the range of the active cells is found a block of rows at a
+/// time (an MPI band's initial state: build_padded_state).
+std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Erosion& erosion,
+                                        int row0, int row1);
 
 /// Builds a Terrain from the `[dem]` synthetic settings: kind `dem.synthetic`, a square grid
 /// of `dem.size` cells per side (Grid::uniform, no CRS), cell size `dem.cell_size` (m; 10 m
