@@ -61,7 +61,9 @@ BackendChoice auto_backend_choice(const std::vector<ClDeviceInfo>& devices,
   if (gpu != devices.end()) {
     c.backend = "opencl";
     c.device = static_cast<int>(gpu - devices.begin());
-    c.reason = "the first OpenCL GPU";
+    c.reason = parallel::size() > 1 ? "an OpenCL GPU (under MPI, the ranks of a machine take its "
+                                      "GPUs in turn)"
+                                    : "the first OpenCL GPU";
     return c;
   }
   c.backend = "cpu";
@@ -88,7 +90,19 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const Terrain& te
       reason = "auto: float64 runs on the CPU reference (OpenCL runs float32 only)";
     } else {
       const char* env = std::getenv("ERODEM_OPENCL_DEVICE");
-      const BackendChoice choice = auto_backend_choice(list_opencl_devices(), env ? env : "");
+      BackendChoice choice = auto_backend_choice(list_opencl_devices(), env ? env : "");
+      // MPI (docs/mpi.md): the ranks must run one backend (their collectives come at different
+      // points of a step on the two, and the bits would differ), so OpenCL only where every
+      // rank would choose it, and every rank says so. Collective: every rank asks (in one
+      // process the identity).
+      const bool some_cpu = parallel::any(choice.backend == "cpu"),
+                 some_opencl = parallel::any(choice.backend != "cpu");
+      if (some_cpu && some_opencl) {
+        choice.backend = "cpu";
+        choice.reason = fmt::format(
+            "the CPU reference: not every one of the {} MPI ranks has an OpenCL GPU (here: {})",
+            parallel::size(), choice.reason);
+      }
       // No choice (a selector that matches nothing): the OpenCL backend says why, exit 2.
       b = choice.backend != "cpu" ? make_opencl_backend(terrain, params)
                                   : make_cpu_backend(terrain, params);

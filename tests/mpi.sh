@@ -27,7 +27,7 @@
 #    step 40 on 2 ranks and on 4, and on one process from a file written by 4 ranks, each
 #    against the serial run of 40 steps;
 #  - refusals: what N > 1 ranks refuse, each with its exit code and a message naming it:
-#    --backend opencl (2), transport.scheme = "semi_lagrangian" (78), bands thinner than
+#    transport.scheme = "semi_lagrangian" (78, on both backends), bands thinner than
 #    the halo (4 ranks on 7 rows: 2), and (parallel HDF5, where unshare -m may mount) an
 #    output folder rank 1 sees as another, empty folder (73);
 #  - interrupt: a stop signal (SIGTERM, SIGUSR1) to erodem, and to each rank under mpirun 0.5 s
@@ -262,6 +262,25 @@ if [ "$scenario" = refusals ]; then
   fi
   refused "bands thinner than the halo" 2 "each rank needs at least 2" -np 4 --backend cpu \
     --set dem.size=7
+  # `--backend auto` where one rank would pick OpenCL and the other the CPU reference (rank 1
+  # names PoCL in ERODEM_OPENCL_DEVICE): every rank must run the CPU reference, and say why
+  # (the two backends' collectives differ: mixed, the ranks wait for each other for ever).
+  if "$erodem" devices 2>/dev/null | grep -q "^  platform "; then
+    printf '%s\n' '#!/bin/sh' \
+      'if [ "${OMPI_COMM_WORLD_RANK:-0}" = 1 ]; then export ERODEM_OPENCL_DEVICE=":"; fi' \
+      'exec "$@"' >mixed.sh
+    rc=0
+    timeout 120 "${mpi[@]}" -np 2 sh mixed.sh "$erodem" run scenario.toml --output mixed.h5 \
+      --overwrite --backend auto >mixed.log 2>&1 || rc=$?
+    if [ $rc -ne 0 ] || ! grep -q "not every one of the 2 MPI ranks has an OpenCL GPU" mixed.log ||
+      ! "$erodem" info mixed.h5 2>/dev/null | grep -q "CPU reference"; then
+      echo "FAIL auto with an OpenCL device on one rank only: exit $rc (expected 0), log:"
+      grep -m3 "erodem\|auto" mixed.log
+      failed=1
+    else
+      echo "auto with an OpenCL device on one rank only: exit 0, $(grep -m1 -o "auto: .*" mixed.log | cut -c1-100)"
+    fi
+  fi
   # An output folder that is not one folder for every rank: rank 1 runs in a mount namespace
   # of its own (unshare -m) with an empty tmpfs over ./shared, as a node-local disk would be.
   # Exit 73 naming the folder and rank 1, and nothing left in the folder. Needs parallel HDF5

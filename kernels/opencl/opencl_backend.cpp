@@ -640,7 +640,8 @@ void OpenClBackend::finish() {
 }
 
 OpenClBackend::~OpenClBackend() {
-  if (profile_pending_.empty()) return;
+  // the commands still queued may read host arrays this object owns (the halo rows written
+  // without waiting, the point inflows) or hold profiling events: all complete before those go
   clFinish(queue_.get());
   for (auto& [name, ev] : profile_pending_)
     if (ev) clReleaseEvent(ev);

@@ -146,7 +146,7 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
 class OpenClBackend final : public Backend {
  public:
   OpenClBackend(const Terrain& terrain, const Params& params, const std::string& selector = "");
-  ~OpenClBackend() override;  // releases the profiling events still pending
+  ~OpenClBackend() override;  // waits for the queue; releases the pending profiling events
 
   std::string name() const override { return "opencl"; }
   std::string device() const override;
