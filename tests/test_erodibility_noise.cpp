@@ -29,7 +29,9 @@ Params::Erosion noise_erosion(double a, double scale, int seed = 1) {
 }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+  // (no memcmp of empty vectors: their data() may be null, which memcmp must not get)
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
 TEST(ErodibilityNoise, FieldSpansOneMinusAmplitudeToOne) {
