@@ -343,9 +343,8 @@ void OpenClBackend::set_field_rows(FieldId id, int row0, int row1,
   // DEM row r is raster row r + 1 - band_.row0), so no exchange between ranks is needed
   const int r0 = std::max(row0, band_.row0 - 1), r1 = std::min(row1, band_.row0 - 1 + H_);
   if (r1 <= r0) return;
-  const auto first = values.begin() + static_cast<std::ptrdiff_t>(r0 - row0) * nx_;
-  const std::vector<double> held(first, first + static_cast<std::ptrdiff_t>(r1 - r0) * nx_);
-  const std::vector<float> v(held.begin(), held.end());
+  const auto held = values.begin() + static_cast<std::ptrdiff_t>(r0 - row0) * nx_;
+  const std::vector<float> v(held, held + static_cast<std::ptrdiff_t>(r1 - r0) * nx_);
   const int y0 = r0 - band_.row0, y1 = r1 - band_.row0;  // write_interior's rows
   write_interior(queue_.get(), dst->get(), nx_, y0, y1, v);
   if (twin) write_interior(queue_.get(), twin->get(), nx_, y0, y1, v);
@@ -353,7 +352,7 @@ void OpenClBackend::set_field_rows(FieldId id, int row0, int row1,
     // a bed keeps what float cannot hold in its residual (set bed_residual after the bed)
     std::vector<float> lo(v.size());
     for (std::size_t i = 0; i < v.size(); ++i)
-      lo[i] = static_cast<float>(held[i] - static_cast<double>(v[i]));
+      lo[i] = static_cast<float>(held[static_cast<std::ptrdiff_t>(i)] - static_cast<double>(v[i]));
     write_interior(queue_.get(), bed_residual_.get(), nx_, y0, y1, lo);
     copy_periodic_columns(bed_residual_);
   }
