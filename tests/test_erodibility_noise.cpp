@@ -28,6 +28,15 @@ Params::Erosion noise_erosion(double a, double scale, int seed = 1) {
   return e;
 }
 
+/// Makes every cell of `t` active but a nodata disc of `radius` cells around (col, row).
+void mask_disc(Terrain& t, double col, double row, double radius) {
+  const int nx = t.grid.nx, ny = t.grid.ny;
+  t.mask.assign(t.grid.cells(), 1);
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c)
+      if (std::hypot(c - col, r - row) < radius) t.mask[static_cast<std::size_t>(r) * nx + c] = 0;
+}
+
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
   // (no memcmp of empty vectors: their data() may be null, which memcmp must not get)
   return a.size() == b.size() &&
@@ -39,10 +48,7 @@ TEST(ErodibilityNoise, FieldSpansOneMinusAmplitudeToOne) {
   // cells R must lie in [1 - a, 1] and reach both ends exactly (the minimum of the fBm maps
   // to n = 0, R = 1 - a; the maximum to n = 1, R = 1); nodata cells hold 1.
   Terrain t = flat_terrain(96, 64, 10.0);
-  t.mask.assign(t.grid.cells(), 1);
-  for (int r = 0; r < 64; ++r)
-    for (int c = 0; c < 96; ++c)
-      if (std::hypot(c - 48.0, r - 32.0) < 26.0) t.mask[static_cast<std::size_t>(r) * 96 + c] = 0;
+  mask_disc(t, 48.0, 32.0, 26.0);
   const double a = 0.3;
   const auto R = hardness_noise(t, noise_erosion(a, 200.0));
   ASSERT_EQ(R.size(), t.grid.cells());
@@ -228,10 +234,7 @@ TEST(ErodibilityNoise, RowsAreThoseOfTheWholeFieldHoldingNoWholeField) {
   // across both boundaries, at the edges and none. A range taken from the asked rows only
   // (what a band would see alone) gives other bits: checked below.
   Terrain t = flat_terrain(40, 600, 10.0);
-  t.mask.assign(t.grid.cells(), 1);
-  for (int r = 0; r < 600; ++r)
-    for (int c = 0; c < 40; ++c)
-      if (std::hypot(c - 20.0, r - 256.0) < 15.0) t.mask[static_cast<std::size_t>(r) * 40 + c] = 0;
+  mask_disc(t, 20.0, 256.0, 15.0);
   const Params::Erosion e = noise_erosion(0.4, 150.0, 3);
   std::vector<double> whole =
       fbm_field(t.grid, e.noise_scale, e.noise_octaves, static_cast<std::uint64_t>(e.noise_seed));
