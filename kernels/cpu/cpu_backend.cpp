@@ -32,22 +32,17 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
       W_(terrain.grid.nx + 2),
       H_(terrain.grid.ny + 2) {
   // the padded rows this backend holds: all of them, or a band's (band_rows.hpp)
-  const BandRows band = band_rows(params, ny_);
-  banded_ = band.banded;
-  halo_rows_ = band.halo;
-  row0_ = band.row0;
-  H_ = band.rows;
-  own0_ = band.own0;
-  own1_ = band.own1;
-  PaddedState s = build_padded_state(terrain, params, row0_, row0_ + H_);
+  band_ = band_rows(params, ny_);
+  H_ = band_.rows;
+  PaddedState s = build_padded_state(terrain, params, band_.row0, band_.row0 + H_);
   periodic_ = s.periodic_x;
-  tails_ = sweeps_tails(params, periodic_ || banded_);
+  tails_ = sweeps_tails(params, periodic_ || band_.banded);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
   // MPI: the ranks on this machine share its cores (unless OMP_NUM_THREADS says otherwise)
-  if (banded_ && params.numerics.threads <= 0 && !std::getenv("OMP_NUM_THREADS"))
+  if (band_.banded && params.numerics.threads <= 0 && !std::getenv("OMP_NUM_THREADS"))
     threads_ = std::max(1, threads_ / parallel::local_size());
 #else
   threads_ = 1;
@@ -120,9 +115,9 @@ std::string CpuBackend<Real>::device() const {
   return fmt::format(
       "CPU reference, {}, {} thread{}, {}{}", sizeof(Real) == 4 ? "float32" : "float64", threads_,
       threads_ == 1 ? "" : "s", cpu_isa_label,
-      banded_ ? fmt::format(" (a rank), {} MPI ranks in bands of rows, halo {} row{}",
-                            parallel::size(), halo_rows_, halo_rows_ == 1 ? "" : "s")
-              : "");
+      band_.banded ? fmt::format(" (a rank), {} MPI ranks in bands of rows, halo {} row{}",
+                                 parallel::size(), band_.halo, band_.halo == 1 ? "" : "s")
+                   : "");
 }
 
 template <class Real>
@@ -130,11 +125,12 @@ double CpuBackend<Real>::sum_rows(const std::vector<double>& rows) const {
   // In a band: the sums of every rank's own rows in global row order. The grid's ghost rows
   // (0 in every row sum) and the halo rows are left out; adding 0.0 to a sum that starts at
   // +0.0 changes no bit, so this is the one-process sum.
-  const std::vector<double> all =
-      banded_ ? parallel::allgather(std::vector<double>(rows.begin() + own0_, rows.begin() + own1_))
-              : std::vector<double>();
+  const std::vector<double> all = band_.banded
+                                      ? parallel::allgather(std::vector<double>(
+                                            rows.begin() + band_.own0, rows.begin() + band_.own1))
+                                      : std::vector<double>();
   double s = 0.0;
-  for (double v : banded_ ? all : rows) s += v;
+  for (double v : band_.banded ? all : rows) s += v;
   return s;
 }
 
@@ -145,7 +141,7 @@ std::vector<double> CpuBackend<Real>::gather_cells(const std::vector<std::int64_
   std::vector<double> mine;
   for (const std::int64_t cell : cells)
     if (owns(cell)) mine.push_back(value(padded(cell)));
-  if (!banded_) return mine;
+  if (!band_.banded) return mine;
   return parallel::gather_owned(cell_owners(cells, nx_, ny_), mine);
 }
 
@@ -210,7 +206,7 @@ bool CpuBackend<Real>::fuses(const std::vector<Process>& pass) const {
   const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water},
       water_only{Process::flow, Process::sources, Process::water, Process::evaporation};
   return (pass == flow_water || pass == water_only) &&
-         params_.flow.scheme != FlowScheme::shallow_water && !periodic_ && !banded_;
+         params_.flow.scheme != FlowScheme::shallow_water && !periodic_ && !band_.banded;
 }
 
 template <class Real>
@@ -227,7 +223,7 @@ void CpuBackend<Real>::run_pass(const std::vector<Process>& pass) {
 
 template <class Real>
 void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
-  if (!periodic_ && !banded_) return;
+  if (!periodic_ && !band_.banded) return;
   std::vector<Real*> fields;
   for (const std::string& name : names) {
     Field* f = name == "depth_flow"      ? &depth_next_
@@ -246,27 +242,27 @@ template <class Real>
 void CpuBackend<Real>::exchange_fields(const std::vector<Real*>& fields) {
   if (periodic_)
     for (Real* f : fields) copy_periodic_columns(f, W_, H_);
-  if (!banded_ || fields.empty()) return;
-  // whole padded rows (the ghost columns and the corners with them): my first halo_rows_ own
+  if (!band_.banded || fields.empty()) return;
+  // whole padded rows (the ghost columns and the corners with them): my first band_.halo own
   // rows to the band above, my last to the band below; theirs into my halo rows. Every field's
   // rows packed into one message each way.
   const int r = parallel::rank(), ranks = parallel::size();
   const bool up = r > 0, down = r + 1 < ranks;
-  const std::size_t per = static_cast<std::size_t>(halo_rows_) * static_cast<std::size_t>(W_);
+  const std::size_t per = static_cast<std::size_t>(band_.halo) * static_cast<std::size_t>(W_);
   const std::size_t n = per * fields.size();
   halo_buffer_.resize(4 * n);
   Real *send_up = halo_buffer_.data(), *recv_up = send_up + n, *send_down = recv_up + n,
        *recv_down = send_down + n;
   auto row = [&](Real* f, int y) { return f + static_cast<std::size_t>(y) * W_; };
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    std::copy_n(row(fields[k], own0_), per, send_up + k * per);
-    std::copy_n(row(fields[k], own1_ - halo_rows_), per, send_down + k * per);
+    std::copy_n(row(fields[k], band_.own0), per, send_up + k * per);
+    std::copy_n(row(fields[k], band_.own1 - band_.halo), per, send_down + k * per);
   }
   parallel::exchange(up ? send_up : nullptr, up ? recv_up : nullptr, down ? send_down : nullptr,
                      down ? recv_down : nullptr, n * sizeof(Real));
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    if (up) std::copy_n(recv_up + k * per, per, row(fields[k], own0_ - halo_rows_));
-    if (down) std::copy_n(recv_down + k * per, per, row(fields[k], own1_));
+    if (up) std::copy_n(recv_up + k * per, per, row(fields[k], band_.own0 - band_.halo));
+    if (down) std::copy_n(recv_down + k * per, per, row(fields[k], band_.own1));
   }
 }
 
@@ -299,16 +295,16 @@ void CpuBackend<Real>::set_faces(const std::vector<Face>& faces) {
   // halo); others' -1
   face_owner_ = face_owners(faces, ny_);
   const int rank = parallel::rank();
-  if (banded_)
+  if (band_.banded)
     for (std::size_t j = 0; j < faces.size(); ++j)
-      face_codes_[j] = face_owner_[j] == rank ? face_codes_[j] - 2 * row0_ * W_ : -1;
+      face_codes_[j] = face_owner_[j] == rank ? band_.face_code(face_codes_[j], nx_) : -1;
   face_water_.assign(face_codes_.size(), 0.0);
   face_sediment_.assign(face_codes_.size(), 0.0);
 }
 
 template <class Real>
 std::vector<double> CpuBackend<Real>::gather_faces(const std::vector<double>& values) const {
-  if (!banded_) return values;
+  if (!band_.banded) return values;
   std::vector<double> mine;
   for (std::size_t j = 0; j < values.size(); ++j)
     if (face_codes_[j] >= 0) mine.push_back(values[j]);
@@ -357,9 +353,9 @@ FieldStats CpuBackend<Real>::stats() {
   std::vector<RowStats> rows(static_cast<std::size_t>(H_ - 2));
   for_rows(1, H_ - 1,
            [&](int y) { rows[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_.data()); });
-  if (banded_)  // every rank's own rows, in global row order
+  if (band_.banded)  // every rank's own rows, in global row order
     rows = parallel::allgather(
-        std::vector<RowStats>(rows.begin() + (own0_ - 1), rows.begin() + (own1_ - 1)));
+        std::vector<RowStats>(rows.begin() + (band_.own0 - 1), rows.begin() + (band_.own1 - 1)));
   return merge_row_stats(rows);
 }
 
@@ -371,7 +367,7 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
              *vx = velocity_x_.data(), *vy = velocity_y_.data();
   const double a = area_[y];
   const std::size_t base = static_cast<std::size_t>(y) * W_;
-  const std::int64_t row_cell = static_cast<std::int64_t>(y - 1 + row0_) * nx_ - 1;
+  const std::int64_t row_cell = static_cast<std::int64_t>(y - 1 + band_.row0) * nx_ - 1;
   double water = 0, material = 0, sed = 0, max_d = -1, max_v2 = -1;
   std::size_t fastest = 0;
   for (int x = 1; x < W_ - 1; ++x) {
@@ -416,7 +412,7 @@ template <class Real>
 std::vector<double> CpuBackend<Real>::field_rows(FieldId id, int row0, int row1) const {
   // this rank's rows of [row0, row1), then every rank's in row order
   OwnRows own = own_field_rows(id, row0, row1);
-  if (banded_) return parallel::allgather(own.values);
+  if (band_.banded) return parallel::allgather(own.values);
   return std::move(own.values);
 }
 
@@ -424,11 +420,12 @@ template <class Real>
 OwnRows CpuBackend<Real>::own_field_rows(FieldId id, int row0, int row1) const {
   check_row_range(id, row0, row1, nx_, ny_);
   // the rows of [row0, row1) this rank owns (all of them in one process; DEM row r is padded
-  // row r + 1 - row0_)
-  const int y0 = std::max(own0_, row0 + 1 - row0_), y1 = std::min(own1_, row1 + 1 - row0_);
+  // row r + 1 - band_.row0)
+  const int y0 = std::max(band_.own0, row0 + 1 - band_.row0),
+            y1 = std::min(band_.own1, row1 + 1 - band_.row0);
   OwnRows out;
-  out.row0 = y1 > y0 ? y0 - 1 + row0_ : row0;
-  out.row1 = y1 > y0 ? y1 - 1 + row0_ : row0;
+  out.row0 = y1 > y0 ? y0 - 1 + band_.row0 : row0;
+  out.row1 = y1 > y0 ? y1 - 1 + band_.row0 : row0;
   out.values.resize(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(std::max(y1 - y0, 0)));
   if (!fields_.reads_zeros(id)) {  // a field not made yet: its zeros, without an array of them
     const Field* src = fields_.peek(id);
@@ -461,7 +458,7 @@ void CpuBackend<Real>::set_field_rows(FieldId id, int row0, int row1,
   if (twin && twin->empty()) twin = nullptr;  // a field updated in place (bed_next_)
   // the DEM rows the padded raster holds (a band's own and halo rows in an MPI run)
   for (int y = 0; y < H_; ++y) {
-    const int r = y + row0_ - 1;
+    const int r = y + band_.row0 - 1;
     if (r < row0 || r >= row1) continue;
     for (int c = 0; c < nx_; ++c) {
       const auto p = at(c + 1, y);
@@ -482,7 +479,7 @@ void CpuBackend<Real>::set_field_rows(FieldId id, int row0, int row1,
 
 template <class Real>
 HostView CpuBackend<Real>::host_view(FieldId id) {
-  Field* src = banded_ ? nullptr : field_storage(id);  // a band holds part of the field
+  Field* src = band_.banded ? nullptr : field_storage(id);  // a band holds part of the field
   if (!src) return {};
   return {src->data() + at(1, 1), sizeof(Real), static_cast<std::ptrdiff_t>(W_)};
 }

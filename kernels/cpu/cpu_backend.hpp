@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "band_rows.hpp"
 #include "cell_params.hpp"
 #include "common/compat.h"
 #include "common/erosion.h"
@@ -112,7 +113,7 @@ class CpuBackend final : public Backend {
   /// the halo rows from the neighbouring ranks (exchange_fields); nothing otherwise.
   void exchange_halo(const std::vector<std::string>& names);
   /// The halo exchange of padded fields (W_ x H_ each): their periodic ghost columns, then (a
-  /// band of an MPI run) their halo_rows_ rows on either side from the neighbouring ranks, all
+  /// band of an MPI run) their band_.halo rows on either side from the neighbouring ranks, all
   /// the fields in one message each way.
   void exchange_fields(const std::vector<Real*>& fields);
 
@@ -125,7 +126,7 @@ class CpuBackend final : public Backend {
   /// Index in the padded raster (the band's, in an MPI run) of DEM cell `cell` (row-major
   /// (ny, nx)), which the raster holds (holds()).
   std::size_t padded(std::int64_t cell) const {
-    return at(static_cast<int>(cell % nx_) + 1, static_cast<int>(cell / nx_) + 1 - row0_);
+    return static_cast<std::size_t>(band_.padded(cell, nx_));
   }
   /// Local inertial or pipes: the new outflows of every padded row over the old ones in
   /// flux_ (in place, as the shallow-water scheme's too), each thread walking its
@@ -147,14 +148,8 @@ class CpuBackend final : public Backend {
   void book_water_rows(Real dt, StepTally& tally);
   /// Whether the padded raster holds DEM cell `cell` (always, but in a band of an MPI run:
   /// its rows and its halo rows), and whether this rank owns it (its rows).
-  bool holds(std::int64_t cell) const {
-    const auto y = cell / nx_ + 1 - row0_;
-    return y >= 0 && y < H_;
-  }
-  bool owns(std::int64_t cell) const {
-    const auto y = cell / nx_ + 1 - row0_;
-    return y >= own0_ && y < own1_;
-  }
+  bool holds(std::int64_t cell) const { return band_.holds(cell, nx_); }
+  bool owns(std::int64_t cell) const { return band_.owns(cell, nx_); }
   /// value(cell) of the cells this rank owns, gathered from every rank into the order of
   /// `cells` (in one process: value(cell) of each).
   template <class F>
@@ -301,14 +296,9 @@ class CpuBackend final : public Backend {
   Params params_;
   CellParams<Real> cell_;  // the processes' run constants (cell_params.hpp)
   int nx_, ny_, W_, H_;    // the DEM (all of it) and the padded raster (a band's in MPI)
-  // The MPI band (docs/mpi.md): the padded raster holds the global padded rows [row0_,
-  // row0_ + H_); this rank owns its rows [own0_, own1_) (the DEM rows it computes, tallies and
-  // writes); the others are halo rows (received after every sweep) or the grid's ghost rows.
-  // One process: row0_ 0, own0_ 1, own1_ H_ - 1.
-  bool banded_ = false;
-  int row0_ = 0, own0_ = 1, own1_ = 0;
-  // The rows of halo a band holds on either side of its own (BandRows::halo, band_rows.hpp).
-  int halo_rows_ = 1;
+  // The padded rows held: all; a band's in an MPI run (band_rows.hpp, docs/mpi.md). H_ is
+  // band_.rows.
+  BandRows band_;
   std::vector<Real> halo_buffer_;  // exchange_fields: send up, receive up, send/receive down
   int threads_;
   bool periodic_ = false;  // boundary.periodic_x (PaddedState::periodic_x)
