@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """erodem — every cell loop of the CPU reference vectorises (ctest CpuVectorisation).
 
-The cell loops of kernels/cpu/*.cpp are the loops marked ERODEM_IVDEP. A loop the compiler
+The cell loops of kernels/cpu/*.cpp are the loops marked ERODEM_IVDEP or `#pragma omp simd`
+(the statistics' reductions, stats_row). A loop the compiler
 leaves scalar runs several times slower and no result shows it: on 2026-11-28 the water
 update's loop had been scalar for a day (a conditional load GCC could not if-convert: 15.4 ms
 against 4.2 ms at 1024², docs/performance.md "The water update's loop vectorises again").
@@ -44,12 +45,15 @@ KNOWN_SCALAR = {
 
 
 def marked_loops(path):
-    """Line numbers (1-based) and text of the loops right after an ERODEM_IVDEP line."""
+    """Line numbers (1-based) and text of the loops right after an ERODEM_IVDEP or an
+    `#pragma omp simd` line (GCC reports an `omp simd` loop at its pragma's line: that line
+    number then)."""
     lines = open(path, encoding="utf-8").read().split("\n")
     out = []
     for k, line in enumerate(lines[:-1]):
-        if line.strip() == "ERODEM_IVDEP" and lines[k + 1].lstrip().startswith("for"):
-            out.append((k + 2, lines[k + 1].strip()))
+        simd = line.strip().startswith("#pragma omp simd")
+        if (simd or line.strip() == "ERODEM_IVDEP") and lines[k + 1].lstrip().startswith("for"):
+            out.append((k + 1 if simd else k + 2, lines[k + 1].strip()))
     return out
 
 

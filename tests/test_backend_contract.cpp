@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -424,6 +426,159 @@ TEST_P(BackendContract, RunOutsideAStepIsAnError) {
     EXPECT_EQ(e.code(), ExitCode::internal) << e.what();
   }
   EXPECT_THROW(be.end_step(), Error);
+}
+
+/// The statistics of `depth`, `u`, `v` (whole DEM fields, row-major) over the cells `mask`
+/// leaves active, by one scan in row-major order (independent of the backends' loops): the
+/// volumes added row by row (each row's sum in x order, then the rows in order), the first cell
+/// of the largest depth and of the largest squared speed, and the first active cell whose
+/// depth is negative or not finite (bed and sediment are finite here).
+FieldStats scan_stats(const Grid& g, const std::vector<std::uint8_t>& mask,
+                      const std::vector<double>& depth, const std::vector<double>& u,
+                      const std::vector<double>& v) {
+  FieldStats st;
+  st.max_depth = 0.0;
+  st.max_speed = 0.0;
+  double max_d = -1, max_v2 = -1;
+  for (int y = 0; y < g.ny; ++y) {
+    double row = 0;
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * g.nx + x;
+      if (!mask[i]) continue;
+      row += depth[i] * g.area[y];
+      if (st.bad_cell < 0 && !(depth[i] >= 0 && std::isfinite(depth[i])))
+        st.bad_cell = static_cast<std::int64_t>(i);
+      if (depth[i] > max_d) {
+        max_d = depth[i];
+        st.max_depth = std::max(0.0, depth[i]);
+        st.max_depth_cell = static_cast<std::int64_t>(i);
+      }
+      const double v2 = u[i] * u[i] + v[i] * v[i];
+      if (v2 > max_v2) {
+        max_v2 = v2;
+        st.max_speed = std::hypot(u[i], v[i]);
+        st.max_speed_cell = static_cast<std::int64_t>(i);
+      }
+    }
+    st.water_volume += row;
+  }
+  return st;
+}
+
+// The statistics take the first cell of each tie in row-major order, skip the nodata cells
+// (which hold the largest depth and speed here), never rank a NaN, and name the first active
+// cell that is not physical; the water volume is the per-row sums' in row order. Four states
+// on a 300 x 19 grid with 5 nodata cells (rows of three chunks of the CPU's row maxima),
+// against scan_stats of the fields read back: ties of the largest depth (two cells in the
+// second chunk of a row, one in its third, one in a later row) and of the squared speed ((3,
+// 4) and (-4, 3) in the second and third chunks of one row, then (4, -3), (0, -5): 25
+// m^2/s^2); a still state of zero depths (-0 in each row's first chunk, +0 beyond) whose first
+// active cell wins both; NaN depths; negative depths with finite volumes (a nodata cell first
+// in both). Cells must be equal; the volume bit for bit on the CPU (its sums are the scan's:
+// the ledger's bits), within 1e-6 on OpenCL (float partial sums on the device). A backend that
+// kept the last cell or chunk of a tie, let a nodata cell in, ranked a NaN or looked for bad
+// cells only where a volume is not finite fails a cell comparison.
+TEST_P(BackendContract, StatisticsTakeTheFirstCellOfATie) {
+  const int nx = 300, ny = 19;  // 3 chunks of the CPU's row maxima (kStatsChunk 128)
+  Terrain t;
+  t.grid = Grid::uniform(nx, ny, 10.0);
+  t.bed.resize(t.grid.cells());
+  for (std::size_t i = 0; i < t.bed.size(); ++i)
+    t.bed[i] = 5.0 + 0.01 * static_cast<double>(i % nx);
+  t.mask.assign(t.grid.cells(), 1);
+  auto at = [&](int x, int y) { return static_cast<std::size_t>(y) * nx + x; };
+  for (const std::size_t i : {at(0, 0), at(4, 1), at(15, 6), at(140, 3), at(299, 18)})
+    t.mask[i] = 0;
+  Params p;
+  p.dem.synthetic = "valley";  // the schema's requirement; the backend takes the terrain above
+  p.dem.cell_size = 10.0;
+  p.numerics.precision = target().precision;
+  validate(p, "ties");
+  std::unique_ptr<Backend> be = make_backend(target().backend, t, p);
+
+  struct State {
+    const char* label;
+    std::vector<double> depth, u, v;
+  };
+  const std::size_t n = t.grid.cells();
+  std::vector<State> states;
+  {
+    State s{"ties", std::vector<double>(n, 0.25), std::vector<double>(n, 0.5),
+            std::vector<double>(n, -1.0)};
+    s.depth[at(4, 1)] = 0.9;    // nodata: not ranked
+    s.depth[at(140, 3)] = 0.9;  // nodata: not ranked
+    // the first two in the second chunk of row 3, the third in its third chunk
+    for (const std::size_t i : {at(150, 3), at(200, 3), at(270, 3), at(2, 15)}) s.depth[i] = 0.75;
+    s.u[at(15, 6)] = 9.0;                           // nodata
+    s.u[at(135, 2)] = 3.0, s.v[at(135, 2)] = 4.0;   // second chunk
+    s.u[at(260, 2)] = -4.0, s.v[at(260, 2)] = 3.0;  // third chunk of the same row
+    s.u[at(5, 10)] = 4.0, s.v[at(5, 10)] = -3.0;
+    s.u[at(0, 18)] = 0.0, s.v[at(0, 18)] = -5.0;
+    states.push_back(s);
+  }
+  {
+    State s{"still", std::vector<double>(n, 0.0), std::vector<double>(n, 0.0),
+            std::vector<double>(n, 0.0)};
+    // -0 in the first chunk of every row, +0 beyond, and +0 and -0 alternating in row 0
+    for (std::size_t i = 0; i < n; ++i)
+      if (i % nx < 128 || (i < static_cast<std::size_t>(nx) && i % 2)) s.depth[i] = -0.0;
+    states.push_back(s);
+  }
+  {
+    State s = states[0];
+    s.label = "nan";
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    s.depth[at(4, 1)] = nan;  // nodata: not bad
+    s.depth[at(9, 4)] = nan;
+    s.depth[at(3, 12)] = nan;
+    s.depth[at(290, 3)] = 0.95;  // the largest beside them (third chunk)
+    states.push_back(s);
+  }
+  {
+    State s = states[0];
+    s.label = "negative";      // finite volumes: only a depth below 0 shows the bad cells
+    s.depth[at(4, 1)] = -0.5;  // nodata: not bad
+    s.depth[at(12, 2)] = -0.01;
+    s.depth[at(3, 7)] = -0.02;
+    states.push_back(s);
+  }
+  int differing = 0;
+  for (const State& s : states) {
+    be->set_field(FieldId::water_depth, s.depth);
+    be->set_field(FieldId::velocity_x, s.u);
+    be->set_field(FieldId::velocity_y, s.v);
+    const FieldStats got = be->stats();
+    const FieldStats want =
+        scan_stats(t.grid, t.mask, be->field(FieldId::water_depth), be->field(FieldId::velocity_x),
+                   be->field(FieldId::velocity_y));
+    // 0 where the two agree bit for bit (the still state's 0 and the NaN state's NaN)
+    const double vol_rel =
+        same_bits(got.water_volume, want.water_volume)
+            ? 0.0
+            : std::abs(got.water_volume - want.water_volume) / std::abs(want.water_volume);
+    std::printf(
+        "[backend contract] %s statistics of '%s': max depth %.6g m at cell %lld (scan: %.6g at "
+        "%lld), max speed %.6g m/s at %lld (scan: %.6g at %lld), first bad cell %lld (scan: "
+        "%lld), water %.17g m^3 (scan: %.17g; relative difference %.2e, bound %s)\n",
+        target().label().c_str(), s.label, got.max_depth,
+        static_cast<long long>(got.max_depth_cell), want.max_depth,
+        static_cast<long long>(want.max_depth_cell), got.max_speed,
+        static_cast<long long>(got.max_speed_cell), want.max_speed,
+        static_cast<long long>(want.max_speed_cell), static_cast<long long>(got.bad_cell),
+        static_cast<long long>(want.bad_cell), got.water_volume, want.water_volume, vol_rel,
+        target().backend == "cpu" ? "0" : "1e-6");
+    const bool cells = got.max_depth_cell == want.max_depth_cell &&
+                       got.max_speed_cell == want.max_speed_cell && got.bad_cell == want.bad_cell;
+    const bool values =
+        same_bits(got.max_depth, want.max_depth) && same_bits(got.max_speed, want.max_speed);
+    const bool volume = target().backend == "cpu" ? same_bits(got.water_volume, want.water_volume)
+                                                  : vol_rel <= 1e-6;
+    EXPECT_TRUE(cells) << s.label << ": the cells differ from the scan's";
+    EXPECT_TRUE(values) << s.label << ": the largest depth or speed differs from the scan's";
+    EXPECT_TRUE(volume) << s.label << ": the water volume differs from the scan's";
+    differing += !(cells && values && volume);
+  }
+  EXPECT_EQ(differing, 0);
 }
 
 // The OpenCL backend's device buffers (Backend::device_bytes, docs/performance.md "Resident

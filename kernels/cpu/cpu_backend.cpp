@@ -361,45 +361,93 @@ FieldStats CpuBackend<Real>::stats() {
 
 template <class Real>
 RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
+  // The bits of one scan of the row's active cells in x order (volumes added cell after cell;
+  // the first cell of the largest depth and of the largest squared speed, "larger" strictly,
+  // so NaN never wins; the first cell not physical), in passes of which only the first is
+  // bound by its adds (performance.md "The statistics' row passes"):
+  //  1. the volumes: three running sums in x order, the ledger's bits (an inactive cell adds
+  //     +0, which leaves a sum as it is: a sum that starts at +0 never becomes -0);
+  //  2. per chunk of kStatsChunk cells, the largest depth and squared speed and the smallest
+  //     depth (SIMD reductions: a maximum's value does not depend on the order), the chunks
+  //     ranked as the scan ranks cells (strictly larger), so the first chunk holding each
+  //     largest value is the scan's; then the first cell in it holding that value;
+  //  3. only where a volume is not finite or a depth negative, the scan for the first cell
+  //     that is not physical (a NaN or infinite depth, bed or sediment makes a volume so).
   RowStats row;
-  const Kind* kind = kind_.data();
-  const Real *bed = bed_.data(), *bed_lo = bed_residual_.data(), *sediment = sediment_.data(),
-             *vx = velocity_x_.data(), *vy = velocity_y_.data();
-  const double a = area_[y];
   const std::size_t base = static_cast<std::size_t>(y) * W_;
+  const Kind* __restrict kind = kind_.data() + base;
+  const Real* __restrict d = depth + base;
+  const Real* __restrict bed = bed_.data() + base;
+  const Real* __restrict bed_lo = bed_residual_.data() + base;
+  const Real* __restrict sediment = sediment_.data() + base;
+  const Real* __restrict vx = velocity_x_.data() + base;
+  const Real* __restrict vy = velocity_y_.data() + base;
+  const double a = area_[y];
+  const int W = W_;
   const std::int64_t row_cell = static_cast<std::int64_t>(y - 1 + band_.row0) * nx_ - 1;
-  double water = 0, material = 0, sed = 0, max_d = -1, max_v2 = -1;
-  std::size_t fastest = 0;
-  for (int x = 1; x < W_ - 1; ++x) {
-    const std::size_t i = base + static_cast<std::size_t>(x);
-    if (kind[i] != ERODEM_CELL_ACTIVE) continue;
-    const Real d = depth[i], b = bed[i], s = sediment[i];
-    if (row.bad_cell < 0 && !cell::cell_state_ok(b, d, s)) row.bad_cell = row_cell + x;
-    water += static_cast<double>(d) * a;
+
+  double water = 0, material = 0, sed = 0;
+  for (int x = 1; x < W - 1; ++x) {
+    const bool active = kind[x] == ERODEM_CELL_ACTIVE;
+    const double s = sediment[x];
+    water += active ? static_cast<double>(d[x]) * a : 0.0;
     material +=
-        (static_cast<double>(b) + static_cast<double>(bed_lo[i]) + static_cast<double>(s)) * a;
-    sed += static_cast<double>(s) * a;
-    if (d > max_d) {
-      max_d = d;
-      row.max_depth_cell = row_cell + x;
-    }
-    // The squared speed ranks the cells (products of floats are exact in double), as in
-    // stats.cl; the winner's speed is hypot below.
-    const double u = vx[i], v = vy[i];
-    const double v2 = u * u + v * v;
-    if (v2 > max_v2) {
-      max_v2 = v2;
-      row.max_speed_cell = row_cell + x;
-      fastest = i;
-    }
+        active ? (static_cast<double>(bed[x]) + static_cast<double>(bed_lo[x]) + s) * a : 0.0;
+    sed += active ? s * a : 0.0;
   }
   row.water = water;
   row.material = material;
   row.sediment = sed;
-  row.max_depth = max_d;
-  row.max_speed2 = max_v2;
-  if (row.max_speed_cell >= 0)
-    row.speed = std::hypot(static_cast<double>(vx[fastest]), static_cast<double>(vy[fastest]));
+
+  constexpr Real inf = std::numeric_limits<Real>::infinity();
+  Real best_d = Real(-1), min_d = inf;
+  double best_v2 = -1;
+  int chunk_d = 0, chunk_v = 0;
+  for (int c0 = 1; c0 < W - 1; c0 += kStatsChunk) {
+    const int c1 = std::min(c0 + kStatsChunk, W - 1);
+    Real m = Real(-1), lo = inf;
+    double mv = -1;
+#pragma omp simd reduction(max : m, mv) reduction(min : lo)
+    for (int x = c0; x < c1; ++x) {
+      const bool active = kind[x] == ERODEM_CELL_ACTIVE;
+      const Real h = d[x];
+      const Real h_rank = active && h > Real(-1) ? h : Real(-1);  // NaN: -1, never ranked
+      m = h_rank > m ? h_rank : m;
+      const Real h_low = active ? h : inf;
+      lo = h_low < lo ? h_low : lo;
+      // The squared speed ranks the cells (products of floats are exact in double), as in
+      // stats.cl; the winner's speed is hypot below.
+      const double u = vx[x], v = vy[x];
+      const double v2 = u * u + v * v;
+      const double v2_rank = active && v2 > -1 ? v2 : -1.0;
+      mv = v2_rank > mv ? v2_rank : mv;
+    }
+    if (m > best_d) best_d = m, chunk_d = c0;
+    if (mv > best_v2) best_v2 = mv, chunk_v = c0;
+    min_d = lo < min_d ? lo : min_d;
+  }
+  if (best_d > Real(-1)) {  // a cell beat the -1 a scan starts from
+    int x = chunk_d;
+    while (!(kind[x] == ERODEM_CELL_ACTIVE && d[x] == best_d)) ++x;
+    row.max_depth = d[x];
+    row.max_depth_cell = row_cell + x;
+  }
+  if (best_v2 > -1) {
+    int x = chunk_v;
+    for (;; ++x) {
+      const double u = vx[x], v = vy[x];
+      if (kind[x] == ERODEM_CELL_ACTIVE && u * u + v * v == best_v2) break;
+    }
+    row.max_speed2 = best_v2;
+    row.max_speed_cell = row_cell + x;
+    row.speed = std::hypot(static_cast<double>(vx[x]), static_cast<double>(vy[x]));
+  }
+  if (!(std::isfinite(water) && std::isfinite(material) && std::isfinite(sed) && min_d >= 0))
+    for (int x = 1; x < W - 1; ++x)
+      if (kind[x] == ERODEM_CELL_ACTIVE && !cell::cell_state_ok(bed[x], d[x], sediment[x])) {
+        row.bad_cell = row_cell + x;
+        break;
+      }
   return row;
 }
 

@@ -143,6 +143,9 @@ class CpuBackend final : public Backend {
   /// bottom) into depth_next_ and the velocities, its tallies into row_sums_a_/b_/c_[y].
   void water_row(int y, Real dt, const std::array<const Real*, 4>& out);
   /// The statistics (stats()) of padded row y (1 .. H - 2) with the depths `depth`.
+  /// Cells per chunk of stats_row's maxima: a SIMD reduction each, and at most this many
+  /// cells searched for the one holding a row's largest value.
+  static constexpr int kStatsChunk = 128;
   RowStats stats_row(int y, const Real* depth) const;
   /// Adds the water update's row sums to the step's tallies.
   void book_water_rows(Real dt, StepTally& tally);
