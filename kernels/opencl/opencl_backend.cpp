@@ -214,8 +214,18 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 }
 
 std::string OpenClBackend::device() const {
-  if (!band_.banded) return rt_->info.label();
-  return fmt::format("{} (a rank), {} MPI ranks in bands of rows, halo {} row{}", rt_->info.label(),
+  std::string label = rt_->info.label();
+  // A CPU device (PoCL) vectorises whole-row launches; where the padded width has no divisor
+  // for them (runtime_for) it takes the rounded launches, about 2.3x slower per cell
+  // (performance.md "Why PoCL is slow at 16385²"): say so, unless ERODEM_OPENCL_WG asked.
+  const char* wg_env = std::getenv("ERODEM_OPENCL_WG");
+  if (rt_->info.type == "CPU" && !rt_->whole_rows && !(wg_env && *wg_env))
+    label += fmt::format(
+        ", rounded work-groups of {}: the padded row width {} (columns + 2) has no divisor in "
+        "[32, 1024] for whole-row launches, about 2.3x slower per cell on a CPU device",
+        local_x_, W_);
+  if (!band_.banded) return label;
+  return fmt::format("{} (a rank), {} MPI ranks in bands of rows, halo {} row{}", label,
                      parallel::size(), band_.halo, band_.halo == 1 ? "" : "s");
 }
 
