@@ -42,6 +42,10 @@ struct BandRows {
   std::int64_t padded(std::int64_t cell, int nx) const {
     return (cell % nx + 1) + (cell / nx + 1 - row0) * static_cast<std::int64_t>(nx + 2);
   }
+  /// Whether the raster's first (last) row is the grid's north (south) ghost row, not a halo
+  /// row that the neighbouring band gives; `ny` DEM rows.
+  bool holds_north_ghost() const { return row0 == 0; }
+  bool holds_south_ghost(int ny) const { return row0 + rows == ny + 2; }
   /// A face's code (padded_faces: twice its cell's global padded index, plus its direction)
   /// in the raster, for a face this rank owns (face_owners).
   int face_code(int code, int nx) const { return code - 2 * row0 * (nx + 2); }

@@ -11,7 +11,7 @@ void CpuBackend<Real>::run_boundary() {
   const cell_params::BoundaryParams<Real> sea = cell_.boundary;
   // the first and last padded rows where they are the grid's ghost rows (in a band of an MPI
   // run they may be halo rows, which the neighbouring band gives)
-  const bool north = band_.row0 == 0, south = band_.row0 + H_ == ny_ + 2;
+  const bool north = band_.holds_north_ghost(), south = band_.holds_south_ghost(ny_);
   for (int x = 1; x < W_ - 1; ++x) {
     if (north)
       cell::boundary_fill_cell(x, 0, W_, H_, kind_.data(), bed_.data(), depth_.data(),

@@ -385,6 +385,13 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
   const double a = area_[y];
   const int W = W_;
   const std::int64_t row_cell = static_cast<std::int64_t>(y - 1 + band_.row0) * nx_ - 1;
+  // The squared speed ranks the cells (products of floats are exact in double), as in
+  // stats.cl; the winner's speed is hypot below. One expression for the reduction and the
+  // search, which finds the cell by equality with the reduction's value.
+  auto speed2 = [vx, vy](int x) {
+    const double u = vx[x], v = vy[x];
+    return u * u + v * v;
+  };
 
   double water = 0, material = 0, sed = 0;
   for (int x = 1; x < W - 1; ++x) {
@@ -415,10 +422,7 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
       m = h_rank > m ? h_rank : m;
       const Real h_low = active ? h : inf;
       lo = h_low < lo ? h_low : lo;
-      // The squared speed ranks the cells (products of floats are exact in double), as in
-      // stats.cl; the winner's speed is hypot below.
-      const double u = vx[x], v = vy[x];
-      const double v2 = u * u + v * v;
+      const double v2 = speed2(x);
       const double v2_rank = active && v2 > -1 ? v2 : -1.0;
       mv = v2_rank > mv ? v2_rank : mv;
     }
@@ -434,10 +438,7 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
   }
   if (best_v2 > -1) {
     int x = chunk_v;
-    for (;; ++x) {
-      const double u = vx[x], v = vy[x];
-      if (kind[x] == ERODEM_CELL_ACTIVE && u * u + v * v == best_v2) break;
-    }
+    while (!(kind[x] == ERODEM_CELL_ACTIVE && speed2(x) == best_v2)) ++x;
     row.max_speed2 = best_v2;
     row.max_speed_cell = row_cell + x;
     row.speed = std::hypot(static_cast<double>(vx[x]), static_cast<double>(vy[x]));

@@ -413,7 +413,7 @@ void OpenClBackend::run_boundary() {
   cl_kernel k = kernel("boundary_fill");
   // the first and last padded rows where they are the grid's ghost rows (in a band of an MPI
   // run they may be halo rows, which the neighbouring band gives)
-  const cl_int north = band_.row0 == 0, south = band_.row0 + H_ == ny_ + 2;
+  const cl_int north = band_.holds_north_ghost(), south = band_.holds_south_ghost(ny_);
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, cell_.boundary, north, south);
   const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
