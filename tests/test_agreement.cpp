@@ -301,6 +301,138 @@ TEST(AgreementStats, MaximaOnLongRowsWithTiesAndNearTies) {
       agreed, states);
 }
 
+// Rows whose padded width W has no divisor in [32, 1024]: on a CPU device (PoCL) each row is
+// launched as work-groups from column 0 and one tail group of its last columns at an x offset
+// (whole_row_launch, launch_rows), whose tally partials sit at the top of each slot
+// (cell_group_index, reduce.cl) and whose statistics are the row's last group (field_stats).
+// Two grids: a synthetic slope of 5637 x 6 cells (W = 5639: groups of 805, a tail of 4, three
+// DEM cells and the east ghost) and a 1029 x 24 window of Big Tujunga (W = 1031: groups of 515,
+// a tail of 1, the ghost only). 300 steps of the storm with every tally kernel on (erosion,
+// transport, thermal, evaporation, infiltration, snow, terrain classes); the fields as in
+// Agreement (relative L2 below 1e-5), every tally of the ledger within a relative 1e-5 (a tail
+// whose partials landed on a main group's, or were not written, loses that group's share of a
+// row: about 1/8 of the synthetic grid's tallies), and the statistics at the same cells: also on
+// planted states whose largest depth and speed, and first bad cell, are in the tail.
+TEST(AgreementRowTail, FieldsTalliesAndStatisticsOnRowsWithATail) {
+  if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  AgreementCase c{"row_tail",
+                  FlowScheme::local_inertial,
+                  TransportScheme::conservative,
+                  true,
+                  2.0,
+                  1,
+                  ErosionLaw::mei,
+                  true,
+                  true,
+                  true};
+  for (const bool synthetic : {true, false}) {
+    Params params = agreement_params(c);
+    Terrain terrain;
+    if (synthetic) {
+      // a slope from 1563 m down to the open east edge at 1000 m (the snow line, 1200 m, across
+      // it), with ridges and a deterministic roughness steep enough for thermal collapse
+      terrain = flat_terrain(5637, 6, 10.0);
+      for (int r = 0; r < 6; ++r)
+        for (int col = 0; col < 5637; ++col) {
+          const std::uint32_t h = (static_cast<std::uint32_t>(col) * 2654435761u) ^
+                                  (static_cast<std::uint32_t>(r) * 40503u);
+          terrain.bed[static_cast<std::size_t>(r) * 5637 + col] =
+              1000.0 + 0.1 * (5637 - col) + 8.0 * std::sin(0.7 * col) * std::cos(1.3 * r) +
+              6.0 * static_cast<double>((h >> 8) % 1000) / 1000.0;
+        }
+    } else {
+      params.dem.window = std::array<int, 4>{0, 300, 1029, 24};
+      terrain = io::read_dem(params.dem);
+    }
+    Simulation cpu(terrain, params, make_backend("cpu", terrain, params));
+    Simulation ocl(terrain, params, make_backend("opencl", terrain, params));
+    const std::string grid = std::to_string(terrain.grid.nx) + " x " +
+                             std::to_string(terrain.grid.ny) +
+                             (synthetic ? " synthetic" : " Tujunga");
+    for (int k = 0; k < 3; ++k) {
+      cpu.step(100);
+      ocl.step(100);
+    }
+    std::printf("[row tail] %s on '%s': time %.6g / %.6g s (cpu / opencl)\n", grid.c_str(),
+                ocl.backend().device().c_str(), cpu.time(), ocl.time());
+    EXPECT_NEAR(ocl.time(), cpu.time(), 1e-5 * cpu.time()) << grid;
+    const double bound = 1e-5;
+    for (FieldId id : {FieldId::bed, FieldId::water_depth, FieldId::sediment, FieldId::velocity_x,
+                       FieldId::velocity_y, FieldId::wetness, FieldId::infiltrated, FieldId::snow,
+                       FieldId::snow_liquid}) {
+      const io::FieldDifference diff =
+          io::field_difference(ocl.field(id), cpu.field(id), terrain.grid.nx);
+      std::printf("[row tail] %s %-12s relative L2 %.3e (bound %.0e)\n", grid.c_str(),
+                  field_info(id).name, diff.rel_l2, bound);
+      EXPECT_EQ(diff.cells, terrain.grid.cells()) << grid << " " << field_info(id).name;
+      EXPECT_LT(diff.rel_l2, bound) << grid << " " << field_info(id).name;
+    }
+    // Every tally. The floor, 1e-9 of the rain: `clipped` is water added at the rounding level
+    // of the depths (about 1e-8 of the rain here), where float32 rounds differently on the two.
+    const Ledger& L = cpu.ledger();
+    const Ledger& M = ocl.ledger();
+    struct Tally {
+      const char* name;
+      double Ledger::*member;
+    };
+#define ERODEM_TALLY_ENTRY(name, zero_if_absent, doc) Tally{#name, &Ledger::name},
+    const Tally tallies[] = {ERODEM_TALLIES(ERODEM_TALLY_ENTRY)};
+#undef ERODEM_TALLY_ENTRY
+    for (const Tally& t : tallies) {
+      const double a = L.*t.member, b = M.*t.member;
+      const double tol = 1e-5 * std::abs(a) + 1e-9 * L.rain;
+      std::printf("[row tail] %s %-18s %.9g / %.9g m^3 (difference %.2e, bound %.2e)\n",
+                  grid.c_str(), t.name, a, b, std::abs(b - a), tol);
+      EXPECT_NEAR(b, a, tol) << grid << " " << t.name;
+    }
+    // the tallies of every kind of tally kernel moved something
+    for (double Ledger::*m :
+         {&Ledger::water_exchanged, &Ledger::eroded, &Ledger::deposited,
+          &Ledger::sediment_exchanged, &Ledger::thermal_moved, &Ledger::evaporated,
+          &Ledger::infiltrated, &Ledger::snowfall, &Ledger::rain_on_snow})
+      EXPECT_GT(L.*m, 0.0) << grid;
+    EXPECT_EQ(ocl.last_stats().max_depth_cell, cpu.last_stats().max_depth_cell) << grid;
+    EXPECT_EQ(ocl.last_stats().max_speed_cell, cpu.last_stats().max_speed_cell) << grid;
+
+    // Planted states: the largest depth and speed in the last DEM column of row 1 (the tail
+    // where W = 5639; the last main group where W = 1031), then also equal in column 3 of row 1
+    // (the first group: its cell is the first), and a NaN depth in the last column of row 2.
+    const std::int64_t nx = terrain.grid.nx;
+    const std::int64_t last = nx + nx - 1, early = nx + 3, bad = 2 * nx + nx - 1;
+    for (int state = 0; state < 3; ++state) {
+      auto depth = cpu.field(FieldId::water_depth);
+      auto u = cpu.field(FieldId::velocity_x), v = cpu.field(FieldId::velocity_y);
+      depth[static_cast<std::size_t>(last)] = 50.0;
+      u[static_cast<std::size_t>(last)] = 40.0;
+      v[static_cast<std::size_t>(last)] = 0.0;
+      if (state >= 1) {
+        depth[static_cast<std::size_t>(early)] = 50.0;
+        u[static_cast<std::size_t>(early)] = -40.0;
+        v[static_cast<std::size_t>(early)] = 0.0;
+      }
+      if (state == 2) depth[static_cast<std::size_t>(bad)] = NAN;
+      const std::int64_t at = state == 0 ? last : early;
+      for (Simulation* sim : {&cpu, &ocl}) {
+        sim->backend().set_field(FieldId::water_depth, depth);
+        sim->backend().set_field(FieldId::velocity_x, u);
+        sim->backend().set_field(FieldId::velocity_y, v);
+        const FieldStats st = sim->backend().stats();
+        std::printf(
+            "[row tail] %s state %d on %s: max depth %.3g m at %lld, max speed %.3g m/s at %lld "
+            "(expected %lld), first bad cell %lld (expected %lld)\n",
+            grid.c_str(), state, sim->backend().name().c_str(), st.max_depth,
+            static_cast<long long>(st.max_depth_cell), st.max_speed,
+            static_cast<long long>(st.max_speed_cell), static_cast<long long>(at),
+            static_cast<long long>(st.bad_cell), static_cast<long long>(state == 2 ? bad : -1));
+        EXPECT_EQ(st.max_depth_cell, at) << grid << " state " << state;
+        EXPECT_EQ(st.max_speed_cell, at) << grid << " state " << state;
+        EXPECT_EQ(st.max_depth, 50.0) << grid << " state " << state;
+        EXPECT_EQ(st.bad_cell, state == 2 ? bad : -1) << grid << " state " << state;
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Tujunga, Agreement,
     ::testing::Values(

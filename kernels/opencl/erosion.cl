@@ -24,7 +24,7 @@ __kernel void erosion(int W, int H, __global const uchar* restrict kind,
                        hardness, dx, dy, area, dt, p, &b, &eroded, &deposited);
     bed_out[x + y * W] = b;
   }
-  const int g = cell_group_index();
+  const int g = cell_group_index(stride);
   cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
                   partials + ERODEM_TALLY_ERODED * stride + g,
                   partials + ERODEM_TALLY_DEPOSITED * stride + g);
@@ -55,7 +55,7 @@ __kernel void erosion_physical(
                         &rock, &bulking);
     bed_out[x + y * W] = b;
   }
-  const int g = cell_group_index();
+  const int g = cell_group_index(stride);
   cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
                   partials + ERODEM_TALLY_ERODED * stride + g,
                   partials + ERODEM_TALLY_DEPOSITED * stride + g);

@@ -17,5 +17,5 @@ __kernel void evaporation(int W, int H, __global const uchar* kind, __global rea
   if (!ERODEM_PAST_ROW(x, W))
     evaporation_sweep_cell(x, y, W, kind, depth, wetness, area, dt, p, &lost);
   cell_group_sum(s, s_lanes, lost,
-                 partials + ERODEM_TALLY_EVAPORATED * stride + cell_group_index());
+                 partials + ERODEM_TALLY_EVAPORATED * stride + cell_group_index(stride));
 }

@@ -20,7 +20,7 @@ __kernel void infiltration(int W, int H, __global const uchar* restrict kind,
   if (!ERODEM_PAST_ROW(x, W))
     infiltration_sweep_cell(x, y, W, kind, depth, infiltrated, ksat, suction, store, area, dt, p,
                             &taken, &drained);
-  const int g = cell_group_index();
+  const int g = cell_group_index(stride);
   cell_group_sum2(s_in, s_drained, s_lanes, taken, drained,
                   partials + ERODEM_TALLY_INFILTRATED * stride + g,
                   partials + ERODEM_TALLY_SOIL_DRAINED * stride + g);

@@ -109,13 +109,24 @@ void OpenClBackend::launch_interior(cl_kernel k) {
 
 void OpenClBackend::launch_rows(cl_kernel k, int y0, int y1, std::size_t row_group) {
   if (y1 <= y0) return;
-  const std::size_t offset[2] = {0, static_cast<std::size_t>(y0)};
-  const std::size_t global[2] = {row_group > 0 ? row_group : groups_x_ * local_x_,
-                                 static_cast<std::size_t>(y1 - y0)};
-  const std::size_t local[2] = {row_group > 0 ? row_group : local_x_, 1};
-  check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr,
-                               profile_event(k)),
-        "clEnqueueNDRangeKernel");
+  const std::size_t rows = static_cast<std::size_t>(y1 - y0);
+  auto enqueue = [&](std::size_t x0, std::size_t width, std::size_t group) {
+    const std::size_t offset[2] = {x0, static_cast<std::size_t>(y0)};
+    const std::size_t global[2] = {width, rows};
+    const std::size_t local[2] = {group, 1};
+    check(clEnqueueNDRangeKernel(queue_.get(), k, 2, offset, global, local, 0, nullptr,
+                                 profile_event(k)),
+          "clEnqueueNDRangeKernel");
+  };
+  if (row_group > 0) {
+    enqueue(0, row_group, row_group);
+    return;
+  }
+  // whole rows with a tail: the groups of local_x_ (none where the row is the tail), then
+  // the tail's one group per row
+  const std::size_t full = tail_x_ > 0 ? groups_x_ - 1 : groups_x_;
+  if (full > 0) enqueue(0, full * local_x_, local_x_);
+  if (tail_x_ > 0) enqueue(full * local_x_, tail_x_, tail_x_);
 }
 
 void OpenClBackend::launch_edge_tallies(int slot, Real dt) {

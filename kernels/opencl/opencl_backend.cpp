@@ -33,7 +33,7 @@ constexpr std::size_t kStatsRowValues = 7;
 /// A size from the environment (the tuning variable ERODEM_OPENCL_WG), else `fallback`. Where
 /// the kernels are built for rounded launches, the cell kernels' work-group is ERODEM_OPENCL_WG
 /// rounded down to a power of two, by default 64 on CPU devices and 128 on others, one row high;
-/// CPU devices launch whole rows (a divisor of the row) unless ERODEM_OPENCL_WG is set.
+/// CPU devices launch whole rows (whole_row_launch) unless ERODEM_OPENCL_WG is set.
 std::size_t env_size(const char* name, std::size_t fallback) {
   if (const char* env = std::getenv(name); env && *env) {
     const long v = std::strtol(env, nullptr, 10);
@@ -71,7 +71,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   tails_ = sweeps_tails(params, periodic_ || band_.banded);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
-  rt_ = runtime_for(selector, static_cast<std::size_t>(W_));
+  rt_ = runtime_for(selector);
   cl_int err = CL_SUCCESS;
   const char* profile_env = std::getenv("ERODEM_OPENCL_PROFILE");
   profiling_ = profile_env && *profile_env && std::string(profile_env) != "0";
@@ -146,10 +146,11 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
       std::clamp<std::size_t>((n_ + reduce_local_ - 1) / reduce_local_, 1, kReduceGroupsMax);
   partial_b_ = make_buffer(reduce_groups_ * acc_size_);
 
-  // Cell kernels: work-groups of (local_x_, 1) that every cell kernel accepts: a divisor
-  // of the row by one row (whole rows), else powers of two; a fixed number of groups for this
-  // grid (the tallies' partials, summed in a fixed order). Where a kernel accepts less than the
-  // device's maximum, the whole-row divisor may be small: still correct, slower.
+  // Cell kernels: work-groups of (local_x_, 1) that every cell kernel accepts: whole rows in
+  // groups of local_x_ and a tail group of tail_x_ (whole_row_launch), else powers of two; a
+  // fixed number of groups for this grid (the tallies' partials, summed in a fixed order).
+  // Where a kernel accepts less than the device's maximum, the groups may be small: still
+  // correct, slower.
   const bool cpu = rt_->info.type == "CPU";
   std::size_t cell_limit =
       std::min(rt_->whole_rows ? kCellGroupMax : kRoundedGroupMax, rt_->max_work_group);
@@ -166,9 +167,12 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
     return p;
   };
   if (rt_->whole_rows) {
-    // the program was built for it: a local size that divides the row (any divisor keeps
-    // the kernels correct; the largest is the fastest)
-    local_x_ = whole_row_group(static_cast<std::size_t>(W_), cell_limit);
+    // the program was built for it: groups that cover the row exactly, the last one shorter
+    // where the size does not divide it (any size keeps the kernels correct; large groups
+    // and a short tail are the fastest)
+    const RowLaunch rows = whole_row_launch(static_cast<std::size_t>(W_), cell_limit);
+    local_x_ = rows.group;
+    tail_x_ = rows.tail;
   } else {
     local_x_ = pow2_at_most(std::min(cell_limit, env_size("ERODEM_OPENCL_WG", cpu ? 64 : 128)));
   }
@@ -214,16 +218,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 }
 
 std::string OpenClBackend::device() const {
-  std::string label = rt_->info.label();
-  // A CPU device (PoCL) vectorises whole-row launches; where the padded width has no divisor
-  // for them (runtime_for) it takes the rounded launches, about 2.3x slower per cell
-  // (performance.md "Why PoCL is slow at 16385²"): say so, unless ERODEM_OPENCL_WG asked.
-  const char* wg_env = std::getenv("ERODEM_OPENCL_WG");
-  if (rt_->info.type == "CPU" && !rt_->whole_rows && !(wg_env && *wg_env))
-    label += fmt::format(
-        ", rounded work-groups of {}: the padded row width {} (columns + 2) has no divisor in "
-        "[32, 1024] for whole-row launches, about 2.3x slower per cell on a CPU device",
-        local_x_, W_);
+  const std::string label = rt_->info.label();
   if (!band_.banded) return label;
   return fmt::format("{} (a rank), {} MPI ranks in bands of rows, halo {} row{}", label,
                      parallel::size(), band_.halo, band_.halo == 1 ? "" : "s");
@@ -704,8 +699,8 @@ FieldStats OpenClBackend::stats() {
 
 FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   cl_kernel k = kernel("field_stats");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, depth_, sediment_, velocity_x_,
-           velocity_y_, area_, partial_a_, partial_cells_);
+  set_args(k, cl_int{W_}, cl_int{H_}, static_cast<cl_int>(groups_x_), kind_, bed_, bed_residual_,
+           depth_, sediment_, velocity_x_, velocity_y_, area_, partial_a_, partial_cells_);
   const int rows = H_ - 2;
   if (stats_local_ == 0)
     launch_rows(k, 1, H_ - 1);  // whole rows: a cell kernel, groups_x_ partials per row

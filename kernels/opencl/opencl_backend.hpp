@@ -118,8 +118,8 @@ struct Runtime {
   std::size_t base_align = 4096;
   /// CL_DEVICE_MAX_MEM_ALLOC_SIZE in bytes: the largest buffer.
   std::size_t max_alloc = 0;
-  /// Built for launches of whole rows (ERODEM_WHOLE_ROWS: every cell kernel's local size
-  /// divides the row; the kernels then need no per-work-item bound check).
+  /// Built for launches of whole rows (ERODEM_WHOLE_ROWS: every cell kernel's launches cover
+  /// the row exactly, whole_row_launch; the kernels then need no per-work-item bound check).
   bool whole_rows = false;
   std::string options;  ///< the build options
 };
@@ -128,18 +128,27 @@ struct Runtime {
 /// build log on failure. ERODEM_OPENCL_DUMP=dir writes the source and options there.
 void build_program(Runtime& rt);
 
-/// The cell kernels' largest work-group of at most `limit` work-items (and of 1024, the
-/// local arrays of reduce.cl) that divides a padded row of W cells: W itself up to there.
-std::size_t whole_row_group(std::size_t W, std::size_t limit);
+/// How whole-row launches cover a padded row of W cells (ERODEM_WHOLE_ROWS): work-groups of
+/// `group` work-items from column 0, then, where `tail` > 0, one work-group of the last `tail`
+/// columns (launch_rows: a second launch at that x offset). `group` is at most `limit` and
+/// 1024 (the local arrays of reduce.cl) and at least min(32, W): of those sizes, the one that
+/// leaves the shortest tail, the largest among equals; W itself up to 1024, else the largest
+/// divisor of W where there is one (tail 0). The tail's group is usually one or two cells: a
+/// padded width with no divisor in [32, 1024] (a prime, 16387 = 7 x 2341) used to take the
+/// rounded launches, which PoCL leaves scalar (about 2.3x slower per cell).
+struct RowLaunch {
+  std::size_t group = 1;
+  std::size_t tail = 0;
+};
+RowLaunch whole_row_launch(std::size_t W, std::size_t limit);
 
 /// The runtime of the device chosen by ERODEM_OPENCL_DEVICE ("<platform>:<device>"
 /// substrings, case-insensitive; either may be empty), else the first GPU, else the first
 /// device; built once per device and launch kind and kept (runtime.cpp) until
-/// release_opencl_runtimes(). `row_width` is the padded row of
-/// the grid to run: on CPU devices the kernels are built for whole-row launches when a
-/// work-group of at least min(32, row_width) divides it (and ERODEM_OPENCL_WG is not set).
-/// Throws Error(usage) when there is no device.
-std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width);
+/// release_opencl_runtimes(). On CPU devices the kernels are built for whole-row launches
+/// (whole_row_launch) unless ERODEM_OPENCL_WG is set. Throws Error(usage) when there is no
+/// device.
+std::shared_ptr<Runtime> runtime_for(const std::string& selector);
 
 /// The CPU reference's algorithms on an OpenCL device, float32 only. State stays on the
 /// device; field() reads back, set_field() uploads, stats() reduces on the device.
@@ -208,9 +217,11 @@ class OpenClBackend final : public Backend {
   /// hold the own rows' only (launch.cpp).
   void launch_interior(cl_kernel k);
   /// Runs a cell kernel over the padded rows [y0, y1) only (global offset y0; work-groups of
-  /// (local_x_, 1)), or with `row_group` > 0 one work-group of (row_group, 1) per row (a
-  /// kernel that walks its row's columns itself: field_stats on GPUs); nothing when the range
-  /// is empty.
+  /// (local_x_, 1), and where tail_x_ > 0 a second launch of one group of (tail_x_, 1) per
+  /// row at the x offset of the row's last tail_x_ columns), or with `row_group` > 0 one
+  /// work-group of (row_group, 1) per row (a kernel that walks its row's columns itself:
+  /// field_stats on GPUs); nothing when the range is empty. A tally kernel writes the tail
+  /// groups' partials at the top of the slot (cell_group_index, reduce.cl).
   void launch_rows(cl_kernel k, int y0, int y1, std::size_t row_group = 0);
   /// Sums the water exchange (slot ERODEM_TALLY_EXCHANGE) or the sediment carried out
   /// (ERODEM_TALLY_SEDIMENT) over the cells beside ghosts into the tally partials.
@@ -335,10 +346,11 @@ class OpenClBackend final : public Backend {
   std::vector<SweepsTail> tails_;
   std::size_t n_;
   std::size_t reduce_local_ = 1, reduce_groups_ = 1, acc_size_ = 8;
-  // The cell kernels' groups: (local_x_, 1) work-items, groups_x_ per padded row (the global
-  // size rounded up to whole groups where local_x_ does not divide the row), interior_groups_
-  // over rows 1 .. H - 2 (launch_interior; the tally kernels: one partial per group).
-  std::size_t local_x_ = 1, groups_x_ = 1, interior_groups_ = 1;
+  // The cell kernels' groups: (local_x_, 1) work-items, groups_x_ per padded row, the last
+  // one of tail_x_ work-items where that is not 0 (whole rows, whole_row_launch; the global
+  // size rounded up to whole groups in the rounded launches), interior_groups_ over rows
+  // 1 .. H - 2 (launch_interior; the tally kernels: one partial per group).
+  std::size_t local_x_ = 1, tail_x_ = 0, groups_x_ = 1, interior_groups_ = 1;
   // field_stats' work-items per row where it runs in row launches (rounded launches, GPUs;
   // stats.cl); 0: a cell kernel like the others (whole rows, CPU devices)
   std::size_t stats_local_ = 0;

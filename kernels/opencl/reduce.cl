@@ -37,7 +37,8 @@ typedef int8 acc8_mask_t;
 #endif
 
 /* Whether work-item column x lies past the padded row of W cells. Where the host launches
- * whole rows (ERODEM_WHOLE_ROWS, on CPU devices: the local size divides W) there is no such
+ * whole rows (ERODEM_WHOLE_ROWS, on CPU devices: groups of the local size from column 0, then
+ * where that does not divide W a group of the row's last columns, launch_rows) there is no such
  * work-item, and a cell kernel has no per-work-item condition left: every load is
  * unconditional, which PoCL needs to vectorise a kernel with loads of per-row values (under a
  * per-work-item condition it gathers them). Elsewhere the global size is rounded up to whole
@@ -77,8 +78,16 @@ typedef int8 acc8_mask_t;
 #error "the host defines the tally slots (ERODEM_TALLY_*) in the build options"
 #endif
 
-/* Linear index of this work-group among the cell kernel's groups. */
-static inline int cell_group_index(void) {
+/* The partial of this work-group in a tally slot of `stride` partials: its linear index among
+ * the launch's groups; for the tail of whole rows (the row's last columns, launched on their
+ * own at an x offset: launch_rows) the slot's top, stride - 1 - its row in the launch. The
+ * host's stride counts a group per row for the tail (groups_x_), so the two never meet; and
+ * a band's own rows, launched last with at least as many rows as a halo launch, write over
+ * every partial of the halo rows (launch_interior). */
+static inline int cell_group_index(int stride) {
+#ifdef ERODEM_WHOLE_ROWS
+  if (get_global_offset(0) > 0) return stride - 1 - (int)get_group_id(1);
+#endif
   return (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
 }
 

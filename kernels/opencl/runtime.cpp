@@ -18,11 +18,13 @@
 
 namespace erodem::opencl {
 
-std::size_t whole_row_group(std::size_t W, std::size_t limit) {
+RowLaunch whole_row_launch(std::size_t W, std::size_t limit) {
   const std::size_t cap = std::min<std::size_t>(limit, 1024);  // ERODEM_CELL_GROUP_MAX
-  for (std::size_t d = std::min(W, cap); d > 1; --d)
-    if (W % d == 0) return d;
-  return 1;
+  const std::size_t lo = std::min<std::size_t>(32, std::min(W, cap));
+  RowLaunch best{std::min(W, cap), W % std::min(W, cap)};
+  for (std::size_t g = std::min(W, cap); g >= lo && g > 0; --g)
+    if (W % g < best.tail) best = {g, W % g};
+  return best;
 }
 
 namespace {
@@ -66,7 +68,7 @@ const DeviceEntry& choose_device(const std::vector<DeviceEntry>& devices,
   return devices.front();
 }
 
-std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t row_width) {
+std::shared_ptr<Runtime> runtime_for(const std::string& selector) {
   RuntimeCache& cache = runtime_cache();
   const auto devices = enumerate_devices();
   const DeviceEntry* chosen = &choose_device(devices, selector);
@@ -74,9 +76,7 @@ std::shared_ptr<Runtime> runtime_for(const std::string& selector, std::size_t ro
   // Whole rows on CPU devices (PoCL vectorises across a row's work-items only where no
   // per-work-item condition guards the loads), unless a tuning size is set.
   const char* wg_env = std::getenv("ERODEM_OPENCL_WG");
-  const bool whole_rows = chosen->info.type == "CPU" && !(wg_env && *wg_env) &&
-                          whole_row_group(row_width, chosen->info.max_work_group) >=
-                              std::min<std::size_t>(32, row_width);
+  const bool whole_rows = chosen->info.type == "CPU" && !(wg_env && *wg_env);
   std::lock_guard<std::mutex> lock(cache.mutex);
   auto& slot = cache.runtimes[{chosen->device, whole_rows}];
   if (slot) return slot;

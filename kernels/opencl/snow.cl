@@ -24,7 +24,7 @@
     if (!ERODEM_PAST_ROW(x, W))                                                               \
       CELL(x, y, W, kind, TEMPERATURE, rain_factor, snow, liquid, depth, area, dt, p, &fall,  \
            &rain, &melted, &out);                                                             \
-    const int g = cell_group_index();                                                         \
+    const int g = cell_group_index(stride);                                                   \
     cell_group_sum2(s_fall, s_rain, s_lanes, fall, rain,                                      \
                     partials + ERODEM_TALLY_SNOWFALL * stride + g,                            \
                     partials + ERODEM_TALLY_RAIN_ON_SNOW * stride + g);                       \

@@ -178,10 +178,11 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
  * another order:
  *  - whole rows (ERODEM_WHOLE_ROWS, CPU devices): a cell kernel (launch_interior), one
  *    work-item per padded cell in groups of (L, 1) inside one row (L <= ERODEM_CELL_GROUP_MAX),
- *    g = group x + (y - 1) * groups per row. Each work-item stores its cell's values in local
- *    memory as they are (floats); one work-item then sums them in acc_t, in eight lanes (see
- *    cell_tallies_sum), and multiplies by the row's cell area: the area is one number per row
- *    (field_stats_group). PoCL runs that walk as vector loops;
+ *    g = group x + (y - 1) * groups_per_row; the row's tail (its last columns, launched on
+ *    their own at an x offset where L does not divide the row: launch_rows) is its last group. Each
+ * work-item stores its cell's values in local memory as they are (floats); one work-item then sums
+ * them in acc_t, in eight lanes (see cell_tallies_sum), and multiplies by the row's cell area: the
+ * area is one number per row (field_stats_group). PoCL runs that walk as vector loops;
  *  - row launches (GPUs): one work-group of L <= ERODEM_STATS_GROUP_MAX work-items per row,
  *    g = y - 1 (stats_rows sees one group per row). Work-item l walks the row's columns
  *    1 + l, 1 + l + L, ... (neighbouring work-items read neighbouring cells), keeping its own
@@ -191,12 +192,15 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
  *    tree over every cell (eight trees of 128 values per 128 cells, each level behind a
  *    barrier, 32 KiB of local memory per group) still 0.88 ms, 11 % of the device's copy
  *    bandwidth for its 25 bytes per cell. */
-__kernel void field_stats(
-    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
-    __global const real* restrict bed_residual, __global const real* restrict depth,
-    __global const real* restrict sediment, __global const real* restrict velocity_x,
-    __global const real* restrict velocity_y, __global const real* restrict area,
-    __global acc_t* restrict sums, __global long* restrict cells) {
+__kernel void field_stats(int W, int H, int groups_per_row, __global const uchar* restrict kind,
+                          __global const real* restrict bed,
+                          __global const real* restrict bed_residual,
+                          __global const real* restrict depth,
+                          __global const real* restrict sediment,
+                          __global const real* restrict velocity_x,
+                          __global const real* restrict velocity_y,
+                          __global const real* restrict area, __global acc_t* restrict sums,
+                          __global long* restrict cells) {
 #ifdef ERODEM_WHOLE_ROWS
   __local real s_d[ERODEM_CELL_GROUP_MAX], s_b[ERODEM_CELL_GROUP_MAX], s_r[ERODEM_CELL_GROUP_MAX],
       s_s[ERODEM_CELL_GROUP_MAX], s_u[ERODEM_CELL_GROUP_MAX], s_v[ERODEM_CELL_GROUP_MAX];
@@ -222,8 +226,9 @@ __kernel void field_stats(
     field_stats_group(W, (int)(get_group_id(1) + get_global_offset(1)),
                       (int)(get_group_id(0) * get_local_size(0) + get_global_offset(0)),
                       (int)get_local_size(0),
-                      (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0), s_d,
-                      s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
+                      (get_global_offset(0) > 0 ? groups_per_row - 1 : (int)get_group_id(0)) +
+                          (int)get_group_id(1) * groups_per_row,
+                      s_d, s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
 #else
   /* The row launch. The maxima as (value, column) pairs: a work-item's columns come in
    * increasing order and only a strictly larger value replaces, so it keeps its first largest;
@@ -241,6 +246,7 @@ __kernel void field_stats(
   const int l = (int)get_local_id(0), L = (int)get_local_size(0);
   const int y = (int)get_global_id(1); /* the padded row */
   (void)H;
+  (void)groups_per_row;
   acc_t water = 0, bed_sum = 0, res = 0, sed = 0, best_v2 = -1;
   real best_d = -1;
   int at_d = INT_MAX, at_v = INT_MAX, bad = INT_MAX;

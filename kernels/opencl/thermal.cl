@@ -39,5 +39,5 @@ __kernel void thermal_apply(int W, int H, __global const uchar* restrict kind,
     bed_out[x + y * W] = b;
   }
   cell_group_sum(s_sum, s_lanes, moved,
-                 partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index());
+                 partials + ERODEM_TALLY_THERMAL_MOVED * stride + cell_group_index(stride));
 }

@@ -25,7 +25,7 @@ __kernel void transport_conservative(
     sediment_out[x + y * W] = s;
   }
   cell_group_sum(s_sum, s_lanes, given,
-                 partials + ERODEM_TALLY_SEDIMENT_EXCHANGED * stride + cell_group_index());
+                 partials + ERODEM_TALLY_SEDIMENT_EXCHANGED * stride + cell_group_index(stride));
 }
 
 /* The change of sum(s * area) is reduced afterwards by reduce_change (stats.cl). */

@@ -27,7 +27,7 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
   if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, bed, depth, depth_out, f_left, f_right, f_top, f_bottom, dx,
                       dy, area, velocity_x, velocity_y, dt, p, &exchange, &clipped, &given);
-  const int g = cell_group_index();
+  const int g = cell_group_index(stride);
   cell_group_sum2(s_clipped, s_given, s_lanes, clipped, given,
                   partials + ERODEM_TALLY_CLIPPED * stride + g,
                   partials + ERODEM_TALLY_WATER_EXCHANGED * stride + g);
