@@ -133,7 +133,7 @@ void OpenClBackend::launch_edge_tallies(int slot, Real dt) {
   if (edge_count_ == 0) return;
   cl_kernel k = kernel("edge_tallies");
   set_args(k, cl_int{W_}, kind_, edge_cells_, static_cast<cl_int>(edge_count_), flux_[0], flux_[1],
-           flux_[2], flux_[3], sediment_, depth_next_, dt, cl_int{slot}, tally_partials_,
+           flux_[2], flux_[3], sediment_, depth_flow(), dt, cl_int{slot}, tally_partials_,
            static_cast<cl_int>(tally_stride_));
   const std::size_t global = edge_groups_ * edge_local_, local = edge_local_;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, &local, 0, nullptr,

@@ -77,6 +77,28 @@ Buffer& OpenClBackend::made(Buffer& b, const Buffer* like) {
   return b;
 }
 
+Buffer& OpenClBackend::second_for(Buffer& second, const Buffer& field) {
+  if (!second) return made(second, &field);
+  scratch_rows(field, second);
+  return second;
+}
+
+const Buffer& OpenClBackend::depth_flow() {
+  if (depth_next_scratch_)
+    throw Error(ExitCode::internal,
+                "OpenCL: the depth the water update started from is read after the face pass or "
+                "thermal collapse held their scratch in its buffer, with no water update between "
+                "(process order)");
+  return made(depth_next_, &depth_);  // before any water update: the depth as it is
+}
+
+void OpenClBackend::scratch_rows(const Buffer& from, const Buffer& to) {
+  const std::size_t row = static_cast<std::size_t>(W_) * sizeof(Real);
+  for (const std::size_t at : {std::size_t{0}, static_cast<std::size_t>(H_ - 1) * row})
+    check(clEnqueueCopyBuffer(queue_.get(), from.get(), to.get(), at, at, row, 0, nullptr, nullptr),
+          "clEnqueueCopyBuffer(rows 0 and H - 1)");
+}
+
 const OpenClBackend::Real* OpenClBackend::uniform_value(const Buffer& b) const {
   for (const auto& [buffer, value] : uniform_)
     if (buffer == &b) return &value;

@@ -95,8 +95,9 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   std::vector<std::uint8_t>().swap(state.kind);
 
   // ---- the device state ----
-  // Only what every run reads is made here; the second buffers a run may not need are made on
-  // first use (made()), the fields of zeros by clEnqueueFillBuffer (zero_field()).
+  // Only what every run reads is made here; the second buffers are made on first use (made(),
+  // second_for(): depth_next_ too, so that the setup's peak, the terrain beside the state, does
+  // not hold it), the fields of zeros by clEnqueueFillBuffer (zero_field()).
   kind_ = upload(kind);
   dx_ = upload(dx);
   dy_ = upload(dy);
@@ -110,7 +111,6 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   {
     std::vector<Real> depth_r = to_real(state.depth);
     depth_ = upload(depth_r);
-    depth_next_ = upload(depth_r);
     wetness_ = upload(depth_r);
   }
   {
@@ -120,7 +120,6 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   for (int k = 0; k < 4; ++k) flux_[k] = zero_field();
   velocity_x_ = zero_field();
   velocity_y_ = zero_field();
-  thermal_share_ = zero_field();
   if (params_.flow.scheme == FlowScheme::shallow_water && params_.flow.order == 2)
     stage_depth_ = zero_field();
   // the parameters the terrain classes write are held per cell from the start
@@ -281,7 +280,7 @@ void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
   std::vector<const Buffer*> buffers;
   for (const std::string& name : names) {
     const Buffer* b = name == "depth_flow"      ? &depth_next_
-                      : name == "thermal_share" ? &thermal_share_
+                      : name == "thermal_share" ? &depth_next_
                       : name == "rain_factor"   ? &rain_factor_
                       : name == "manning_n"     ? &manning_
                       : name == "hardness"      ? &hardness_
@@ -395,8 +394,8 @@ void OpenClBackend::measure_faces(bool sediment) {
   // before the water update or the transport: the arrays they read (sections.h)
   cl_kernel k = kernel("section_faces");
   set_args(k, static_cast<cl_int>(face_count_), cl_int{W_}, cl_int{sediment ? 1 : 0}, face_codes_,
-           sediment_, depth_next_, flux_[0], flux_[1], flux_[2], flux_[3],
-           sediment ? face_sediment_out_ : face_water_out_);
+           sediment_, sediment ? depth_flow() : made(depth_next_), flux_[0], flux_[1], flux_[2],
+           flux_[3], sediment ? face_sediment_out_ : face_water_out_);
   const std::size_t global = face_count_;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
                                profile_event(k)),
@@ -529,13 +528,16 @@ void OpenClBackend::run_flow(Real dt) {
   // Each face once (face pass), then split into the cells' outflows (cell pass); the
   // interior rows by kernels that need no clamping (they vectorise on CPU devices), the
   // edge rows by the general ones. H >= 3. The cell pass reads only the faces and its own
-  // cell, so it writes the outflows in place: no second buffers (16 B per cell).
-  made(face_x_);
-  made(face_y_);
+  // cell, so it writes the outflows in place: no second buffers (16 B per cell). The faces
+  // are scratch in buffers that hold nothing alive during the flow (depth_next_, spare_):
+  // the face kernels together write every face the cell pass reads.
+  const Buffer& face_x = made(depth_next_);
+  depth_next_scratch_ = true;
+  const Buffer& face_y = made(spare_);
   for (const char* name : {"flow_local_inertial_faces_x_interior",
                            "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
     set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_,
-             flux_[0], flux_[1], flux_[2], flux_[3], face_x_, face_y_, dt, cell_.flow);
+             flux_[0], flux_[1], flux_[2], flux_[3], face_x, face_y, dt, cell_.flow);
   launch_rows(kernel("flow_local_inertial_faces_x_interior"), 1, H_ - 2);
   launch_rows(kernel("flow_local_inertial_faces_y_interior"), 1, H_ - 2);
   launch_rows(kernel("flow_local_inertial_faces"), 0, 1);
@@ -543,14 +545,14 @@ void OpenClBackend::run_flow(Real dt) {
   if (periodic_) {
     cl_kernel seam = kernel("flow_local_inertial_seam_x");
     set_args(seam, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, manning_, dx_, dy_, flux_[0],
-             flux_[1], face_x_, dt, cell_.flow);
+             flux_[1], face_x, dt, cell_.flow);
     const std::size_t rows = static_cast<std::size_t>(H_);
     check(clEnqueueNDRangeKernel(queue_.get(), seam, 1, nullptr, &rows, nullptr, 0, nullptr,
                                  profile_event(seam)),
           "clEnqueueNDRangeKernel(flow_local_inertial_seam_x)");
   }
   for (const char* name : {"flow_local_inertial_split_interior", "flow_local_inertial_split"})
-    set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x_, face_y_, flux_[0],
+    set_args(kernel(name), cl_int{W_}, cl_int{H_}, kind_, depth_, area_, face_x, face_y, flux_[0],
              flux_[1], flux_[2], flux_[3], dt);
   launch_rows(kernel("flow_local_inertial_split_interior"), 1, H_ - 1);
   launch_rows(kernel("flow_local_inertial_split"), 0, 1);
@@ -558,6 +560,8 @@ void OpenClBackend::run_flow(Real dt) {
 }
 
 void OpenClBackend::run_water(Real dt, StepTally& tally) {
+  second_for(depth_next_, depth_);  // it held the faces and the shares
+  depth_next_scratch_ = false;      // the update writes its rows 1 .. H - 2
   cl_kernel k = kernel("water_update");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
            flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water,
@@ -573,69 +577,69 @@ void OpenClBackend::run_water(Real dt, StepTally& tally) {
 }
 
 void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
-  made(bed_next_, &bed_);  // rows 0 and H - 1, which the kernels do not write, hold the bed
+  second_for(spare_, bed_);
   if (params_.erosion.law == ErosionLaw::physical) {
     cl_kernel k = kernel("erosion_physical");
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_,
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, spare_, bed_residual_, sediment_,
              *field_buffer(FieldId::soil_thickness), depth_, velocity_x_, velocity_y_, manning_,
              hardness_, dx_, dy_, area_, dt, cell_.sediment, tally_partials_,
              static_cast<cl_int>(tally_stride_));
     defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited) |
                      tally_bit(&StepTally::eroded_bedrock) | tally_bit(&StepTally::bed_bulking));
     launch_interior(k);
-    std::swap(bed_, bed_next_);
+    std::swap(bed_, spare_);
     return;
   }
   cl_kernel k = kernel("erosion");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_next_, bed_residual_, sediment_, depth_,
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, spare_, bed_residual_, sediment_, depth_,
            velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt, cell_.erosion, tally_partials_,
            static_cast<cl_int>(tally_stride_));
   defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited));
   launch_interior(k);
-  std::swap(bed_, bed_next_);
+  std::swap(bed_, spare_);
 }
 
 void OpenClBackend::run_transport(Real dt, StepTally& tally) {
-  made(sediment_next_, &sediment_);  // as the bed's (run_erosion)
+  second_for(spare_, sediment_);
   if (params_.transport.scheme == TransportScheme::conservative) {
     cl_kernel k = kernel("transport_conservative");
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, depth_next_, flux_[0],
-             flux_[1], flux_[2], flux_[3], area_, dt, tally_partials_,
-             static_cast<cl_int>(tally_stride_));
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, spare_, depth_flow(), flux_[0], flux_[1],
+             flux_[2], flux_[3], area_, dt, tally_partials_, static_cast<cl_int>(tally_stride_));
     defer(tally, tally_bit(&StepTally::sediment_out) | tally_bit(&StepTally::sediment_exchanged));
     launch_interior(k);
     launch_edge_tallies(tally_slot(&StepTally::sediment_out),
                         dt);  // reads sediment_ before the swap
   } else {
     cl_kernel k = kernel("transport_semi_lagrangian");
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, sediment_next_, velocity_x_, velocity_y_,
-             dx_, dy_, dt, cl_int{periodic_ ? 1 : 0});
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, sediment_, spare_, velocity_x_, velocity_y_, dx_,
+             dy_, dt, cl_int{periodic_ ? 1 : 0});
     launch_interior(k);
     cl_kernel r = kernel("reduce_change");
-    set_args(r, cl_int{W_}, cl_int{H_}, kind_, sediment_next_, sediment_, area_, partial_b_);
+    set_args(r, cl_int{W_}, cl_int{H_}, kind_, spare_, sediment_, area_, partial_b_);
     defer(tally, kChangeBit);
     launch_reduction(r, reduce_groups_);
   }
-  std::swap(sediment_, sediment_next_);
+  std::swap(sediment_, spare_);
 }
 
 void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
-  made(bed_next_, &bed_);  // as in run_erosion
+  second_for(spare_, bed_);
+  const Buffer& shares = made(depth_next_);  // scratch after the transport
+  depth_next_scratch_ = true;
   cl_kernel share = kernel("thermal_share");
   // The talus slopes are read only where the classes set them (by_class); otherwise any
   // buffer of the grid's size stands in, so that no field of zeros is made for them (4 B/cell).
   const Buffer& talus = cell_.thermal.by_class ? *field_buffer(FieldId::talus_slope) : wetness_;
-  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, talus, dx_, dy_, area_,
-           thermal_share_, dt, cell_.thermal);
+  set_args(share, cl_int{W_}, cl_int{H_}, kind_, bed_, wetness_, talus, dx_, dy_, area_, shares, dt,
+           cell_.thermal);
   launch_interior(share);
-  exchange_buffers({&thermal_share_});  // the apply pass reads the neighbours' shares
+  exchange_buffers({&shares});  // the apply pass reads the neighbours' shares
   cl_kernel apply = kernel("thermal_apply");
-  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, wetness_, talus,
-           thermal_share_, dx_, dy_, area_, bed_next_, cell_.thermal, tally_partials_,
-           static_cast<cl_int>(tally_stride_));
+  set_args(apply, cl_int{W_}, cl_int{H_}, kind_, bed_, bed_residual_, wetness_, talus, shares, dx_,
+           dy_, area_, spare_, cell_.thermal, tally_partials_, static_cast<cl_int>(tally_stride_));
   defer(tally, tally_bit(&StepTally::thermal_moved));
   launch_interior(apply);
-  std::swap(bed_, bed_next_);
+  std::swap(bed_, spare_);
 }
 
 void OpenClBackend::finish() {

@@ -274,6 +274,17 @@ class OpenClBackend final : public Backend {
   /// Reals, a copy of `like` where given (what the cells a kernel leaves untouched must hold),
   /// else zeros. Returns `b`.
   Buffer& made(Buffer& b, const Buffer* like = nullptr);
+  /// A second buffer (spare_, depth_next_) ready to take `field`'s new values: made on first
+  /// use as a copy of `field`; else its rows 0 and H - 1, which the update kernels do not
+  /// write, copied from `field` (scratch_rows), so that after the swap they hold the field's.
+  Buffer& second_for(Buffer& second, const Buffer& field);
+  /// depth_next_ as the depth the water update started from ("depth_flow": the transport, the
+  /// sections' and the edges' sediment): made as a copy of the depth before any water update;
+  /// Error(internal) where it holds scratch (depth_next_scratch_).
+  const Buffer& depth_flow();
+  /// Copies rows 0 and H - 1 of `from` into `to`: a second buffer that held scratch gets the
+  /// rows its update leaves as they are.
+  void scratch_rows(const Buffer& from, const Buffer& to);
 
   // Uniform parameters (docs/architecture.md), held as on the CPU reference: Manning n, the
   // hardness and the rain factor are each one row of W values where the run gives one value
@@ -364,10 +375,25 @@ class OpenClBackend final : public Backend {
   Buffer kind_, dx_, dy_, area_;
   // the bed is the pair bed_ + bed_residual_ (common/compensated.h); the residual is read and
   // written at its own cell only, so one buffer
-  Buffer bed_, bed_next_, bed0_, bed_residual_, depth_, depth_next_, sediment_, sediment_next_;
+  Buffer bed_, bed0_, bed_residual_, depth_, sediment_;
+  // The depth the water update started from, for conservative transport ("depth_flow"). From
+  // the transport to the next water update nothing reads it, and it holds thermal collapse's
+  // shares between its two passes ("thermal_share") and the local-inertial face pass's east
+  // faces (discharge, m^3/s) until its cell pass: second_for restores its rows 0 and H - 1,
+  // which the water update does not write, before that update. Made on first use.
+  Buffer depth_next_;
+  bool depth_next_scratch_ = false;  // it holds the faces or the shares, not a depth
+  // The spare: the second buffer of the bed and of the sediment (erosion, thermal collapse and
+  // the transport write their field's new values into it, and the two swap: second_for), and
+  // the local-inertial face pass's south faces (discharge, m^3/s) until its cell pass. One
+  // buffer for the three, as none of them is alive when another begins. bed_next_ is its name
+  // for the field registry (the bed's twin); sediment_next_ is never made (field_registry.hpp
+  // binds both names on both backends).
+  Buffer spare_;
+  Buffer& bed_next_ = spare_;
+  Buffer sediment_next_;
   std::array<Buffer, 4> flux_;  // the outflows, updated in place by every scheme
-  Buffer face_x_, face_y_;      // local inertial: discharge (m^3/s) east / south of each cell
-  Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_, thermal_share_;
+  Buffer velocity_x_, velocity_y_, hardness_, manning_, wetness_, rain_factor_;
   Buffer stage_depth_;  // shallow water, second order: the depth after Heun's first stage
   // The parameters held as one row (uniform_value): their buffers (members above) and values.
   std::vector<std::pair<const Buffer*, Real>> uniform_;
