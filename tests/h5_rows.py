@@ -1,22 +1,22 @@
 #!/usr/bin/env python3
 """erodem — the datasets of one group of two result files, row by row (tests/mpi.sh).
 
-Usage: h5_rows.py REFERENCE RESULT GROUP [--ledger]
+Usage: h5_rows.py REFERENCE RESULT GROUP [--ledger] [--continued]
 
-Every dataset under GROUP in REFERENCE must be in RESULT and the other way round. Where
-RESULT holds fewer rows along the first (unlimited) dimension than REFERENCE, with the other
-dimensions equal (a run continued from a restart file writes only the steps and snapshots from
-there on), its rows are compared with REFERENCE's last rows; the two step and time datasets
-among them show that those are the same steps. h5diff does not compare such datasets at all:
-it calls them "not comparable" and exits 0.
+Every dataset under GROUP in REFERENCE must be in RESULT, with its shape, and the other way
+round. With --continued (RESULT is a run continued from a restart file, which writes only the
+steps and snapshots from there on) a dataset of RESULT may hold fewer rows along the first
+(unlimited) dimension, the other dimensions equal: its rows are compared with REFERENCE's last
+rows, and the step and time datasets among them show that those are the same steps. h5diff
+does not compare such datasets at all: it calls them "not comparable" and exits 0.
 
 The sections' cumulative volumes (sections/volume, sections/sediment_volume) count from the
 restart on (docs/results.md): there RESULT's rows are compared with REFERENCE's last rows less
-the row before them, within a relative 1e-12 of the largest of those (the two sums add the
-same steps' volumes in a different order). The per-step discharges beside them are compared
-exactly.
+the row before them, within a relative 1e-12 of the largest magnitude among the reference's
+rows compared and the one before (the two sums add the same steps' volumes in a different
+order). The per-step discharges beside them are compared exactly.
 
-Otherwise the values must be equal, NaN to NaN. With --ledger (OpenCL, where each MPI rank sums its own
+Otherwise the values must be equal: NaN to NaN, an infinity to the same infinity. With --ledger (OpenCL, where each MPI rank sums its own
 rows' tallies on the device and the ranks' sums are added in rank order): the ledger's
 tallies and volumes (ledger_*, *_volume) within a relative 1e-12 (0 where the reference is 0),
 the relative closure errors within 1e-12, the other closure errors within 1e-9 m^3; a tally
@@ -58,18 +58,21 @@ def datasets(group):
 
 
 def differs(a, b, kind, bound):
-    """The largest difference of a from b where it is beyond the bound, else None."""
+    """The largest difference of a from b where it is beyond the bound, else None. Equal
+    values (the same infinities included) and NaN against NaN differ by 0; a finite value
+    against a non-finite one by infinity; a relative bound applies to finite references."""
     if a.dtype.names or a.dtype.kind not in "fiub":
         return None if np.array_equal(a, b) else "values differ"
     a = a.astype(np.float64)
     b = b.astype(np.float64)
-    both_nan = np.isnan(a) & np.isnan(b)
-    diff = np.where(both_nan, 0.0, np.abs(a - b))
+    with np.errstate(invalid="ignore"):
+        same = (a == b) | (np.isnan(a) & np.isnan(b))
+        diff = np.where(same, 0.0, np.abs(a - b))
     diff = np.where(np.isnan(diff), np.inf, diff)
     if kind == "exact":
         limit = np.zeros_like(a)
     elif kind == "rel":
-        limit = bound * np.abs(a)
+        limit = np.where(np.isfinite(a), bound * np.abs(a), 0.0)
     else:
         limit = np.full_like(a, bound)
     if np.all(diff <= limit):
@@ -78,10 +81,12 @@ def differs(a, b, kind, bound):
 
 
 def main(argv):
-    if len(argv) not in (4, 5) or (len(argv) == 5 and argv[4] != "--ledger"):
+    options = set(argv[4:])
+    if len(argv) < 4 or not options <= {"--ledger", "--continued"}:
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         return 2
-    ref_path, out_path, group, ledger = argv[1], argv[2], argv[3], len(argv) == 5
+    ref_path, out_path, group = argv[1], argv[2], argv[3]
+    ledger, continued = "--ledger" in options, "--continued" in options
     try:
         ref_file, out_file = h5py.File(ref_path, "r"), h5py.File(out_path, "r")
         ref, out = datasets(ref_file[group]), datasets(out_file[group])
@@ -97,11 +102,14 @@ def main(argv):
         a, b = ref[name][()], out[name][()]
         kind, bound = tolerance(name.split("/")[-1], ledger)
         if a.shape != b.shape:
-            if a.ndim >= 1 and a.shape[1:] == b.shape[1:] and b.shape[0] < a.shape[0]:
+            if continued and a.ndim >= 1 and a.shape[1:] == b.shape[1:] and \
+                    b.shape[0] < a.shape[0]:
                 first = a.shape[0] - b.shape[0]
                 if f"{group.strip('/')}/{name}" in RESTARTED_SUMS:
+                    scale = np.abs(a[first - 1:].astype(np.float64))
+                    scale = float(np.max(scale[np.isfinite(scale)], initial=0.0))
                     a = a[first:] - a[first - 1]
-                    kind, bound = "abs", 1e-12 * float(np.max(np.abs(ref[name][()])))
+                    kind, bound = "abs", 1e-12 * scale
                 else:
                     a = a[first:]
                 tails += 1

@@ -52,7 +52,8 @@
 # context) against the serial OpenCL run, bit for bit as on the CPU, twice: with the launches
 # of whole rows PoCL gets by default, and with ERODEM_OPENCL_WG=64 (work-groups that do not
 # divide a row, and the statistics' tree reduction: the launches GPUs get).
-# Exit 77 (skipped) without mpirun or h5diff, or for `opencl` without an OpenCL device.
+# Exit 77 (skipped) without mpirun, h5diff or Python's h5py, or for `opencl` without an OpenCL
+# device.
 # Usage: mpi.sh path/to/erodem SCENARIO [BACKEND]
 set -euo pipefail
 erodem=$(realpath "$1")
@@ -69,6 +70,10 @@ for tool in mpirun h5diff; do
     exit 77
   fi
 done
+if ! python3 -c 'import h5py, numpy' 2>/dev/null; then
+  echo "python3 without h5py and numpy (tests/h5_rows.py; scripts/setup.sh installs them): skipped"
+  exit 77
+fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
@@ -167,7 +172,8 @@ EOF
 esac
 
 failed=0
-# same_as REFERENCE RESULT LABEL: the comparisons above; failed=1 on any difference. Every
+# same_as REFERENCE RESULT LABEL [continued]: the comparisons above; failed=1 on any
+# difference; `continued`: RESULT is a run continued from a restart file. Every
 # dataset of /diagnostics, /restart, /gauges and /sections by tests/h5_rows.py: a run continued
 # from a restart file holds only the steps and snapshots from there on, compared with the
 # reference's last rows (h5diff calls datasets of other lengths "not comparable" and exits 0:
@@ -181,7 +187,7 @@ failed=0
 # relative_material_closure_error differs by 2.4e-20 at np 3, shallow water). A tally that
 # missed or doubled a band's halo rows would be off by a few per cent.
 same_as() {
-  local ref=$1 out=$2 label=$3 rc=0 g groups=(/diagnostics /restart) opts
+  local ref=$1 out=$2 label=$3 continued=${4:-} rc=0 g groups=(/diagnostics /restart) opts
   "$erodem" compare "$out" "$ref" --tol 0 >compare.txt 2>&1 || rc=$?
   if [ $rc -ne 0 ]; then
     echo "FAIL $label: erodem compare --tol 0 exit $rc:"
@@ -194,8 +200,10 @@ same_as() {
   for g in "${groups[@]}"; do
     opts=()
     if [ "$backend" = opencl ] && [ $g = /diagnostics -o $g = /restart ]; then opts=(--ledger); fi
-    if ! python3 "$here/h5_rows.py" "$ref" "$out" $g "${opts[@]}" >rows.txt 2>&1; then
-      echo "FAIL $label: $g differs (h5_rows.py${opts:+ --ledger}):"
+    local rows_opts=("${opts[@]}")
+    [ -z "$continued" ] || rows_opts+=(--continued)
+    if ! python3 "$here/h5_rows.py" "$ref" "$out" $g "${rows_opts[@]}" >rows.txt 2>&1; then
+      echo "FAIL $label: $g differs (h5_rows.py ${rows_opts[*]}):"
       head -20 rows.txt
       failed=1
       rc=1
@@ -371,10 +379,10 @@ elif [ "$scenario" = restart ]; then
   run "np 4, 20 steps" first4.h5 "${mpi[@]}" -np 4 "$erodem" run scenario.toml --set time.steps=20
   for n in 2 4; do
     run "np $n from np 3" rest$n.h5 "${mpi[@]}" -np $n "$erodem" run scenario.toml --restart first3.h5
-    same_as serial.h5 rest$n.h5 "restart np 3 -> np $n"
+    same_as serial.h5 rest$n.h5 "restart np 3 -> np $n" continued
   done
   run "one process from np 4" rest1.h5 "$erodem" run scenario.toml --restart first4.h5
-  same_as serial.h5 rest1.h5 "restart np 4 -> no mpirun"
+  same_as serial.h5 rest1.h5 "restart np 4 -> no mpirun" continued
 else
   # With parallel HDF5 (`erodem --version` says so) the ranks write the one result file
   # together and none needs a file of its own: they run with TMPDIR naming no folder, where the

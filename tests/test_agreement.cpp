@@ -16,6 +16,9 @@
 #include "erodem/io/raster.hpp"
 #include "erodem/simulation.hpp"
 #include "scenarios.hpp"
+#ifdef ERODEM_HAVE_OPENCL
+#include "opencl/opencl_backend.hpp"
+#endif
 
 namespace erodem::test {
 namespace {
@@ -349,6 +352,20 @@ TEST(AgreementRowTail, FieldsTalliesAndStatisticsOnRowsWithATail) {
     const std::string grid = std::to_string(terrain.grid.nx) + " x " +
                              std::to_string(terrain.grid.ny) +
                              (synthetic ? " synthetic" : " Tujunga");
+#ifdef ERODEM_HAVE_OPENCL
+    // the launches this test is for: on a device with whole-row launches (CPU devices), the
+    // row's groups and its tail; on one with the rounded launches (GPUs) the same comparisons
+    // hold, but no tail is launched
+    const auto* backend = dynamic_cast<const opencl::OpenClBackend*>(&ocl.backend());
+    ASSERT_NE(backend, nullptr);
+    const opencl::RowLaunch rows = backend->row_launch();
+    std::printf("[row tail] %s: %s, groups of %zu, a tail of %zu (expected %d)\n", grid.c_str(),
+                backend->whole_rows() ? "whole-row launches" : "rounded launches (no tail)",
+                rows.group, rows.tail, synthetic ? 4 : 1);
+    if (backend->whole_rows()) {
+      EXPECT_EQ(rows.tail, synthetic ? 4u : 1u) << grid;
+    }
+#endif
     for (int k = 0; k < 3; ++k) {
       cpu.step(100);
       ocl.step(100);

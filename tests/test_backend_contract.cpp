@@ -588,7 +588,8 @@ TEST_P(BackendContract, StatisticsTakeTheFirstCellOfATie) {
 // 4 B per cell: bed, the spare (the second buffer of the bed and of the sediment, and the face
 // pass's south faces), the initial bed, the bed residual, depth, depth_next (which holds the
 // face pass's east faces and the thermal shares while it is not read), wetness, sediment, four
-// outflows, two velocities and the soil: 61 B, the CPU reference's fields and the spare. Until
+// outflows, two velocities and the soil: 61 B, the CPU reference's 15 with the spare in place
+// of its thermal-share field. Until
 // 2026-11-28 it also held the outflows' second buffers (16 B) and the three parameters per cell
 // (12 B); until 2026-11-29 the sediment's own second buffer, the two face fields and the thermal
 // shares (16 B): 77 B. Water only (no erosion, no thermal collapse) it needs no soil: 14 fields,

@@ -175,6 +175,10 @@ class OpenClBackend final : public Backend {
   OwnRows own_field_rows(FieldId id, int row0, int row1) const override;
   void set_field(FieldId id, const std::vector<double>& values) override;
   void set_field_rows(FieldId id, int row0, int row1, const std::vector<double>& values) override;
+  /// How the cell kernels cover a padded row: whole rows (whole_row_launch: groups and a tail),
+  /// or the rounded launches (GPUs, ERODEM_OPENCL_WG) with `group` work-items and no tail.
+  bool whole_rows() const { return rt_->whole_rows; }
+  RowLaunch row_launch() const { return {local_x_, tail_x_}; }
 
  private:
   using Real = float;
