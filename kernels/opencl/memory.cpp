@@ -92,6 +92,11 @@ const Buffer& OpenClBackend::depth_flow() {
   return made(depth_next_, &depth_);  // before any water update: the depth as it is
 }
 
+Buffer& OpenClBackend::depth_next_as_scratch() {
+  depth_next_scratch_ = true;
+  return made(depth_next_);
+}
+
 void OpenClBackend::scratch_rows(const Buffer& from, const Buffer& to) {
   const std::size_t row = static_cast<std::size_t>(W_) * sizeof(Real);
   for (const std::size_t at : {std::size_t{0}, static_cast<std::size_t>(H_ - 1) * row})

@@ -391,11 +391,12 @@ void OpenClBackend::set_faces(const std::vector<Face>& faces) {
 
 void OpenClBackend::measure_faces(bool sediment) {
   if (face_count_ == 0) return;
-  // before the water update or the transport: the arrays they read (sections.h)
+  // before the water update or the transport: the arrays they read (sections.h); the water's
+  // faces do not read depth_flow, for which the depth stands in
   cl_kernel k = kernel("section_faces");
   set_args(k, static_cast<cl_int>(face_count_), cl_int{W_}, cl_int{sediment ? 1 : 0}, face_codes_,
-           sediment_, sediment ? depth_flow() : made(depth_next_), flux_[0], flux_[1], flux_[2],
-           flux_[3], sediment ? face_sediment_out_ : face_water_out_);
+           sediment_, sediment ? depth_flow() : depth_, flux_[0], flux_[1], flux_[2], flux_[3],
+           sediment ? face_sediment_out_ : face_water_out_);
   const std::size_t global = face_count_;
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
                                profile_event(k)),
@@ -531,8 +532,7 @@ void OpenClBackend::run_flow(Real dt) {
   // cell, so it writes the outflows in place: no second buffers (16 B per cell). The faces
   // are scratch in buffers that hold nothing alive during the flow (depth_next_, spare_):
   // the face kernels together write every face the cell pass reads.
-  const Buffer& face_x = made(depth_next_);
-  depth_next_scratch_ = true;
+  const Buffer& face_x = depth_next_as_scratch();
   const Buffer& face_y = made(spare_);
   for (const char* name : {"flow_local_inertial_faces_x_interior",
                            "flow_local_inertial_faces_y_interior", "flow_local_inertial_faces"})
@@ -624,8 +624,7 @@ void OpenClBackend::run_transport(Real dt, StepTally& tally) {
 
 void OpenClBackend::run_thermal(Real dt, StepTally& tally) {
   second_for(spare_, bed_);
-  const Buffer& shares = made(depth_next_);  // scratch after the transport
-  depth_next_scratch_ = true;
+  const Buffer& shares = depth_next_as_scratch();  // after the transport
   cl_kernel share = kernel("thermal_share");
   // The talus slopes are read only where the classes set them (by_class); otherwise any
   // buffer of the grid's size stands in, so that no field of zeros is made for them (4 B/cell).

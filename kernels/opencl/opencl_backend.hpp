@@ -286,6 +286,9 @@ class OpenClBackend final : public Backend {
   /// sections' and the edges' sediment): made as a copy of the depth before any water update;
   /// Error(internal) where it holds scratch (depth_next_scratch_).
   const Buffer& depth_flow();
+  /// depth_next_ to hold scratch (the face pass's east faces, the thermal shares) until the
+  /// next water update: made on first use, and marked so that depth_flow refuses it.
+  Buffer& depth_next_as_scratch();
   /// Copies rows 0 and H - 1 of `from` into `to`: a second buffer that held scratch gets the
   /// rows its update leaves as they are.
   void scratch_rows(const Buffer& from, const Buffer& to);

@@ -78,6 +78,12 @@ typedef int8 acc8_mask_t;
 #error "the host defines the tally slots (ERODEM_TALLY_*) in the build options"
 #endif
 
+/* Whether this launch is the tail of whole rows: launch_rows launches a row's last columns on
+ * their own at an x offset, every other launch at column 0. */
+static inline int row_tail_launch(void) {
+  return get_global_offset(0) > 0;
+}
+
 /* The partial of this work-group in a tally slot of `stride` partials: its linear index among
  * the launch's groups; for the tail of whole rows (the row's last columns, launched on their
  * own at an x offset: launch_rows) the slot's top, stride - 1 - its row in the launch. The
@@ -86,7 +92,7 @@ typedef int8 acc8_mask_t;
  * every partial of the halo rows (launch_interior). */
 static inline int cell_group_index(int stride) {
 #ifdef ERODEM_WHOLE_ROWS
-  if (get_global_offset(0) > 0) return stride - 1 - (int)get_group_id(1);
+  if (row_tail_launch()) return stride - 1 - (int)get_group_id(1);
 #endif
   return (int)get_group_id(0) + (int)get_group_id(1) * (int)get_num_groups(0);
 }

@@ -19,10 +19,10 @@
 namespace erodem::opencl {
 
 RowLaunch whole_row_launch(std::size_t W, std::size_t limit) {
-  const std::size_t cap = std::min<std::size_t>(limit, 1024);  // ERODEM_CELL_GROUP_MAX
-  const std::size_t lo = std::min<std::size_t>(32, std::min(W, cap));
-  RowLaunch best{std::min(W, cap), W % std::min(W, cap)};
-  for (std::size_t g = std::min(W, cap); g >= lo && g > 0; --g)
+  const std::size_t hi = std::min<std::size_t>({W, limit, 1024});  // ERODEM_CELL_GROUP_MAX
+  const std::size_t lo = std::min<std::size_t>(32, hi);
+  RowLaunch best{hi, W % hi};
+  for (std::size_t g = hi; g >= lo && g > 0; --g)
     if (W % g < best.tail) best = {g, W % g};
   return best;
 }

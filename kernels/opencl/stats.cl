@@ -179,10 +179,11 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
  *  - whole rows (ERODEM_WHOLE_ROWS, CPU devices): a cell kernel (launch_interior), one
  *    work-item per padded cell in groups of (L, 1) inside one row (L <= ERODEM_CELL_GROUP_MAX),
  *    g = group x + (y - 1) * groups_per_row; the row's tail (its last columns, launched on
- *    their own at an x offset where L does not divide the row: launch_rows) is its last group. Each
- * work-item stores its cell's values in local memory as they are (floats); one work-item then sums
- * them in acc_t, in eight lanes (see cell_tallies_sum), and multiplies by the row's cell area: the
- * area is one number per row (field_stats_group). PoCL runs that walk as vector loops;
+ *    their own at an x offset where L does not divide the row: launch_rows) is its last
+ *    group. Each work-item stores its cell's values in local memory as they are (floats); one
+ *    work-item then sums them in acc_t, in eight lanes (see cell_tallies_sum), and multiplies
+ *    by the row's cell area: the area is one number per row (field_stats_group). PoCL runs
+ *    that walk as vector loops;
  *  - row launches (GPUs): one work-group of L <= ERODEM_STATS_GROUP_MAX work-items per row,
  *    g = y - 1 (stats_rows sees one group per row). Work-item l walks the row's columns
  *    1 + l, 1 + l + L, ... (neighbouring work-items read neighbouring cells), keeping its own
@@ -226,7 +227,7 @@ __kernel void field_stats(int W, int H, int groups_per_row, __global const uchar
     field_stats_group(W, (int)(get_group_id(1) + get_global_offset(1)),
                       (int)(get_group_id(0) * get_local_size(0) + get_global_offset(0)),
                       (int)get_local_size(0),
-                      (get_global_offset(0) > 0 ? groups_per_row - 1 : (int)get_group_id(0)) +
+                      (row_tail_launch() ? groups_per_row - 1 : (int)get_group_id(0)) +
                           (int)get_group_id(1) * groups_per_row,
                       s_d, s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
 #else
