@@ -81,19 +81,17 @@ int bytes_per_cell(const std::string& process, const Params& p) {
   return 0;
 }
 
-/// The bytes per cell of the full step run in `passes` on `backend`: a pass the backend fuses
-/// counts its fields once (pass_sweep), any other each process's sweeps; plus the statistics.
+/// The bytes per cell of the full step run in `passes` on `backend`: each part of a pass that
+/// the backend fuses (Backend::fused_parts) counts its fields once (pass_sweep), any other
+/// process its sweeps; plus the statistics.
 int full_step_bytes(const std::vector<std::vector<Process>>& passes, const Backend& backend,
                     const Params& p) {
   const int real = p.numerics.precision == Precision::float64 ? 8 : 4;
   int bytes = sweep_bytes(stats_sweep(), real).total();
-  for (const auto& pass : passes) {
-    if (backend.fuses(pass)) {
-      bytes += sweep_bytes(pass_sweep(pass, p), real).total();
-      continue;
-    }
-    for (const Process q : pass) bytes += process_bytes(q, p, real).total();
-  }
+  for (const auto& pass : passes)
+    for (const auto& part : backend.fused_parts(pass))
+      bytes += part.size() > 1 ? sweep_bytes(pass_sweep(part, p), real).total()
+                               : process_bytes(part.front(), p, real).total();
   return bytes;
 }
 

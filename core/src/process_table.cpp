@@ -534,8 +534,15 @@ std::vector<std::vector<Process>> fused_passes(const Params& params) {
   for (const Process p : {Process::flow, Process::sources, Process::water})
     for (const auto& s : process_info(p).sweeps(params))
       if (s.generic) return {};
-  return {{Process::flow, Process::sources, Process::water, Process::evaporation},
-          {Process::flow, Process::sources, Process::water}};
+  std::vector<std::vector<Process>> runs{
+      {Process::flow, Process::sources, Process::water, Process::evaporation}};
+  bool erosion_generic = false;
+  for (const auto& s : process_info(Process::erosion).sweeps(params))
+    erosion_generic = erosion_generic || s.generic;
+  if (!erosion_generic)
+    runs.push_back({Process::flow, Process::sources, Process::water, Process::erosion});
+  runs.push_back({Process::flow, Process::sources, Process::water});
+  return runs;
 }
 
 std::vector<std::vector<Process>> step_passes(const Params& params, bool fused) {

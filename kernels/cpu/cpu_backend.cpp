@@ -200,25 +200,32 @@ void CpuBackend<Real>::run(Process p) {
 }
 
 template <class Real>
-bool CpuBackend<Real>::fuses(const std::vector<Process>& pass) const {
+std::vector<std::vector<Process>> CpuBackend<Real>::fused_parts(
+    const std::vector<Process>& pass) const {
   // fused_passes() leaves out shallow water and generic sweeps; a periodic halo, or the halo
-  // rows of an MPI band, are exchanged between the three, so it runs them one by one
-  const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water},
-      water_only{Process::flow, Process::sources, Process::water, Process::evaporation};
-  return (pass == flow_water || pass == water_only) &&
-         params_.flow.scheme != FlowScheme::shallow_water && !periodic_ && !band_.banded;
+  // rows of an MPI band, are exchanged between the three, so it runs them one by one. The
+  // pass of flow, sources, water (and evaporation after them, or erosion: that one alone).
+  const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water};
+  auto parts = Backend::fused_parts(pass);
+  if (params_.flow.scheme == FlowScheme::shallow_water || periodic_ || band_.banded ||
+      pass.size() < flow_water.size() ||
+      !std::equal(flow_water.begin(), flow_water.end(), pass.begin()))
+    return parts;
+  const std::size_t n = pass.size() > 3 && pass[3] == Process::evaporation ? 4 : flow_water.size();
+  parts.erase(parts.begin(), parts.begin() + static_cast<std::ptrdiff_t>(n));
+  parts.insert(parts.begin(),
+               std::vector<Process>(pass.begin(), pass.begin() + static_cast<std::ptrdiff_t>(n)));
+  return parts;
 }
 
 template <class Real>
-void CpuBackend<Real>::run_pass(const std::vector<Process>& pass) {
-  if (!fuses(pass)) {
-    Backend::run_pass(pass);
-    return;
-  }
+void CpuBackend<Real>::run_fused(const std::vector<Process>& part) {
   if (!in_step_) throw Error(ExitCode::internal, "backend: run_pass() outside a step (begin_step)");
+  if (part.size() < 3 || part[0] != Process::flow || part[2] != Process::water)
+    throw Error(ExitCode::internal, "backend: no fused pass for this part of a pass");
   pass_stats_ = false;
   run_flow_water(static_cast<Real>(step_inputs_.dt), step_tally_,
-                 pass.back() == Process::evaporation);
+                 part.back() == Process::evaporation);
 }
 
 template <class Real>

@@ -57,9 +57,9 @@ class CpuBackend final : public Backend {
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
   /// Flow + sources + water (+ evaporation) as one pass (run_flow_water) where it can: local
-  /// inertial or pipes, no periodic halo; any other pass as run() of each process.
-  void run_pass(const std::vector<Process>& pass) override;
-  bool fuses(const std::vector<Process>& pass) const override;
+  /// inertial or pipes, no periodic halo, no MPI band; any other part as run() of its process.
+  std::vector<std::vector<Process>> fused_parts(const std::vector<Process>& pass) const override;
+  void run_fused(const std::vector<Process>& part) override;
   StepResult end_step() override;
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,

@@ -3,6 +3,28 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "erosion.h"
 
+/* Erosion's tallies of a work-group (erosion, erosion_physical and the fused kernels): the
+ * eroded and deposited volumes, each summed as cell_group_sum2 sums into its slot of partial g
+ * (reduce.cl). */
+static inline void erosion_group_sums(__local real* s_eroded, __local real* s_deposited,
+                                      __local acc_t* lanes, real eroded, real deposited,
+                                      __global acc_t* partials, int stride, int g) {
+  cell_group_sum2(s_eroded, s_deposited, lanes, eroded, deposited,
+                  partials + ERODEM_TALLY_ERODED * stride + g,
+                  partials + ERODEM_TALLY_DEPOSITED * stride + g);
+}
+
+/* The physical law's two more (erosion_physical, water_erosion_physical): the bedrock's part
+ * of the eroded volume and the bed's bulking, in arrays of their own (their barrier comes
+ * after every work-item stored erosion_group_sums' values). */
+static inline void bedrock_group_sums(__local real* s_rock, __local real* s_bulking,
+                                      __local acc_t* lanes, real rock, real bulking,
+                                      __global acc_t* partials, int stride, int g) {
+  cell_group_sum2(s_rock, s_bulking, lanes, rock, bulking,
+                  partials + ERODEM_TALLY_ERODED_BEDROCK * stride + g,
+                  partials + ERODEM_TALLY_BED_BULKING * stride + g);
+}
+
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
  * is rounded up, every work-item still reaches the group sums): erosion_sweep_cell. The
  * eroded and deposited volumes are summed per work-group into the tally partials (reduce.cl). */
@@ -24,10 +46,8 @@ __kernel void erosion(int W, int H, __global const uchar* restrict kind,
                        hardness, dx, dy, area, dt, p, &b, &eroded, &deposited);
     bed_out[x + y * W] = b;
   }
-  const int g = cell_group_index(stride);
-  cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
-                  partials + ERODEM_TALLY_ERODED * stride + g,
-                  partials + ERODEM_TALLY_DEPOSITED * stride + g);
+  erosion_group_sums(s_eroded, s_deposited, s_lanes, eroded, deposited, partials, stride,
+                     cell_group_index(stride));
 }
 
 /* The physical law (erosion.law = "physical"): sediment_sweep_cell, with the soil thickness and
@@ -56,10 +76,6 @@ __kernel void erosion_physical(
     bed_out[x + y * W] = b;
   }
   const int g = cell_group_index(stride);
-  cell_group_sum2(s_eroded, s_deposited, s_lanes, eroded, deposited,
-                  partials + ERODEM_TALLY_ERODED * stride + g,
-                  partials + ERODEM_TALLY_DEPOSITED * stride + g);
-  cell_group_sum2(s_rock, s_bulking, s_lanes, rock, bulking,
-                  partials + ERODEM_TALLY_ERODED_BEDROCK * stride + g,
-                  partials + ERODEM_TALLY_BED_BULKING * stride + g);
+  erosion_group_sums(s_eroded, s_deposited, s_lanes, eroded, deposited, partials, stride, g);
+  bedrock_group_sums(s_rock, s_bulking, s_lanes, rock, bulking, partials, stride, g);
 }

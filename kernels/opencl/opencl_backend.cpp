@@ -275,6 +275,39 @@ void OpenClBackend::run(Process p) {
       [&](const std::vector<std::string>& names) { exchange_halo(names); });
 }
 
+std::vector<std::vector<Process>> OpenClBackend::fused_parts(
+    const std::vector<Process>& pass) const {
+  // fused_passes() leaves out generic sweeps of both; a periodic halo, or the halo rows of an
+  // MPI band, are exchanged between the two (the erosion of a halo row would read velocities
+  // its band computed without the rows beyond), so they run one by one there
+  std::vector<std::vector<Process>> parts;
+  for (std::size_t k = 0; k < pass.size(); ++k) {
+    if (pass[k] == Process::water && k + 1 < pass.size() && pass[k + 1] == Process::erosion &&
+        !periodic_ && !band_.banded && params_.flow.scheme != FlowScheme::shallow_water) {
+      parts.push_back({Process::water, Process::erosion});
+      ++k;
+      continue;
+    }
+    parts.push_back({pass[k]});
+  }
+  return parts;
+}
+
+void OpenClBackend::run_fused(const std::vector<Process>& part) {
+  if (!in_step_) throw Error(ExitCode::internal, "backend: run_pass() outside a step (begin_step)");
+  if (part != std::vector<Process>{Process::water, Process::erosion})
+    throw Error(ExitCode::internal, "backend: no fused kernel for this part of a pass");
+  const Real dt = static_cast<Real>(step_inputs_.dt);
+  measure_faces(false);  // as run(water)
+  run_water_erosion(dt, step_tally_);
+  // the generic sweeps and exchanges after each (none outside a band: fused_passes)
+  for (const Process p : part)
+    run_sweeps_tail(
+        tails_.at(static_cast<std::size_t>(p)),
+        [&](const SweepInfo& s) { run_generic(s, p, dt, step_tally_); },
+        [&](const std::vector<std::string>& names) { exchange_halo(names); });
+}
+
 void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
   if (!periodic_ && !band_.banded) return;
   std::vector<const Buffer*> buffers;
@@ -596,6 +629,35 @@ void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
            static_cast<cl_int>(tally_stride_));
   defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited));
   launch_interior(k);
+  std::swap(bed_, spare_);
+}
+
+void OpenClBackend::run_water_erosion(Real dt, StepTally& tally) {
+  second_for(depth_next_, depth_);  // as run_water
+  depth_next_scratch_ = false;
+  second_for(spare_, bed_);  // as run_erosion
+  const bool physical = params_.erosion.law == ErosionLaw::physical;
+  cl_kernel k = kernel(physical ? "water_erosion_physical" : "water_erosion");
+  if (physical)
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
+             flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water, spare_,
+             bed_residual_, sediment_, *field_buffer(FieldId::soil_thickness), manning_, hardness_,
+             cell_.sediment, tally_partials_, static_cast<cl_int>(tally_stride_));
+  else
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
+             flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water, spare_,
+             bed_residual_, sediment_, hardness_, cell_.erosion, tally_partials_,
+             static_cast<cl_int>(tally_stride_));
+  defer(tally,
+        tally_bit(&StepTally::boundary_out) | tally_bit(&StepTally::clipped) |
+            tally_bit(&StepTally::water_exchanged) | tally_bit(&StepTally::eroded) |
+            tally_bit(&StepTally::deposited) |
+            (physical ? tally_bit(&StepTally::eroded_bedrock) | tally_bit(&StepTally::bed_bulking)
+                      : 0u));
+  pending_water_dt_ = dt;
+  launch_interior(k);
+  launch_edge_tallies(tally_slot(&StepTally::boundary_out), dt);
+  std::swap(depth_, depth_next_);  // depth_next_ keeps the depth the update started from
   std::swap(bed_, spare_);
 }
 

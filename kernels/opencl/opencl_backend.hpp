@@ -162,6 +162,11 @@ class OpenClBackend final : public Backend {
   std::size_t device_bytes() const override { return device_bytes_; }
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
+  /// The water update and erosion, where one follows the other in a pass, as one kernel
+  /// (run_water_erosion, fused.cl), outside a periodic halo and an MPI band; every other part
+  /// as run() of its process.
+  std::vector<std::vector<Process>> fused_parts(const std::vector<Process>& pass) const override;
+  void run_fused(const std::vector<Process>& part) override;
   StepResult end_step() override;
   FieldStats stats() override;
   void set_probes(const std::vector<std::int64_t>& cells,
@@ -188,6 +193,8 @@ class OpenClBackend final : public Backend {
   void run_flow(Real dt);
   void run_water(Real dt, StepTally& tally);
   void run_erosion(Real dt, StepTally& tally);
+  /// run_water then run_erosion in one launch (fused.cl): the same buffers, tallies and swaps.
+  void run_water_erosion(Real dt, StepTally& tally);
   void run_transport(Real dt, StepTally& tally);
   void run_thermal(Real dt, StepTally& tally);
   /// A generic sweep of the process table (process.hpp SweepInfo::generic): its kernel with

@@ -7,6 +7,17 @@
 #include "shallow_water.h"
 #include "water.h"
 
+/* The water update's tallies of a work-group (water_update, water_erosion): the volume lifted
+ * from rounding-level negatives and the volume the cells gave, each summed as cell_group_sum2
+ * sums into its slot of partial g (reduce.cl). */
+static inline void water_group_sums(__local real* s_clipped, __local real* s_given,
+                                    __local acc_t* lanes, real clipped, real given,
+                                    __global acc_t* partials, int stride, int g) {
+  cell_group_sum2(s_clipped, s_given, lanes, clipped, given,
+                  partials + ERODEM_TALLY_CLIPPED * stride + g,
+                  partials + ERODEM_TALLY_WATER_EXCHANGED * stride + g);
+}
+
 /* One work-item per padded cell of rows 1 .. H - 2 (the host's launch; where the global size
  * is rounded up, every work-item still reaches the group sums). water_update_cell is
  * branch-free and keeps the ghosts' depth (the first and last column are ghosts; their
@@ -27,10 +38,8 @@ __kernel void water_update(int W, int H, __global const uchar* restrict kind,
   if (!ERODEM_PAST_ROW(x, W))
     water_update_cell(x, y, W, kind, bed, depth, depth_out, f_left, f_right, f_top, f_bottom, dx,
                       dy, area, velocity_x, velocity_y, dt, p, &exchange, &clipped, &given);
-  const int g = cell_group_index(stride);
-  cell_group_sum2(s_clipped, s_given, s_lanes, clipped, given,
-                  partials + ERODEM_TALLY_CLIPPED * stride + g,
-                  partials + ERODEM_TALLY_WATER_EXCHANGED * stride + g);
+  water_group_sums(s_clipped, s_given, s_lanes, clipped, given, partials, stride,
+                   cell_group_index(stride));
 }
 
 /* The shallow-water scheme's cell velocities (the generic sweep "shallow_water_velocity",

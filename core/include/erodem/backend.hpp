@@ -149,13 +149,38 @@ class Backend {
   /// Error(ExitCode::internal).
   virtual void run(Process p) = 0;
   /// Runs a pass of step_passes() (process.hpp): consecutive processes of the sequence that
-  /// the backend may run as one pass over memory. The same bits as run() of each in turn,
-  /// which is what this default does; the CPU reference fuses flow + sources + water.
-  virtual void run_pass(const std::vector<Process>& pass) {
-    for (const Process p : pass) run(p);
+  /// the backend may run as fewer passes over memory. Each part of fused_parts(pass) in turn:
+  /// a part of one process by run(), a longer one by run_fused(). The same bits as run() of
+  /// each process in turn (the CPU reference fuses flow + sources + water, the OpenCL backend
+  /// water + erosion).
+  void run_pass(const std::vector<Process>& pass) {
+    for (const auto& part : fused_parts(pass)) {
+      if (part.size() == 1)
+        run(part.front());
+      else
+        run_fused(part);
+    }
   }
-  /// Whether run_pass(pass) runs it as one pass (else one process after the other).
-  virtual bool fuses(const std::vector<Process>& /*pass*/) const { return false; }
+  /// Runs a part of a pass that fused_parts() gives as one sweep; outside a step:
+  /// Error(ExitCode::internal). This default (for a backend that fuses nothing): run() of
+  /// each.
+  virtual void run_fused(const std::vector<Process>& part) {
+    for (const Process p : part) run(p);
+  }
+  /// The parts of `pass` (a pass of step_passes()) that run_pass runs as one sweep each, in
+  /// order, every process of the pass in one; a part of one process runs as run() runs it.
+  /// This default: every process alone.
+  virtual std::vector<std::vector<Process>> fused_parts(const std::vector<Process>& pass) const {
+    std::vector<std::vector<Process>> parts;
+    for (const Process p : pass) parts.push_back({p});
+    return parts;
+  }
+  /// Whether run_pass(pass) runs any part of it as one sweep (fused_parts).
+  bool fuses(const std::vector<Process>& pass) const {
+    for (const auto& part : fused_parts(pass))
+      if (part.size() > 1) return true;
+    return false;
+  }
   /// The bytes of the device buffers the backend has created so far (OpenCL; 0 where the
   /// state lives in host memory): an upper bound of what it holds on the device at once.
   virtual std::size_t device_bytes() const { return 0; }

@@ -149,15 +149,18 @@ std::vector<std::pair<Process, SweepInfo>> step_sweeps(const Params& params);
 /// backend may run as one pass over memory (Backend::run_pass), each run in step order. With
 /// `fused` false every process is a pass of its own (the readable reference path); with it,
 /// the longest run of fused_passes() that the sequence holds in full at each place is one
-/// pass. Whether a backend fuses a pass is its own choice (the CPU reference does for both
-/// runs, outside a periodic halo); fused or not, the results are the same bits
+/// pass. Which parts of a pass a backend fuses is its own choice (Backend::fused_parts: the
+/// CPU reference flow + sources + water, the OpenCL backend water + erosion, both outside a
+/// periodic halo and an MPI band); fused or not, the results are the same bits
 /// (tests/test_fused.cpp).
 std::vector<std::vector<Process>> step_passes(const Params& params, bool fused);
 /// The runs of processes the table lets a backend fuse with these parameters, longest first:
 /// flow, sources and water (the water update reads the outflows of the rows around it as the
-/// flow leaves them), and evaporation after them where it follows the water update in the
-/// sequence (erosion, transport and thermal collapse off: the water-only step); with local
-/// inertial or pipes flow and none of the first three running a generic sweep.
+/// flow leaves them), with evaporation after them where it follows the water update in the
+/// sequence (erosion, transport and thermal collapse off: the water-only step) or with erosion
+/// where that does (erosion reads only its own cell of what the water update writes: its
+/// depth and velocities); with local inertial or pipes flow and none of the four running a
+/// generic sweep.
 std::vector<std::vector<Process>> fused_passes(const Params& params);
 /// A pass as one sweep for the byte model: the union of its processes' cells sweeps' uses,
 /// each field counted once, as read where its first use reads it and as written where any use
