@@ -90,7 +90,9 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
 
   /* net outflow through faces shared with ghosts; computed on every cell and selected (the
    * neighbours' kinds loaded unconditionally: under `active`, GCC 12 could not if-convert
-   * those loads and left the CPU loop scalar) */
+   * those loads and left the CPU loop scalar). Both backends leave it unused and sum it over
+   * the cells beside a ghost only (edges.cl; CpuBackend::water_row), so their compilers drop
+   * it from the cell loop. */
   const real ghost_exchange = water_exchange_cell(i, W, kind, f_left, f_right, f_top, f_bottom);
   *exchange = active ? ghost_exchange : (real)0;
 

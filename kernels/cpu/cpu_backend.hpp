@@ -239,6 +239,20 @@ class CpuBackend final : public Backend {
     for (std::size_t x = n4; x < n; ++x) s += static_cast<double>(v[x]);
     return s;
   }
+  /// sum_row of a row whose values are +0 but at the columns xs[0 .. count) (increasing), where
+  /// they are value(x): the same bits, since adding +0 leaves a partial sum that started at +0
+  /// as it is (no partial is ever -0). For a tally that only a few cells of a row have.
+  template <class Value>
+  static double sum_row_at(const int* xs, std::size_t count, std::size_t n, const Value& value) {
+    const std::size_t n4 = n - n % 4;
+    double p[4] = {0.0, 0.0, 0.0, 0.0};
+    std::size_t k = 0;
+    for (; k < count && static_cast<std::size_t>(xs[k]) < n4; ++k)
+      p[xs[k] % 4] += static_cast<double>(value(xs[k]));
+    double s = (p[0] + p[1]) + (p[2] + p[3]);
+    for (; k < count; ++k) s += static_cast<double>(value(xs[k]));
+    return s;
+  }
   /// Per-row scratch of `n` zeros for per-cell tallies. From new[], so GCC knows the pointer
   /// is not null and if-converts the stores of the cell loops (a vector's data() may be).
   static std::unique_ptr<Real[]> row_scratch(int n) {
@@ -330,6 +344,10 @@ class CpuBackend final : public Backend {
   // field of ERODEM_FIELDS (field_registry.hpp).
   FieldRegistry<Field> fields_;
   std::vector<double> row_sums_a_, row_sums_b_, row_sums_c_;  // scratch for per-row reductions
+  // The active cells beside a ghost or a wall, the only ones with a water exchange through the
+  // domain's faces: their columns, row by row (edge_x_[edge_row_[y] .. edge_row_[y + 1]) for
+  // padded row y). The kinds never change.
+  std::vector<int> edge_x_, edge_row_;
   std::vector<std::vector<double>> row_sums_;  // per tally of a generic sweep (sweeps.cpp)
   std::vector<std::pair<int, std::size_t>> point_rows_;  // run_flow_water: (row, inflow index)
   // The fused pass with evaporation, when it ends the step (stats_in_pass_), takes the

@@ -19,15 +19,24 @@ void CpuBackend<Real>::water_row(int y, Real dt, const std::array<const Real*, 4
   const Real step = dt;
   const cell_params::WaterParams<Real> p = cell_.water;
   const int W = W_;
-  const auto exchange = row_scratch(W), clipped = row_scratch(W), given = row_scratch(W);
-  Real* ex = exchange.get();
+  const auto clipped = row_scratch(W), given = row_scratch(W);
   Real* cl = clipped.get();
   Real* gv = given.get();
   ERODEM_IVDEP
-  for (int x = 1; x < W - 1; ++x)
+  for (int x = 1; x < W - 1; ++x) {
+    Real exchange;  // unused here (below), so the compiler drops it from the loop
     cell::water_update_cell(x, y, W, kind, bed, depth, depth_out, fl, fr, ft, fb, dx, dy, area, u,
-                            v, step, p, ex + x, cl + x, gv + x);
-  row_sums_a_[y] = sum_row(ex, static_cast<std::size_t>(W));
+                            v, step, p, &exchange, cl + x, gv + x);
+  }
+  // The exchange through the domain's faces, of the cells beside a ghost or a wall only (it is
+  // +0 at every other cell): the bits of sum_row over the whole row (sum_row_at).
+  const std::size_t e0 = static_cast<std::size_t>(edge_row_[static_cast<std::size_t>(y)]),
+                    e1 = static_cast<std::size_t>(edge_row_[static_cast<std::size_t>(y) + 1]);
+  const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
+  row_sums_a_[y] =
+      sum_row_at(edge_x_.data() + e0, e1 - e0, static_cast<std::size_t>(W), [&](int x) {
+        return cell::water_exchange_cell(static_cast<int>(row + x), W, kind, fl, fr, ft, fb);
+      });
   row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
   row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));
 }
