@@ -44,13 +44,17 @@ using std::sqrt;
 typedef std::uint8_t erodem_kind_t;
 }  // namespace cell
 }  // namespace erodem
-#define ERODEM_FN       \
-  template <class real> \
+/* The kinds' type is a template parameter too (erodem_kind_t, a byte by default): a CPU loop
+ * may pass them as int (CpuBackend::water_row), since GCC sizes a loop's vectors by the
+ * smallest type it reads (64 cells at once with AVX-512 for a byte, four registers for every
+ * float value). */
+#define ERODEM_FN                                             \
+  template <class real, class erodem_kind_t = ::std::uint8_t> \
   inline
 /* A cell function too large for GCC's inliner that a vectorised loop must still inline (the
  * shallow-water cell: its four faces and their Riemann problems). */
-#define ERODEM_FN_INLINED \
-  template <class real>   \
+#define ERODEM_FN_INLINED                                     \
+  template <class real, class erodem_kind_t = ::std::uint8_t> \
   inline __attribute__((always_inline))
 #define ERODEM_INLINE inline
 #define GLOBAL
