@@ -218,15 +218,14 @@ std::vector<std::vector<Process>> CpuBackend<Real>::fused_parts(
   // rows of an MPI band, are exchanged between the three, so it runs them one by one. The
   // pass of flow, sources, water (and evaporation after them, or erosion: that one alone).
   const std::vector<Process> flow_water{Process::flow, Process::sources, Process::water};
-  auto parts = Backend::fused_parts(pass);
   if (params_.flow.scheme == FlowScheme::shallow_water || periodic_ || band_.banded ||
       pass.size() < flow_water.size() ||
       !std::equal(flow_water.begin(), flow_water.end(), pass.begin()))
-    return parts;
-  const std::size_t n = pass.size() > 3 && pass[3] == Process::evaporation ? 4 : flow_water.size();
-  parts.erase(parts.begin(), parts.begin() + static_cast<std::ptrdiff_t>(n));
-  parts.insert(parts.begin(),
-               std::vector<Process>(pass.begin(), pass.begin() + static_cast<std::ptrdiff_t>(n)));
+    return Backend::fused_parts(pass);
+  const std::size_t n = pass.size() > 3 && pass[3] == Process::evaporation ? 4 : 3;
+  std::vector<std::vector<Process>> parts{
+      {pass.begin(), pass.begin() + static_cast<std::ptrdiff_t>(n)}};
+  for (std::size_t k = n; k < pass.size(); ++k) parts.push_back({pass[k]});
   return parts;
 }
 

@@ -592,42 +592,59 @@ void OpenClBackend::run_flow(Real dt) {
   launch_rows(kernel("flow_local_inertial_split"), H_ - 1, H_);
 }
 
+template <class... Rest>
+void OpenClBackend::set_water_args(cl_kernel k, Real dt, const Rest&... rest) {
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
+           flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water, rest...);
+}
+
+unsigned OpenClBackend::water_tally_bits() {
+  return tally_bit(&StepTally::boundary_out) | tally_bit(&StepTally::clipped) |
+         tally_bit(&StepTally::water_exchanged);
+}
+
+unsigned OpenClBackend::erosion_tally_bits() const {
+  const unsigned bits = tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited);
+  return params_.erosion.law == ErosionLaw::physical
+             ? bits | tally_bit(&StepTally::eroded_bedrock) | tally_bit(&StepTally::bed_bulking)
+             : bits;
+}
+
+// After the water update's launch: its exchange through the domain's faces (edges.cl), and
+// depth_next_ keeps the depth the update started from (after this step's sources): conservative
+// transport needs it.
+void OpenClBackend::water_update_done(Real dt) {
+  pending_water_dt_ = dt;
+  launch_edge_tallies(tally_slot(&StepTally::boundary_out), dt);
+  std::swap(depth_, depth_next_);
+}
+
 void OpenClBackend::run_water(Real dt, StepTally& tally) {
   second_for(depth_next_, depth_);  // it held the faces and the shares
   depth_next_scratch_ = false;      // the update writes its rows 1 .. H - 2
   cl_kernel k = kernel("water_update");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
-           flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water,
-           tally_partials_, static_cast<cl_int>(tally_stride_));
-  defer(tally, tally_bit(&StepTally::boundary_out) | tally_bit(&StepTally::clipped) |
-                   tally_bit(&StepTally::water_exchanged));
-  pending_water_dt_ = dt;
+  set_water_args(k, dt, tally_partials_, static_cast<cl_int>(tally_stride_));
+  defer(tally, water_tally_bits());
   launch_interior(k);
-  launch_edge_tallies(tally_slot(&StepTally::boundary_out), dt);
-  // depth_next_ keeps the depth the water update started from (after this step's sources):
-  // conservative transport needs it.
-  std::swap(depth_, depth_next_);
+  water_update_done(dt);
 }
 
 void OpenClBackend::run_erosion(Real dt, StepTally& tally) {
   second_for(spare_, bed_);
+  cl_kernel k;
   if (params_.erosion.law == ErosionLaw::physical) {
-    cl_kernel k = kernel("erosion_physical");
+    k = kernel("erosion_physical");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, spare_, bed_residual_, sediment_,
              *field_buffer(FieldId::soil_thickness), depth_, velocity_x_, velocity_y_, manning_,
              hardness_, dx_, dy_, area_, dt, cell_.sediment, tally_partials_,
              static_cast<cl_int>(tally_stride_));
-    defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited) |
-                     tally_bit(&StepTally::eroded_bedrock) | tally_bit(&StepTally::bed_bulking));
-    launch_interior(k);
-    std::swap(bed_, spare_);
-    return;
+  } else {
+    k = kernel("erosion");
+    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, spare_, bed_residual_, sediment_, depth_,
+             velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt, cell_.erosion,
+             tally_partials_, static_cast<cl_int>(tally_stride_));
   }
-  cl_kernel k = kernel("erosion");
-  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, spare_, bed_residual_, sediment_, depth_,
-           velocity_x_, velocity_y_, hardness_, dx_, dy_, area_, dt, cell_.erosion, tally_partials_,
-           static_cast<cl_int>(tally_stride_));
-  defer(tally, tally_bit(&StepTally::eroded) | tally_bit(&StepTally::deposited));
+  defer(tally, erosion_tally_bits());
   launch_interior(k);
   std::swap(bed_, spare_);
 }
@@ -639,25 +656,15 @@ void OpenClBackend::run_water_erosion(Real dt, StepTally& tally) {
   const bool physical = params_.erosion.law == ErosionLaw::physical;
   cl_kernel k = kernel(physical ? "water_erosion_physical" : "water_erosion");
   if (physical)
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
-             flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water, spare_,
-             bed_residual_, sediment_, *field_buffer(FieldId::soil_thickness), manning_, hardness_,
-             cell_.sediment, tally_partials_, static_cast<cl_int>(tally_stride_));
+    set_water_args(k, dt, spare_, bed_residual_, sediment_, *field_buffer(FieldId::soil_thickness),
+                   manning_, hardness_, cell_.sediment, tally_partials_,
+                   static_cast<cl_int>(tally_stride_));
   else
-    set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, depth_next_, flux_[0], flux_[1],
-             flux_[2], flux_[3], dx_, dy_, area_, velocity_x_, velocity_y_, dt, cell_.water, spare_,
-             bed_residual_, sediment_, hardness_, cell_.erosion, tally_partials_,
-             static_cast<cl_int>(tally_stride_));
-  defer(tally,
-        tally_bit(&StepTally::boundary_out) | tally_bit(&StepTally::clipped) |
-            tally_bit(&StepTally::water_exchanged) | tally_bit(&StepTally::eroded) |
-            tally_bit(&StepTally::deposited) |
-            (physical ? tally_bit(&StepTally::eroded_bedrock) | tally_bit(&StepTally::bed_bulking)
-                      : 0u));
-  pending_water_dt_ = dt;
+    set_water_args(k, dt, spare_, bed_residual_, sediment_, hardness_, cell_.erosion,
+                   tally_partials_, static_cast<cl_int>(tally_stride_));
+  defer(tally, water_tally_bits() | erosion_tally_bits());
   launch_interior(k);
-  launch_edge_tallies(tally_slot(&StepTally::boundary_out), dt);
-  std::swap(depth_, depth_next_);  // depth_next_ keeps the depth the update started from
+  water_update_done(dt);
   std::swap(bed_, spare_);
 }
 

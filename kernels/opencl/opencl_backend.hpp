@@ -195,6 +195,14 @@ class OpenClBackend final : public Backend {
   void run_erosion(Real dt, StepTally& tally);
   /// run_water then run_erosion in one launch (fused.cl): the same buffers, tallies and swaps.
   void run_water_erosion(Real dt, StepTally& tally);
+  /// The pieces the water update's and erosion's launches share (run_water, run_erosion,
+  /// run_water_erosion): set_args with water_update's arguments first, then `rest`; what each
+  /// does after its launch; the tallies each books.
+  template <class... Rest>
+  void set_water_args(cl_kernel k, Real dt, const Rest&... rest);
+  void water_update_done(Real dt);
+  static unsigned water_tally_bits();
+  unsigned erosion_tally_bits() const;
   void run_transport(Real dt, StepTally& tally);
   void run_thermal(Real dt, StepTally& tally);
   /// A generic sweep of the process table (process.hpp SweepInfo::generic): its kernel with
