@@ -152,12 +152,16 @@ class BackendContract : public TargetTest {};
 /// instruction set or the thread count (test_cpu_isa.cpp); OpenCL's belong to one device.
 /// Float64 local inertial recorded again on 2026-11-27, when its cube root became
 /// cbrt_f64_positive (compat.h; within 1 ulp as the C library's, which it replaced: was
-/// 0x218ca05766e5842d); pipes take no cube root and kept theirs.
+/// 0x218ca05766e5842d); pipes take no cube root and kept theirs. All four recorded again on
+/// 2026-11-29, when the CPU's row sums (sum_row) and the statistics' volumes moved from four
+/// partial sums and one running sum to sixteen partial sums (performance.md, "Sums in sixteen
+/// lanes"; every field kept its bits; were 0xad8184f0755a5e10, 0x60cd89222141a995,
+/// 0x8706ca05ca84c2d5, 0xd9ec0168a9106f3a).
 std::uint64_t old_path_digest(const Target& t, FlowScheme flow) {
   const bool li = flow == FlowScheme::local_inertial;
   if (t.backend != "cpu") return 0;
-  if (t.f64()) return li ? 0xad8184f0755a5e10ULL : 0x60cd89222141a995ULL;
-  return li ? 0x8706ca05ca84c2d5ULL : 0xd9ec0168a9106f3aULL;
+  if (t.f64()) return li ? 0x4abfc11e008dc6f1ULL : 0xc5370fa82ee0124aULL;
+  return li ? 0x1216715d3afb16afULL : 0xfe856bb7888ac17aULL;
 }
 
 // end_step gives the tallies and statistics the old path gave, and waits do not change them:

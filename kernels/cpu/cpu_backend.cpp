@@ -379,12 +379,12 @@ FieldStats CpuBackend<Real>::stats() {
 
 template <class Real>
 RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
-  // The bits of one scan of the row's active cells in x order (volumes added cell after cell;
-  // the first cell of the largest depth and of the largest squared speed, "larger" strictly,
-  // so NaN never wins; the first cell not physical), in passes of which only the first is
-  // bound by its adds (performance.md "The statistics' row passes"):
-  //  1. the volumes: three running sums in x order, the ledger's bits (an inactive cell adds
-  //     +0, which leaves a sum as it is: a sum that starts at +0 never becomes -0);
+  // The row's volumes (in the fixed order of sum_row's lanes) and the results of one scan of
+  // its active cells in x order (the first cell of the largest depth and of the largest
+  // squared speed, "larger" strictly, so NaN never wins; the first cell not physical), in
+  // passes (performance.md "The statistics' row passes", "Sums in sixteen lanes"):
+  //  1. the volumes: three sums in the lanes of sum_row, times the area (an inactive cell
+  //     adds +0, which leaves a sum as it is: a sum that starts at +0 never becomes -0);
   //  2. per chunk of kStatsChunk cells, the largest depth and squared speed and the smallest
   //     depth (SIMD reductions: a maximum's value does not depend on the order), the chunks
   //     ranked as the scan ranks cells (strictly larger), so the first chunk holding each
@@ -411,15 +411,34 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
     return u * u + v * v;
   };
 
-  double water = 0, material = 0, sed = 0;
-  for (int x = 1; x < W - 1; ++x) {
-    const bool active = kind[x] == ERODEM_CELL_ACTIVE;
-    const double s = sediment[x];
-    water += active ? static_cast<double>(d[x]) * a : 0.0;
-    material +=
-        active ? (static_cast<double>(bed[x]) + static_cast<double>(bed_lo[x]) + s) * a : 0.0;
-    sed += active ? s * a : 0.0;
-  }
+  // the volumes: each a sum over the row's cells in the lanes of sum_row (the x - 1'th active
+  // cell value into lane (x - 1) % kSumLanes), combined by sum_lanes, times the cells' area
+  double pw[kSumLanes] = {}, pm[kSumLanes] = {}, ps[kSumLanes] = {};
+  // The kinds as int: with their bytes in the loop GCC would work on 64 cells at once, more
+  // than a call's kSumLanes (as in water_row).
+  const auto kinds = std::unique_ptr<int[]>(new int[static_cast<std::size_t>(W)]);
+  for (int x = 0; x < W; ++x) kinds[static_cast<std::size_t>(x)] = kind[x];
+  // cells x0 + j, j < count, into lanes j (count <= kSumLanes)
+  const auto add = [&](int x0, std::size_t count) {
+    const int* __restrict k = kinds.get() + x0;
+    const Real* __restrict dd = d + x0;
+    const Real* __restrict b = bed + x0;
+    const Real* __restrict bl = bed_lo + x0;
+    const Real* __restrict sd = sediment + x0;
+    // not unrolled: unrolled, its sixteen cells would not be vectorised (GCC's SLP fails)
+#pragma GCC unroll 1
+    for (std::size_t j = 0; j < count; ++j) {
+      const bool active = k[j] == ERODEM_CELL_ACTIVE;
+      const double s = sd[j];
+      pw[j] += active ? static_cast<double>(dd[j]) : 0.0;
+      pm[j] += active ? static_cast<double>(b[j]) + static_cast<double>(bl[j]) + s : 0.0;
+      ps[j] += active ? s : 0.0;
+    }
+  };
+  const int n = W - 2, whole = n - n % static_cast<int>(kSumLanes);
+  for (int x0 = 1; x0 < 1 + whole; x0 += static_cast<int>(kSumLanes)) add(x0, kSumLanes);
+  add(1 + whole, static_cast<std::size_t>(n - whole));
+  const double water = sum_lanes(pw) * a, material = sum_lanes(pm) * a, sed = sum_lanes(ps) * a;
   row.water = water;
   row.material = material;
   row.sediment = sed;

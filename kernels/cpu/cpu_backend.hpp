@@ -222,36 +222,39 @@ class CpuBackend final : public Backend {
   /// Sums per-row partial sums (one per padded row) in row order (deterministic for any
   /// thread count): in an MPI run, those of the rows of every rank in global row order.
   double sum_rows(const std::vector<double>& rows) const;
-  /// Sums a row of per-cell values in double in a fixed order: four interleaved partial
-  /// sums (cells x = 4k + j into partial j), then (p0 + p1) + (p2 + p3), then the tail.
-  /// Four independent chains of adds instead of one; the same order on every run and for
-  /// any number of threads.
+  /// The partial sums of sum_row: cell x of a row goes to partial x % kSumLanes.
+  static constexpr std::size_t kSumLanes = 16;
+  /// The kSumLanes partial sums of a row combined in a fixed tree (lanes j and j + 8, then
+  /// j and j + 4, j and j + 2, the last two).
+  static double sum_lanes(const double* p) {
+    double q[8];
+    for (std::size_t j = 0; j < 8; ++j) q[j] = p[j] + p[j + 8];
+    for (std::size_t j = 0; j < 4; ++j) q[j] += q[j + 4];
+    return (q[0] + q[2]) + (q[1] + q[3]);
+  }
+  /// Sums a row of per-cell values in double in a fixed order: kSumLanes interleaved partial
+  /// sums (cell x into partial x % kSumLanes, in x order), combined by sum_lanes. Independent
+  /// chains of adds that the compiler keeps in vector registers (each partial is added to in
+  /// the same order whatever the vector width, so the v2, v3 and v4 builds give the same bits);
+  /// the same order on every run and for any number of threads (performance.md, "Sums in
+  /// sixteen lanes").
   static double sum_row(const Real* v, std::size_t n) {
-    const std::size_t n4 = n - n % 4;
-    double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
-    for (std::size_t x = 0; x < n4; x += 4) {
-      p0 += static_cast<double>(v[x]);
-      p1 += static_cast<double>(v[x + 1]);
-      p2 += static_cast<double>(v[x + 2]);
-      p3 += static_cast<double>(v[x + 3]);
-    }
-    double s = (p0 + p1) + (p2 + p3);
-    for (std::size_t x = n4; x < n; ++x) s += static_cast<double>(v[x]);
-    return s;
+    const std::size_t whole = n - n % kSumLanes;
+    double p[kSumLanes] = {};
+    for (std::size_t x = 0; x < whole; x += kSumLanes)
+      for (std::size_t j = 0; j < kSumLanes; ++j) p[j] += static_cast<double>(v[x + j]);
+    for (std::size_t x = whole; x < n; ++x) p[x - whole] += static_cast<double>(v[x]);
+    return sum_lanes(p);
   }
   /// sum_row of a row whose values are +0 but at the columns xs[0 .. count) (increasing), where
   /// they are value(x): the same bits, since adding +0 leaves a partial sum that started at +0
   /// as it is (no partial is ever -0). For a tally that only a few cells of a row have.
   template <class Value>
-  static double sum_row_at(const int* xs, std::size_t count, std::size_t n, const Value& value) {
-    const std::size_t n4 = n - n % 4;
-    double p[4] = {0.0, 0.0, 0.0, 0.0};
-    std::size_t k = 0;
-    for (; k < count && static_cast<std::size_t>(xs[k]) < n4; ++k)
-      p[xs[k] % 4] += static_cast<double>(value(xs[k]));
-    double s = (p[0] + p[1]) + (p[2] + p[3]);
-    for (; k < count; ++k) s += static_cast<double>(value(xs[k]));
-    return s;
+  static double sum_row_at(const int* xs, std::size_t count, const Value& value) {
+    double p[kSumLanes] = {};
+    for (std::size_t k = 0; k < count; ++k)
+      p[static_cast<std::size_t>(xs[k]) % kSumLanes] += static_cast<double>(value(xs[k]));
+    return sum_lanes(p);
   }
   /// Per-row scratch of `n` zeros for per-cell tallies. From new[], so GCC knows the pointer
   /// is not null and if-converts the stores of the cell loops (a vector's data() may be).

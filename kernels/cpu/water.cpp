@@ -45,10 +45,9 @@ void CpuBackend<Real>::water_row(int y, Real dt, const std::array<const Real*, 4
   // +0 at every other cell): the bits of sum_row over the whole row (sum_row_at).
   const std::size_t e0 = static_cast<std::size_t>(edge_row_[static_cast<std::size_t>(y)]),
                     e1 = static_cast<std::size_t>(edge_row_[static_cast<std::size_t>(y) + 1]);
-  row_sums_a_[y] =
-      sum_row_at(edge_x_.data() + e0, e1 - e0, static_cast<std::size_t>(W), [&](int x) {
-        return cell::water_exchange_cell(static_cast<int>(row + x), W, kind, fl, fr, ft, fb);
-      });
+  row_sums_a_[y] = sum_row_at(edge_x_.data() + e0, e1 - e0, [&](int x) {
+    return cell::water_exchange_cell(static_cast<int>(row + x), W, kind, fl, fr, ft, fb);
+  });
   row_sums_b_[y] = sum_row(cl, static_cast<std::size_t>(W));
   row_sums_c_[y] = sum_row(gv, static_cast<std::size_t>(W));
 }
