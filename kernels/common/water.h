@@ -44,6 +44,17 @@ ERODEM_FN real water_exchange_cell(int i, int W, GLOBAL const erodem_kind_t* kin
          (kind[i + W] != ERODEM_CELL_ACTIVE ? f_bottom[i] - f_top[i + W] : (real)0);
 }
 
+/* Whether padded cell i is active and shares a face with a cell that is not (a ghost, a wall
+ * or a nodata cell): the only cells for which water_exchange_cell and the sediment's
+ * transport_boundary_out_cell can be non-zero. The kinds never change, so each backend lists
+ * these cells once and sums those tallies over the list (CpuBackend's edge_x_, OpenCL's
+ * edge_cells_ for edges.cl). */
+ERODEM_INLINE int active_beside_inactive(int i, int W, GLOBAL const erodem_kind_t* kind) {
+  return kind[i] == ERODEM_CELL_ACTIVE &&
+         (kind[i - 1] != ERODEM_CELL_ACTIVE || kind[i + 1] != ERODEM_CELL_ACTIVE ||
+          kind[i - W] != ERODEM_CELL_ACTIVE || kind[i + W] != ERODEM_CELL_ACTIVE);
+}
+
 /* The depth (m) of a cell of depth d (m) and area (m^2) after dt (s) of inflow and outflow
  * (m^3/s). */
 ERODEM_FN real depth_after_fluxes(real d, real inflow, real outflow, real dt, real area) {

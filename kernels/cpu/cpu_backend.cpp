@@ -86,13 +86,8 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   row_sums_c_.assign(H_, 0.0);
   edge_row_.assign(static_cast<std::size_t>(H_) + 1, 0);
   for (int y = 1; y < H_ - 1; ++y) {
-    for (int x = 1; x < W_ - 1; ++x) {
-      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
-      if (kind_[i] == ERODEM_CELL_ACTIVE &&
-          (kind_[i - 1] != ERODEM_CELL_ACTIVE || kind_[i + 1] != ERODEM_CELL_ACTIVE ||
-           kind_[i - W_] != ERODEM_CELL_ACTIVE || kind_[i + W_] != ERODEM_CELL_ACTIVE))
-        edge_x_.push_back(x);
-    }
+    for (int x = 1; x < W_ - 1; ++x)
+      if (cell::active_beside_inactive(x + y * W_, W_, kind_.data())) edge_x_.push_back(x);
     edge_row_[static_cast<std::size_t>(y) + 1] = static_cast<int>(edge_x_.size());
   }
   edge_row_[static_cast<std::size_t>(H_)] = static_cast<int>(edge_x_.size());

@@ -196,13 +196,8 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   // MPI run. The kinds never change.
   std::vector<cl_int> edges;
   for (int y = band_.own0; y < band_.own1; ++y)
-    for (int x = 1; x < W_ - 1; ++x) {
-      const std::size_t i = static_cast<std::size_t>(x) + static_cast<std::size_t>(y) * W_;
-      if (kind[i] != ERODEM_CELL_ACTIVE) continue;
-      if (kind[i - 1] != ERODEM_CELL_ACTIVE || kind[i + 1] != ERODEM_CELL_ACTIVE ||
-          kind[i - W_] != ERODEM_CELL_ACTIVE || kind[i + W_] != ERODEM_CELL_ACTIVE)
-        edges.push_back(static_cast<cl_int>(i));
-    }
+    for (int x = 1; x < W_ - 1; ++x)
+      if (cell::active_beside_inactive(x + y * W_, W_, kind.data())) edges.push_back(x + y * W_);
   edge_count_ = edges.size();
   edge_cells_ = upload(edges);
   edge_local_ = pow2_at_most(std::min<std::size_t>(cell_limit, 64));
