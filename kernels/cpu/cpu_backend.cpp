@@ -465,8 +465,10 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
     return u * u + v * v;
   };
 
-  // the volumes: each a sum over the row's cells in the lanes of sum_row (the x - 1'th active
-  // cell value into lane (x - 1) % kSumLanes), combined by sum_lanes, times the cells' area
+  // the volumes: each a sum over the row's cells in the lanes of sum_row (cell x's value into
+  // lane (x - 1) % kSumLanes, +0 for an inactive cell), combined by sum_lanes, times the
+  // cells' area
+  static_assert(kSumLanes == 16, "volume_lanes holds sixteen lanes");
   double pw[kSumLanes] = {}, pm[kSumLanes] = {}, ps[kSumLanes] = {};
   const int n = W - 2, whole = n - n % static_cast<int>(kSumLanes);
   volume_lanes(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, whole, pw, pm, ps);
