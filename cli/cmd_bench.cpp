@@ -73,9 +73,21 @@ Params bench_params(const BenchOptions& o) {
 // sweeps not counted, no write-allocate traffic (as STREAM counts). "stats" is the driver's
 // reduction after every step. The OpenCL backend moves the same fields, plus the face fields
 // of its local-inertial face pass and per-group partial tallies, not counted here.
-int bytes_per_cell(const std::string& process, const Params& p) {
+
+/// The statistics' bytes per cell on `backend`: without the bed, its residual and the sediment
+/// where the backend keeps their volumes and no process of the step changes them
+/// (Backend::keeps_material_volumes, changes_material).
+int stats_bytes(const Backend& backend, const Params& p) {
   const int real = p.numerics.precision == Precision::float64 ? 8 : 4;
-  if (process == "stats") return sweep_bytes(stats_sweep(), real).total();
+  bool material = !backend.keeps_material_volumes();
+  for (const Process q : step_sequence(p)) material = material || changes_material(q, p);
+  return sweep_bytes(stats_sweep(material), real).total();
+}
+
+/// The bytes per cell of `process` (a process table name, or "stats") on `backend`.
+int bytes_per_cell(const std::string& process, const Backend& backend, const Params& p) {
+  const int real = p.numerics.precision == Precision::float64 ? 8 : 4;
+  if (process == "stats") return stats_bytes(backend, p);
   for (const auto& e : process_table())
     if (process == e.name) return process_bytes(e.id, p, real).total();
   return 0;
@@ -87,7 +99,7 @@ int bytes_per_cell(const std::string& process, const Params& p) {
 int full_step_bytes(const std::vector<std::vector<Process>>& passes, const Backend& backend,
                     const Params& p) {
   const int real = p.numerics.precision == Precision::float64 ? 8 : 4;
-  int bytes = sweep_bytes(stats_sweep(), real).total();
+  int bytes = stats_bytes(backend, p);
   for (const auto& pass : passes)
     for (const auto& part : backend.fused_parts(pass))
       bytes += part.size() > 1 ? sweep_bytes(pass_sweep(part, p), real).total()
@@ -200,7 +212,7 @@ std::vector<Row> bench_one(const Terrain& terrain, const Params& p, const std::s
     const int bytes = k == n_full      ? (p.numerics.fused_sweeps ? fused_bytes : unfused_bytes)
                       : k == n_fused   ? fused_bytes
                       : k == n_unfused ? unfused_bytes
-                                       : bytes_per_cell(name, p);
+                                       : bytes_per_cell(name, b, p);
     const double sps = median(per_step[k]);
     rows.push_back({backend, device, name, threads, bytes, sps, cells / sps});
   }

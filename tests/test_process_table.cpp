@@ -123,6 +123,21 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
   EXPECT_EQ(bytes(Process::thermal), 38);
   EXPECT_EQ(bytes(Process::evaporation), 17);  // kind depth wetness | depth wetness
   EXPECT_EQ(sweep_bytes(stats_sweep(), 4).total(), 25);
+  // kept material volumes (changes_material): kind depth velocity_x velocity_y
+  EXPECT_EQ(sweep_bytes(stats_sweep(false), 4).total(), 13);
+  for (const Process pr : step_sequence(p)) {
+    const bool changes = pr == Process::erosion || pr == Process::transport ||
+                         pr == Process::thermal;  // the boundary's fill: the ghosts only
+    EXPECT_EQ(changes_material(pr, p), changes) << process_info(pr).name;
+  }
+  {  // an inflow's sediment (the sources write it at the inflow cells) and a stage hydrograph
+    Params q = p;
+    q.inflow.push_back(InflowSpec{});
+    EXPECT_TRUE(changes_material(Process::sources, q));
+    EXPECT_FALSE(changes_material(Process::boundary, q));
+    q.boundary.stage = {{0.0, 1.0}};
+    EXPECT_TRUE(changes_material(Process::boundary, q));
+  }
   int full = sweep_bytes(stats_sweep(), 4).total();
   for (Process pr : step_sequence(p)) full += bytes(pr);
   EXPECT_EQ(full, 245);

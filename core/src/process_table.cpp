@@ -689,6 +689,17 @@ bool step_writes(const Params& params, const std::string& field) {
   return sweeps_write(params, field, false);
 }
 
+bool changes_material(Process p, const Params& params) {
+  for (const SweepInfo& s : process_info(p).sweeps(params))
+    if (s.domain != Domain::halo)
+      for (const FieldUse& u : s.uses)
+        if (writes(u.access) &&
+            (std::string(u.field) == "bed" || std::string(u.field) == "bed_residual" ||
+             std::string(u.field) == "sediment"))
+          return true;
+  return false;
+}
+
 SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes) {
   SweepBytes b;
   if (sweep.domain != Domain::cells) return b;
@@ -718,7 +729,7 @@ SweepBytes process_bytes(Process p, const Params& params, int real_bytes) {
   return total;
 }
 
-const SweepInfo& stats_sweep() {
+const SweepInfo& stats_sweep(bool material) {
   // CpuBackend::stats and stats.cl (cell_state_ok, stats.h): volumes, maxima, the first bad
   // cell, over the active cells
   static const SweepInfo sweep{"stats",
@@ -731,7 +742,12 @@ const SweepInfo& stats_sweep() {
                                 {"velocity_x", R},
                                 {"velocity_y", R}},
                                {"field_stats"}};
-  return sweep;
+  static const SweepInfo water_only{
+      "stats",
+      Domain::cells,
+      {{"kind", R}, {"water_depth", R}, {"velocity_x", R}, {"velocity_y", R}},
+      {"field_stats"}};
+  return material ? sweep : water_only;
 }
 
 std::vector<std::string> opencl_cell_kernels() {

@@ -40,6 +40,10 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   periodic_ = s.periodic_x;
   tails_ = sweeps_tails(params, periodic_ || band_.banded);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
+  changes_material_.assign(tails_.size(), 0);
+  for (const ProcessInfo& info : process_table())
+    changes_material_.at(static_cast<std::size_t>(info.id)) = changes_material(info.id, params);
+  material_rows_.resize(static_cast<std::size_t>(H_ - 2));
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
@@ -170,6 +174,7 @@ template <class Real>
 void CpuBackend<Real>::run(Process p) {
   if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
   pass_stats_ = false;  // the state changes after the fused pass's statistics
+  if (changes_material_.at(static_cast<std::size_t>(p))) material_known_ = false;
   const StepInputs& in = step_inputs_;
   StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
@@ -232,6 +237,8 @@ void CpuBackend<Real>::run_fused(const std::vector<Process>& part) {
   if (part.size() < 3 || part[0] != Process::flow || part[2] != Process::water)
     throw Error(ExitCode::internal, "backend: no fused pass for this part of a pass");
   pass_stats_ = false;
+  for (const Process p : part)
+    if (changes_material_.at(static_cast<std::size_t>(p))) material_known_ = false;
   run_flow_water(static_cast<Real>(step_inputs_.dt), step_tally_,
                  part.back() == Process::evaporation);
 }
@@ -366,8 +373,11 @@ std::vector<double> CpuBackend<Real>::sample(const std::vector<std::int64_t>& ce
 template <class Real>
 FieldStats CpuBackend<Real>::stats() {
   std::vector<RowStats> rows(static_cast<std::size_t>(H_ - 2));
-  for_rows(1, H_ - 1,
-           [&](int y) { rows[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_.data()); });
+  const bool known = material_known();
+  for_rows(1, H_ - 1, [&](int y) {
+    rows[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_.data(), known);
+  });
+  material_known_ = true;
   if (band_.banded)  // every rank's own rows, in global row order
     rows = parallel::allgather(
         std::vector<RowStats>(rows.begin() + (band_.own0 - 1), rows.begin() + (band_.own1 - 1)));
@@ -402,11 +412,11 @@ inline void active8(const std::uint8_t* kind, Mask8& mask) {
 }
 
 /// stats_row's volumes over the cells [0, count) of arrays that start at a row's first DEM cell
-/// (count a multiple of 16): cell x into lane x % 16 of pw (depth), pm (bed + residual +
-/// sediment) and ps (sediment), each in x order; an inactive cell adds +0. The sums stay in
-/// registers (a loop over arrays of lanes kept them in memory and ran slower than the single
-/// running sums it replaced when the row came from memory).
-template <class Real>
+/// (count a multiple of 16): cell x into lane x % 16 of pw (depth) and, with kMaterial, of pm
+/// (bed + residual + sediment) and ps (sediment), each in x order; an inactive cell adds +0.
+/// The sums stay in registers (a loop over arrays of lanes kept them in memory and ran slower
+/// than the single running sums it replaced when the row came from memory).
+template <bool kMaterial, class Real>
 void volume_lanes(const std::uint8_t* kind, const Real* d, const Real* bed, const Real* bed_lo,
                   const Real* sediment, int count, double* pw, double* pm, double* ps) {
   const Double8 zero = {};
@@ -415,24 +425,29 @@ void volume_lanes(const std::uint8_t* kind, const Real* d, const Real* bed, cons
     for (int h = 0; h < 2; ++h) {
       const int x = x0 + 8 * h;
       Mask8 active;
-      Double8 dv, bv, lv, sv;
+      Double8 dv;
       active8(kind + x, active);
       load8(d + x, dv);
-      load8(bed + x, bv);
-      load8(bed_lo + x, lv);
-      load8(sediment + x, sv);
       w[h] += active ? dv : zero;
-      m[h] += active ? bv + lv + sv : zero;
-      s[h] += active ? sv : zero;
+      if constexpr (kMaterial) {
+        Double8 bv, lv, sv;
+        load8(bed + x, bv);
+        load8(bed_lo + x, lv);
+        load8(sediment + x, sv);
+        m[h] += active ? bv + lv + sv : zero;
+        s[h] += active ? sv : zero;
+      }
     }
   std::memcpy(pw, w, sizeof w);
-  std::memcpy(pm, m, sizeof m);
-  std::memcpy(ps, s, sizeof s);
+  if constexpr (kMaterial) {
+    std::memcpy(pm, m, sizeof m);
+    std::memcpy(ps, s, sizeof s);
+  }
 }
 }  // namespace
 
 template <class Real>
-RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
+RowStats CpuBackend<Real>::stats_row(int y, const Real* depth, bool material_known) {
   // The row's volumes (in the fixed order of sum_row's lanes) and the results of one scan of
   // its active cells in x order (the first cell of the largest depth and of the largest
   // squared speed, "larger" strictly, so NaN never wins; the first cell not physical), in
@@ -467,20 +482,27 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth) const {
 
   // the volumes: each a sum over the row's cells in the lanes of sum_row (cell x's value into
   // lane (x - 1) % kSumLanes, +0 for an inactive cell), combined by sum_lanes, times the
-  // cells' area
+  // cells' area; the material's and the sediment's only when they may have changed
+  // (material_rows_)
   static_assert(kSumLanes == 16, "volume_lanes holds sixteen lanes");
   double pw[kSumLanes] = {}, pm[kSumLanes] = {}, ps[kSumLanes] = {};
   const int n = W - 2, whole = n - n % static_cast<int>(kSumLanes);
-  volume_lanes(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, whole, pw, pm, ps);
+  if (material_known)
+    volume_lanes<false>(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, whole, pw, pm, ps);
+  else
+    volume_lanes<true>(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, whole, pw, pm, ps);
   for (int x = 1 + whole; x < W - 1; ++x) {  // the tail, into lanes 0 .. n - whole - 1
     const std::size_t j = static_cast<std::size_t>(x - 1 - whole);
     const bool active = kind[x] == ERODEM_CELL_ACTIVE;
-    const double s = sediment[x];
     pw[j] += active ? static_cast<double>(d[x]) : 0.0;
+    if (material_known) continue;
+    const double s = sediment[x];
     pm[j] += active ? static_cast<double>(bed[x]) + static_cast<double>(bed_lo[x]) + s : 0.0;
     ps[j] += active ? s : 0.0;
   }
-  const double water = sum_lanes(pw) * a, material = sum_lanes(pm) * a, sed = sum_lanes(ps) * a;
+  MaterialRow& kept = material_rows_[static_cast<std::size_t>(y - 1)];
+  if (!material_known) kept = {sum_lanes(pm) * a, sum_lanes(ps) * a};
+  const double water = sum_lanes(pw) * a, material = kept.material, sed = kept.sediment;
   row.water = water;
   row.material = material;
   row.sediment = sed;
@@ -576,6 +598,7 @@ template <class Real>
 void CpuBackend<Real>::set_field_rows(FieldId id, int row0, int row1,
                                       const std::vector<double>& values) {
   check_rows(id, row0, row1, values.size(), nx_, ny_);
+  material_known_ = false;                               // (any field: the bed, the sediment)
   if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Field* dst = field_storage(id);
   if (!dst)
@@ -609,6 +632,8 @@ template <class Real>
 HostView CpuBackend<Real>::host_view(FieldId id) {
   Field* src = band_.banded ? nullptr : field_storage(id);  // a band holds part of the field
   if (!src) return {};
+  // its writes come unannounced: the volumes are summed every time from now on
+  if (src == &bed_ || src == &bed_residual_ || src == &sediment_) material_viewed_ = true;
   return {src->data() + at(1, 1), sizeof(Real), static_cast<std::ptrdiff_t>(W_)};
 }
 

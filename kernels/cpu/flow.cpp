@@ -655,14 +655,15 @@ void CpuBackend<Real>::run_flow_water(Real dt, StepTally& tally, bool evaporatio
     const auto sweeps = process_info(Process::evaporation).sweeps(params_);
     evaporate = generic_rows(sweeps.at(0), Process::evaporation, dt, depth_next_.data());
   }
-  const bool stats = evaporation && stats_in_pass_;
+  const bool stats = evaporation && stats_in_pass_, material_known = this->material_known();
   if (stats) pass_stats_rows_.resize(static_cast<std::size_t>(H - 2));
   const Real* depth_new = depth_next_.data();
   const auto water_evaporation_stats = [&](int y) {
     water_row(y, dt, out);
     if (!evaporation) return;
     evaporate.row(y);
-    if (stats) pass_stats_rows_[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_new);
+    if (stats)
+      pass_stats_rows_[static_cast<std::size_t>(y - 1)] = stats_row(y, depth_new, material_known);
   };
   // A block's flow reads the depths of the row above it and the row below it (the faces
   // between blocks): the sources of a block's first and last rows wait until every block's
@@ -707,6 +708,7 @@ void CpuBackend<Real>::run_flow_water(Real dt, StepTally& tally, bool evaporatio
   // depth_next_ keeps the depth the water update started from (run_water)
   std::swap(depth_, depth_next_);
   pass_stats_ = stats;
+  if (stats) material_known_ = true;  // every row's volumes summed or kept
 }
 
 template void CpuBackend<float>::run_flow(float);

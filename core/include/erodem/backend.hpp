@@ -181,6 +181,10 @@ class Backend {
       if (part.size() > 1) return true;
     return false;
   }
+  /// Whether stats() keeps the material and sediment volumes it summed last while no process
+  /// that changes them (changes_material, process.hpp) has run and no field was set (the CPU
+  /// reference), or sums them every time (OpenCL): the bench's byte model of the statistics.
+  virtual bool keeps_material_volumes() const { return false; }
   /// The bytes of the device buffers the backend has created so far (OpenCL; 0 where the
   /// state lives in host memory): an upper bound of what it holds on the device at once.
   virtual std::size_t device_bytes() const { return 0; }

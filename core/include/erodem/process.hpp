@@ -235,6 +235,13 @@ bool bed_changes(const Params& params);
 /// restart, Python's set_field, the terrain-class pass).
 bool step_writes(const Params& params, const std::string& field);
 
+/// Whether process `p` with these parameters may change the volumes of material or sediment
+/// (FieldStats::material_volume, sediment_volume): a sweep of it over the DEM's cells or
+/// point cells writes the bed, its residual or the sediment. Sweeps over the halo write the
+/// ghost cells only, which no volume counts. A backend may keep the volumes it summed last
+/// until such a process runs (CpuBackend::stats_row).
+bool changes_material(Process p, const Params& params);
+
 /// The bytes a sweep moves per cell and step: every distinct field it reads, once, plus every
 /// field it writes, once; `real_bytes` (4 or 8) per field, 1 byte for the cell kind. Neighbour
 /// reads count once (they hit the cache lines the sweep brings in anyway); per-row arrays and
@@ -249,8 +256,10 @@ SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes);
 /// The bytes per cell of every sweep of process `p` with these parameters, together.
 SweepBytes process_bytes(Process p, const Params& params, int real_bytes);
 /// The driver's reductions after every step (Simulation::step: the ledger's volumes, the
-/// maxima, the first bad cell), as a sweep.
-const SweepInfo& stats_sweep();
+/// maxima, the first bad cell), as a sweep; without `material`, the sweep of a backend that
+/// keeps the material and sediment volumes while no process changes them (changes_material):
+/// it reads neither the bed, its residual nor the sediment.
+const SweepInfo& stats_sweep(bool material = true);
 
 /// Every OpenCL cell kernel of any configuration: the kernels of the cells sweeps of every
 /// process with either flow and either transport scheme, and of stats_sweep(), once each (the
