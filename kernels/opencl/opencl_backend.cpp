@@ -69,6 +69,9 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   PaddedState state = build_padded_state(terrain, params, band_.row0, band_.row0 + H_);
   periodic_ = state.periodic_x;
   tails_ = sweeps_tails(params, periodic_ || band_.banded);
+  changes_material_.assign(tails_.size(), 0);
+  for (const ProcessInfo& info : process_table())
+    changes_material_.at(static_cast<std::size_t>(info.id)) = changes_material(info.id, params);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
   rt_ = runtime_for(selector);
@@ -232,6 +235,7 @@ void OpenClBackend::begin_step(const StepInputs& in) {
 
 void OpenClBackend::run(Process p) {
   if (!in_step_) throw Error(ExitCode::internal, "backend: run() outside a step (begin_step)");
+  if (changes_material_.at(static_cast<std::size_t>(p))) material_known_ = false;
   const StepInputs& in = step_inputs_;
   StepTally& tally = step_tally_;
   const Real dt = static_cast<Real>(in.dt);
@@ -292,6 +296,8 @@ void OpenClBackend::run_fused(const std::vector<Process>& part) {
   if (!in_step_) throw Error(ExitCode::internal, "backend: run_pass() outside a step (begin_step)");
   if (part != std::vector<Process>{Process::water, Process::erosion})
     throw Error(ExitCode::internal, "backend: no fused kernel for this part of a pass");
+  for (const Process p : part)
+    if (changes_material_.at(static_cast<std::size_t>(p))) material_known_ = false;
   const Real dt = static_cast<Real>(step_inputs_.dt);
   measure_faces(false);  // as run(water)
   run_water_erosion(dt, step_tally_);
@@ -766,8 +772,10 @@ FieldStats OpenClBackend::stats() {
 
 FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   cl_kernel k = kernel("field_stats");
-  set_args(k, cl_int{W_}, cl_int{H_}, static_cast<cl_int>(groups_x_), kind_, bed_, bed_residual_,
-           depth_, sediment_, velocity_x_, velocity_y_, area_, partial_a_, partial_cells_);
+  const bool known = material_known_ && material_ok_;  // the volumes kept (material_rows_)
+  set_args(k, cl_int{W_}, cl_int{H_}, static_cast<cl_int>(groups_x_), cl_int{known ? 0 : 1}, kind_,
+           bed_, bed_residual_, depth_, sediment_, velocity_x_, velocity_y_, area_, partial_a_,
+           partial_cells_);
   const int rows = H_ - 2;
   if (stats_local_ == 0)
     launch_rows(k, 1, H_ - 1);  // whole rows: a cell kernel, groups_x_ partials per row
@@ -819,14 +827,23 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   // as the CPU's (stats_merge.hpp). stats_rows numbers the cells from the raster's first row.
   const std::int64_t first_cell = static_cast<std::int64_t>(band_.row0) * nx_;
   auto cell = [&](cl_long c) { return c < 0 ? std::int64_t{-1} : first_cell + c; };
+  if (!known) {  // every row's, halo rows included: the volumes summed, kept from now on
+    material_rows_.resize(static_cast<std::size_t>(rows));
+    material_ok_ = true;
+    for (std::size_t y = 0; y < material_rows_.size(); ++y) {
+      material_rows_[y] = {sums[n * y + 1], sums[n * y + 2]};
+      material_ok_ = material_ok_ && cells[3 * y + 2] < 0;
+    }
+    material_known_ = true;
+  }
   std::vector<RowStats> row_stats;
   row_stats.reserve(static_cast<std::size_t>(band_.own1 - band_.own0));
   for (int yy = band_.own0; yy < band_.own1; ++yy) {
     const auto y = static_cast<std::size_t>(yy - 1);
     RowStats row;
     row.water = sums[n * y + 0];
-    row.material = sums[n * y + 1];
-    row.sediment = sums[n * y + 2];
+    row.material = material_rows_[y].first;
+    row.sediment = material_rows_[y].second;
     row.max_depth = sums[n * y + 3];
     row.max_speed2 = sums[n * y + 4];
     row.max_depth_cell = cell(cells[3 * y + 0]);

@@ -160,6 +160,7 @@ class OpenClBackend final : public Backend {
   std::string name() const override { return "opencl"; }
   std::string device() const override;
   std::size_t device_bytes() const override { return device_bytes_; }
+  bool keeps_material_volumes() const override { return true; }
   void begin_step(const StepInputs& in) override;
   void run(Process p) override;
   /// The water update and erosion, where one follows the other in a pass, as one kernel
@@ -423,7 +424,17 @@ class OpenClBackend final : public Backend {
   // field of ERODEM_FIELDS (field_registry.hpp).
   FieldRegistry<Buffer> fields_;
   Buffer partial_a_, partial_b_, partial_cells_;
-  Buffer row_sums_, row_cells_;         // stats_rows: one result per padded row 1 .. H - 2
+  Buffer row_sums_, row_cells_;  // stats_rows: one result per padded row 1 .. H - 2
+  // The material and sediment volumes (m^3) of each padded row 1 .. H - 2 (row y at y - 1) as
+  // the last field_stats that summed them gave them, as the CPU reference keeps them
+  // (CpuBackend::material_rows_): they hold while material_known_ (no process that may change
+  // them ran since, changes_material_ by Process, and no field was set). field_stats then
+  // reads neither the bed, its residual nor the sediment, and takes a cell's state from its
+  // depth: so only while material_ok_, the last full pass having found every active cell's
+  // bed and sediment finite (no bad cell in any row).
+  std::vector<std::pair<double, double>> material_rows_;
+  std::vector<char> changes_material_;
+  bool material_known_ = false, material_ok_ = false;
   Buffer tally_partials_, tally_sums_;  // [slot][tally_stride_] partials, [slot] sums
   StepTally* pending_tally_ = nullptr;
   unsigned pending_ = 0;       // bits: 1 << tally slot; kChangeBit: the transport change

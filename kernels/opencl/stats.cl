@@ -60,7 +60,7 @@ __kernel void reduce_change(int W, int H, __global const uchar* restrict kind,
 /* The part of field_stats that one work-item does for its group, once the cells' values are
  * in local memory: the group of n work-items starts at column x0 of padded row `row` and
  * writes partial g (see field_stats). ERODEM_GROUP_ONCE: see reduce.cl. */
-ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
+ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g, int material,
                                          __local const real* s_d, __local const real* s_b,
                                          __local const real* s_r, __local const real* s_s,
                                          __local const real* s_u, __local const real* s_v,
@@ -73,7 +73,7 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
    * by side run in the time of one (each waits for its previous add) */
   acc_t water = 0, bed_sum = 0, res = 0, sed = 0;
   const int sum_blocks = last / 8;
-  if (sum_blocks > 0) {
+  if (sum_blocks > 0 && material) {
     acc8_t w8 = convert_acc8(vload8(0, s_d)), b8 = convert_acc8(vload8(0, s_b)),
            r8 = convert_acc8(vload8(0, s_r)), s8 = convert_acc8(vload8(0, s_s));
     for (int k = 1; k < sum_blocks; ++k) {
@@ -86,9 +86,14 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
     bed_sum = acc8_total(b8);
     res = acc8_total(r8);
     sed = acc8_total(s8);
+  } else if (sum_blocks > 0) { /* the depths alone, in the same lanes and order */
+    acc8_t w8 = convert_acc8(vload8(0, s_d));
+    for (int k = 1; k < sum_blocks; ++k) w8 += convert_acc8(vload8(k, s_d));
+    water = acc8_total(w8);
   }
   for (int k = 8 * sum_blocks; k < last; ++k) {
     water += (acc_t)s_d[k];
+    if (!material) continue;
     bed_sum += (acc_t)s_b[k];
     res += (acc_t)s_r[k];
     sed += (acc_t)s_s[k];
@@ -158,7 +163,8 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
     }
   }
   sums[5 * g + 0] = water * a;
-  sums[5 * g + 1] = ((bed_sum + res) + sed) * a; /* the bed pair (compensated.h) */
+  sums[5 * g + 1] =
+      ((bed_sum + res) + sed) * a; /* the bed pair (compensated.h); 0 unless material */
   sums[5 * g + 2] = sed * a;
   sums[5 * g + 3] = max_d;
   sums[5 * g + 4] = max_v;
@@ -192,9 +198,13 @@ ERODEM_GROUP_ONCE void field_stats_group(int W, int row, int x0, int n, int g,
  *    group walking the group's values took half of the step (2.3 of 4.7 ms at 4096^2), and a
  *    tree over every cell (eight trees of 128 values per 128 cells, each level behind a
  *    barrier, 32 KiB of local memory per group) still 0.88 ms, 11 % of the device's copy
- *    bandwidth for its 25 bytes per cell. */
-__kernel void field_stats(int W, int H, int groups_per_row, __global const uchar* restrict kind,
-                          __global const real* restrict bed,
+ *    bandwidth for its 25 bytes per cell.
+ * material = 0 (the host keeps the material and sediment volumes, OpenClBackend::collect):
+ * neither the bed, its residual nor the sediment is read; their sums are 0 and a cell's state
+ * is its depth's (the host asks for this only while every active cell's bed and sediment are
+ * as the last full pass found them: finite). */
+__kernel void field_stats(int W, int H, int groups_per_row, int material,
+                          __global const uchar* restrict kind, __global const real* restrict bed,
                           __global const real* restrict bed_residual,
                           __global const real* restrict depth,
                           __global const real* restrict sediment,
@@ -209,15 +219,20 @@ __kernel void field_stats(int W, int H, int groups_per_row, __global const uchar
   const int x = (int)get_global_id(0), y = (int)get_global_id(1), l = (int)get_local_id(0);
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-  const real d = depth[i], b = bed[i], sd = sediment[i];
+  const real d = depth[i];
   /* inactive cells add +0 and rank below every active cell (depth >= 0, speed^2 >= 0) */
   s_d[l] = active ? d : (real)0;
-  s_b[l] = active ? b : (real)0;
-  s_r[l] = active ? bed_residual[i] : (real)0;
-  s_s[l] = active ? sd : (real)0;
   s_u[l] = active ? velocity_x[i] : (real)0;
   s_v[l] = active ? velocity_y[i] : (real)0;
-  s_state[l] = active ? (cell_state_ok(b, d, sd) ? 1 : 2) : 0; /* 0 ghost, 1 ok, 2 not physical */
+  if (material) {
+    const real b = bed[i], sd = sediment[i];
+    s_b[l] = active ? b : (real)0;
+    s_r[l] = active ? bed_residual[i] : (real)0;
+    s_s[l] = active ? sd : (real)0;
+    s_state[l] = active ? (cell_state_ok(b, d, sd) ? 1 : 2) : 0; /* 0 ghost, 1 ok, 2 not physical */
+  } else {
+    s_state[l] = active ? (cell_state_ok((real)0, d, (real)0) ? 1 : 2) : 0;
+  }
   barrier(CLK_LOCAL_MEM_FENCE);
   /* The group's row and first column from the group's ids, not from x and y: PoCL keeps every
    * work-item's values that are used after a barrier in per-work-item storage, and a 64-bit
@@ -229,7 +244,7 @@ __kernel void field_stats(int W, int H, int groups_per_row, __global const uchar
                       (int)get_local_size(0),
                       (row_tail_launch() ? groups_per_row - 1 : (int)get_group_id(0)) +
                           (int)get_group_id(1) * groups_per_row,
-                      s_d, s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
+                      material, s_d, s_b, s_r, s_s, s_u, s_v, s_state, area, sums, cells);
 #else
   /* The row launch. The maxima as (value, column) pairs: a work-item's columns come in
    * increasing order and only a strictly larger value replaces, so it keeps its first largest;
@@ -254,11 +269,16 @@ __kernel void field_stats(int W, int H, int groups_per_row, __global const uchar
   for (int x = 1 + l; x <= W - 2; x += L) {
     const int i = x + y * W;
     if (kind[i] != ERODEM_CELL_ACTIVE) continue;
-    const real d = depth[i], b = bed[i], sd = sediment[i];
+    const real d = depth[i];
+    real b = 0, sd = 0;
     water += (acc_t)d;
-    bed_sum += (acc_t)b;
-    res += (acc_t)bed_residual[i];
-    sed += (acc_t)sd;
+    if (material) {
+      b = bed[i];
+      sd = sediment[i];
+      bed_sum += (acc_t)b;
+      res += (acc_t)bed_residual[i];
+      sed += (acc_t)sd;
+    }
     if (d > best_d) { /* best_d starts at -1: the scan's start */
       best_d = d;
       at_d = x;
