@@ -282,9 +282,9 @@ TEST(InPlace, EveryBlockSizeGivesTheBitsOfOneThread) {
 // change them runs (CpuBackend::material_rows_, OpenClBackend::material_rows_,
 // changes_material): through the water-only steps, not after erosion, transport or thermal
 // collapse. Either way they give, step by step, the bits of the statistics summed every time,
-// which a twin run does that sets a field before each step (the hardness, to the values it
-// holds: a set field makes the backend sum the volumes again). Bound: 0 differing values. A
-// process missing from changes_material leaves its change out of the kept volumes, which then
+// which a twin run does that sets a field before each step (the sediment, to the values it
+// holds: a set bed or sediment makes the backend sum the volumes again). Bound: 0 differing values.
+// A process missing from changes_material leaves its change out of the kept volumes, which then
 // stay at an earlier step's value while the summed ones move (the test demands the material
 // move under erosion): with changes_material false for every process, the material and
 // sediment volumes of every step of the erosion runs differ, 80 of 200 values in each of their
@@ -302,7 +302,7 @@ TEST(KeptVolumes, GiveTheBitsOfVolumesSummedEveryStep) {
           const FieldStats first = kept.last_stats();
           std::size_t differ = 0;
           for (int s = 0; s < 40; ++s) {
-            summed.backend().set_field(FieldId::hardness, summed.field(FieldId::hardness));
+            summed.backend().set_field(FieldId::sediment, summed.field(FieldId::sediment));
             kept.step();
             summed.step();
             const FieldStats a = kept.last_stats(), b = summed.last_stats();

@@ -130,6 +130,10 @@ TEST(ProcessTable, ByteModelFromTheSweeps) {
                          pr == Process::thermal;  // the boundary's fill: the ghosts only
     EXPECT_EQ(changes_material(pr, p), changes) << process_info(pr).name;
   }
+  EXPECT_TRUE(material_field(FieldId::bed) && material_field(FieldId::bed_residual) &&
+              material_field(FieldId::sediment));
+  EXPECT_FALSE(material_field(FieldId::water_depth) || material_field(FieldId::rain_factor) ||
+               material_field(FieldId::hardness));
   {  // an inflow's sediment (the sources write it at the inflow cells) and a stage hydrograph
     Params q = p;
     q.inflow.push_back(InflowSpec{});

@@ -689,14 +689,17 @@ bool step_writes(const Params& params, const std::string& field) {
   return sweeps_write(params, field, false);
 }
 
+bool material_field(FieldId id) {
+  return id == FieldId::bed || id == FieldId::bed_residual || id == FieldId::sediment;
+}
+
 bool changes_material(Process p, const Params& params) {
   for (const SweepInfo& s : process_info(p).sweeps(params))
     if (s.domain != Domain::halo)
       for (const FieldUse& u : s.uses)
-        if (writes(u.access) &&
-            (std::string(u.field) == "bed" || std::string(u.field) == "bed_residual" ||
-             std::string(u.field) == "sediment"))
-          return true;
+        if (writes(u.access))
+          for (const FieldInfo& f : field_table())
+            if (material_field(f.id) && std::string(f.name) == u.field) return true;
   return false;
 }
 

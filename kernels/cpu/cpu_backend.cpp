@@ -598,7 +598,7 @@ template <class Real>
 void CpuBackend<Real>::set_field_rows(FieldId id, int row0, int row1,
                                       const std::vector<double>& values) {
   check_rows(id, row0, row1, values.size(), nx_, ny_);
-  material_known_ = false;                               // (any field: the bed, the sediment)
+  if (material_field(id)) material_known_ = false;       // the volumes summed again
   if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Field* dst = field_storage(id);
   if (!dst)

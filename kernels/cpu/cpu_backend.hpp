@@ -366,11 +366,11 @@ class CpuBackend final : public Backend {
   // The material and sediment volumes (m^3) of each padded row 1 .. H - 2 (row y at y - 1) as
   // stats_row last summed them. They hold while material_known_: every row summed since the
   // last process that may change them ran (changes_material_, by Process: the process table's
-  // changes_material) and the last field was set. A host view of the bed or the sediment
-  // (host_view) can be written at any time, so after one they are summed every time
-  // (material_viewed_). Kept, they are the sums of the same values in the same order: the
-  // same bits. A water-only step then reads 13 B per cell less in float32 (the bed, its
-  // residual and the sediment; performance.md "Volumes that did not change").
+  // changes_material) and the bed, its residual or the sediment was last set (material_field). A
+  // host view of the bed or the sediment (host_view) can be written at any time, so after one they
+  // are summed every time (material_viewed_). Kept, they are the sums of the same values in the
+  // same order: the same bits. A water-only step then reads 12 B per cell less in float32 (the bed,
+  // its residual and the sediment; performance.md "Volumes that did not change").
   struct MaterialRow {
     double material = 0, sediment = 0;
   };

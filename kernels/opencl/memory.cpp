@@ -357,7 +357,7 @@ void OpenClBackend::set_field(FieldId id, const std::vector<double>& values) {
 void OpenClBackend::set_field_rows(FieldId id, int row0, int row1,
                                    const std::vector<double>& values) {
   check_rows(id, row0, row1, values.size(), nx_, ny_);
-  material_known_ = false;                               // (any field: the bed, the sediment)
+  if (material_field(id)) material_known_ = false;       // the volumes summed again
   if (fields_.setting_keeps_unmade(id, values)) return;  // reads give these zeros already
   Buffer* dst = field_buffer(id);
   if (!dst)

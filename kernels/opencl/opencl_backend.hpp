@@ -428,9 +428,9 @@ class OpenClBackend final : public Backend {
   // The material and sediment volumes (m^3) of each padded row 1 .. H - 2 (row y at y - 1) as
   // the last field_stats that summed them gave them, as the CPU reference keeps them
   // (CpuBackend::material_rows_): they hold while material_known_ (no process that may change
-  // them ran since, changes_material_ by Process, and no field was set). field_stats then
-  // reads neither the bed, its residual nor the sediment, and takes a cell's state from its
-  // depth: so only while material_ok_, the last full pass having found every active cell's
+  // them ran since, changes_material_ by Process, and no bed, residual or sediment was set).
+  // field_stats then reads neither the bed, its residual nor the sediment, and takes a cell's state
+  // from its depth: so only while material_ok_, the last full pass having found every active cell's
   // bed and sediment finite (no bad cell in any row).
   std::vector<std::pair<double, double>> material_rows_;
   std::vector<char> changes_material_;

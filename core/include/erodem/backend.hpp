@@ -182,9 +182,9 @@ class Backend {
     return false;
   }
   /// Whether stats() keeps the material and sediment volumes it summed last while no process
-  /// that changes them (changes_material, process.hpp) has run and no field was set (both
-  /// backends; the CPU reference no longer once it has handed out a host view of the bed or the
-  /// sediment), or sums them every time: the bench's byte model of the statistics.
+  /// that changes them (changes_material, process.hpp) has run and no bed, bed residual or sediment
+  /// was set (both backends; the CPU reference no longer once it has handed out a host view of the
+  /// bed or the sediment), or sums them every time: the bench's byte model of the statistics.
   virtual bool keeps_material_volumes() const { return false; }
   /// The bytes of the device buffers the backend has created so far (OpenCL; 0 where the
   /// state lives in host memory): an upper bound of what it holds on the device at once.
