@@ -703,6 +703,16 @@ bool changes_material(Process p, const Params& params) {
   return false;
 }
 
+std::vector<char> material_changers(const Params& params) {
+  std::vector<char> out;
+  for (const ProcessInfo& info : process_table()) {
+    const auto p = static_cast<std::size_t>(info.id);
+    if (out.size() <= p) out.resize(p + 1, 0);
+    out[p] = changes_material(info.id, params);
+  }
+  return out;
+}
+
 SweepBytes sweep_bytes(const SweepInfo& sweep, int real_bytes) {
   SweepBytes b;
   if (sweep.domain != Domain::cells) return b;

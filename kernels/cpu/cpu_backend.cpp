@@ -40,9 +40,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   periodic_ = s.periodic_x;
   tails_ = sweeps_tails(params, periodic_ || band_.banded);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
-  changes_material_.assign(tails_.size(), 0);
-  for (const ProcessInfo& info : process_table())
-    changes_material_.at(static_cast<std::size_t>(info.id)) = changes_material(info.id, params);
+  changes_material_ = material_changers(params);
   material_rows_.resize(static_cast<std::size_t>(H_ - 2));
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP

@@ -69,9 +69,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
   PaddedState state = build_padded_state(terrain, params, band_.row0, band_.row0 + H_);
   periodic_ = state.periodic_x;
   tails_ = sweeps_tails(params, periodic_ || band_.banded);
-  changes_material_.assign(tails_.size(), 0);
-  for (const ProcessInfo& info : process_table())
-    changes_material_.at(static_cast<std::size_t>(info.id)) = changes_material(info.id, params);
+  changes_material_ = material_changers(params);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
   rt_ = runtime_for(selector);

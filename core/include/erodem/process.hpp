@@ -241,6 +241,9 @@ bool step_writes(const Params& params, const std::string& field);
 /// ghost cells only, which no volume counts. A backend may keep the volumes it summed last
 /// until such a process runs (CpuBackend::stats_row).
 bool changes_material(Process p, const Params& params);
+/// changes_material of every process of the table, indexed by Process (1 or 0): what a backend
+/// that keeps the volumes looks up before each process it runs.
+std::vector<char> material_changers(const Params& params);
 /// Whether field `id` is one of the material volume's: the bed, its residual, the sediment (a
 /// backend that keeps the volumes sums them again after such a field is set).
 bool material_field(FieldId id);
