@@ -32,11 +32,12 @@ std::uint8_t cell_kind(BoundaryKind b) {
 PaddedState build_padded_state(const Terrain& terrain, const Params& params, int y0, int y1) {
   const auto& g = terrain.grid;
   g.validate();
-  const std::size_t cells = g.cells();
+  const std::size_t cells = terrain.held_cells();  // the rows the terrain holds
   auto check_size = [&](const std::vector<double>& v, const char* what) {
     if (!v.empty() && v.size() != cells)
       throw Error(ExitCode::data,
-                  fmt::format("{}: {} values for a grid of {} x {}", what, v.size(), g.nx, g.ny));
+                  fmt::format("{}: {} values for {} rows of a grid of {} x {}", what, v.size(),
+                              terrain.end_row() - terrain.row0, g.nx, g.ny));
   };
   if (terrain.bed.size() != cells) throw Error(ExitCode::data, "bed: missing");
   check_size(terrain.water_depth, "initial water depth");
@@ -63,6 +64,11 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
   const auto dem = [nx](int c, int r) { return static_cast<std::size_t>(r) * nx + c; };
   // the DEM rows [r0, r1) on the rows [a, b), and the same as padded rows [first, last]
   const int r0 = std::max(0, a - 1), r1 = std::min(ny, b - 1);
+  // a terrain read by rows (an MPI rank's band: io::load_terrain) holds them all
+  if (!(terrain.holds_row(r0) && terrain.holds_row(r1 - 1)))
+    throw Error(ExitCode::internal,
+                fmt::format("padded state: DEM rows [{}, {}) of a terrain holding rows [{}, {})",
+                            r0, r1, terrain.row0, terrain.end_row()));
   const int first = r0 + 1, last = r1;
 
   // Geometry per padded row; halo rows repeat their neighbours.
@@ -109,9 +115,9 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
       const auto i = dem(c, r);
       const auto p = at(c + 1, r + 1);
       if (s.kind[p] != ERODEM_CELL_ACTIVE) continue;
-      s.bed[p] = terrain.bed[i];
+      s.bed[p] = terrain.bed[terrain.held(i)];
       if (!terrain.water_depth.empty())
-        s.depth[p] = terrain.water_depth[i];
+        s.depth[p] = terrain.water_depth[terrain.held(i)];
       else if (params.initial.water_level)
         s.depth[p] = std::max(0.0, *params.initial.water_level - s.bed[p]);
       else
@@ -131,7 +137,7 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
       double low = lowest;
       for (auto q : {p - 1, p + 1, p - W, p + W})
         if (s.kind[q] == ERODEM_CELL_ACTIVE) low = std::min(low, s.bed[q]);
-      if (held_on_own_bed(terrain, i)) low = terrain.bed[i];
+      if (held_on_own_bed(terrain, i)) low = terrain.bed[terrain.held(i)];
       s.bed[p] = s.kind[p] == ERODEM_CELL_FIXED ? low : 0.0;
       s.depth[p] = s.kind[p] == ERODEM_CELL_FIXED ? std::max(sea - low, 0.0) : 0.0;
       if (params.erosion.enabled)
@@ -141,7 +147,7 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
   // Rasters or scalars; halo cells copy the nearest DEM cell (Manning n is read at faces).
   // (A scalar stays one value: CellParameter::is_uniform.)
   // (`first_row`: the DEM row of the raster's first row, where it holds only some rows)
-  auto raster_or = [&](const std::vector<double>& raster, double scalar, int first_row = 0) {
+  auto raster_or = [&](const std::vector<double>& raster, double scalar, int first_row) {
     CellParameter out;
     out.uniform = scalar;
     if (raster.empty()) return out;
@@ -153,7 +159,7 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
       }
     return out;
   };
-  s.manning = raster_or(terrain.manning_n, params.flow.manning_n.value);
+  s.manning = raster_or(terrain.manning_n, params.flow.manning_n.value, terrain.row0);
   // erosion.hardness = "noise": the noise field stands where a hardness raster would, made for
   // the DEM rows these padded rows read only (scaled to the range of the whole grid's active
   // cells, which hardness_noise_rows finds a block of rows at a time)
@@ -164,9 +170,9 @@ PaddedState build_padded_state(const Terrain& terrain, const Params& params, int
     s.hardness = raster_or(hardness_noise_rows(terrain, params.erosion, r0, r1),
                            params.erosion.hardness.value, r0);
   } else {
-    s.hardness = raster_or(terrain.hardness, params.erosion.hardness.value);
+    s.hardness = raster_or(terrain.hardness, params.erosion.hardness.value, terrain.row0);
   }
-  s.rain_factor = raster_or(terrain.rain_factor, 1.0);
+  s.rain_factor = raster_or(terrain.rain_factor, 1.0, terrain.row0);
   s.periodic_x = periodic_x(terrain, params);
   if (s.periodic_x && nx < 2)
     throw config_error("boundary.periodic_x",

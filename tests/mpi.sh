@@ -38,6 +38,16 @@
 #    [32, 1024], so every row is launched as three groups of 687 and a tail group of two (the
 #    last DEM column and the ghost), whose tally partials sit at the top of each slot, and a
 #    band's own rows must still write over its halo rows' partials;
+#  - dem_rows: a real DEM read by rows (../shared/data/dem/rhine, a 48 x 45 window across the
+#    basin's edge on a lat/lon grid, two thirds nodata as sea at 330 m) with a raster for the
+#    initial depth, the Manning n, the hardness, the rain factor, the soil (physical erosion)
+#    and the snow pack (whose slope limit reads the neighbours' beds), gridded rain and air
+#    temperature, boundary codes and a latitude cap: under N > 1 each rank reads only its
+#    band's rows and 4 beside them (the log's note says so); and a bad elevation, raster value
+#    or boundary code stops every rank with the message and exit code (65) of one process;
+#  - dem_rows_coarse: dem_rows averaged 2 x 2 as it is read (dem.resample = 2): each rank reads
+#    whole blocks of its coarse rows (without the boundary code of 1.5, which averaging takes
+#    as its block's most frequent whole code);
 #  - interrupt: a stop signal (SIGTERM, SIGUSR1) to erodem, and to each rank under mpirun 0.5 s
 #    apart: exit 130 and a partial file identical to the serial run to the step it names.
 # The ranks write their one result file together where the build has parallel HDF5: then they
@@ -75,7 +85,7 @@ if ! python3 -c 'import h5py, numpy' 2>/dev/null; then
   exit 77
 fi
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+trap '[ -n "${ERODEM_KEEP_WORK:-}" ] || rm -rf "$work"' EXIT
 cd "$work"
 export OMP_NUM_THREADS=1 OMP_WAIT_POLICY=PASSIVE
 mpi=(mpirun --allow-run-as-root --oversubscribe --bind-to none)
@@ -164,9 +174,54 @@ EOF
     sed -i '/^synthetic = /,/^cell_size = /c\path = "wide_valley.tif"\nwindow = [0, 1000, 2061, 37]' \
       scenario.toml
     ;;
+  dem_rows | dem_rows_coarse)
+    # a real DEM (../shared/data/dem) read by rows: a window across the Rhine basin's western
+    # edge, two thirds nodata (sea at 330 m: coast cells on every band), on a lat/lon grid,
+    # with every parameter raster a band reads by rows (each a linear map of the elevations)
+    rhine="$here/../../shared/data/dem/rhine/rhine_elv0.tif"
+    if [ ! -f "$rhine" ]; then
+      echo "FAIL: $rhine is missing (../shared/data/dem beside the repository)"
+      exit 1
+    fi
+    scaled() { # NAME LOW HIGH: the elevations 280 .. 480 m mapped onto LOW .. HIGH
+      gdal_translate -q -ot Float32 -a_nodata none -scale 280 480 "$2" "$3" "$rhine" "$1.tif"
+    }
+    scaled manning 0.02 0.08
+    scaled hardness 0.2 0.9
+    scaled rain 0.5 2
+    scaled soil 0.5 3
+    scaled snow 0 0.1
+    scaled depth 0 0.01
+    # gridded rain (3 bands 10 s apart, mm/h) and air temperature (2 bands 20 s apart, C)
+    scaled rain1 0 200
+    scaled rain2 200 0
+    scaled rain3 50 60
+    scaled air1 -5 5
+    scaled air2 5 -5
+    gdalbuildvrt -q -separate rains.vrt rain1.tif rain2.tif rain3.tif
+    gdal_translate -q rains.vrt rains.tif
+    gdalbuildvrt -q -separate airs.vrt air1.tif air2.tif
+    gdal_translate -q airs.vrt airs.tif
+    # boundary codes: closed (1) on the cells of 400 .. 410 m, fixed_level on their own bed (3)
+    # above 440 m, as the edge says (0) elsewhere
+    gdal_calc.py --quiet -A "$rhine" --outfile=codes.tif --type=Float32 \
+      --calc="where(A > 440, 3, where((A > 400) * (A <= 410), 1, 0))"
+    sed -i '/^synthetic = /,/^cell_size = /c\path = "'"$rhine"'"\nwindow = [200, 440, 48, 45]' \
+      scenario.toml
+    sed -i 's/^rate = "100 mm\/h"/raster = "rain.tif"/' scenario.toml
+    sed -i 's/^water_depth = "5 mm"/water_depth = "depth.tif"/' scenario.toml
+    sets=(--set boundary.nodata=sea --set boundary.sea_level=330 --set flow.manning_n=manning.tif
+      --set erosion.law=physical --set erosion.soil_thickness=soil.tif
+      --set erosion.hardness=hardness.tif --set snow.enabled=true --set snow.initial=snow.tif
+      --set snow.max_slope=2 --set rain.grids=rains.tif --set rain.grid_interval=10
+      --set snow.temperature_grids=airs.tif --set snow.temperature_grid_interval=20
+      --set boundary.raster=codes.tif --set boundary.latitude_cap=48.3)
+    # averaged 2 x 2 as it is read (24 x 22 cells): each rank reads the blocks of its rows
+    [ "$scenario" = dem_rows ] || sets+=(--set dem.resample=2)
+    ;;
   refusals | interrupt) ;;
   *)
-    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, water_cycle, row_tail, restart, refusals, interrupt)"
+    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, water_cycle, row_tail, dem_rows, dem_rows_coarse, restart, refusals, interrupt)"
     exit 2
     ;;
 esac
@@ -402,8 +457,48 @@ else
     for n in 1 2 3 4; do
       run "np $n" np$n.h5 "${mpi[@]}" -np $n "${tmp[@]}" "$erodem" run scenario.toml
       same_as serial.h5 np$n.h5 "$label, np $n"
+      # each rank read or made only its rows of the terrain (the note load_terrain leaves)
+      if [ $n -gt 1 ] && ! grep -Eq "each of the $n ranks (read|made) its own rows" np$n.h5.log; then
+        echo "FAIL $label, np $n: the ranks did not read or make the terrain by rows (no note in the log)"
+        failed=1
+      fi
     done
   done
+  if [ "$scenario" = dem_rows ] || [ "$scenario" = dem_rows_coarse ]; then
+    # A bad value is found by the rank owning its row, and every rank stops with the message
+    # and exit code one process gives (the first bad cell in row order: io/src/setup.cpp
+    # first_bad_cell): elevations beyond 440 m (the first on row 15, rank 1's of 3 and of 4;
+    # rank 2 of 4 holds more), an initial depth raster below 0 on every band, and a boundary
+    # code of 1.5 (no code) on the cells beyond 440 m. Checked by
+    # hand: with each rank naming its own first bad cell (no allgather), np 4 names cell (31,
+    # 23) of rank 2 and fails here.
+    scaled negative -1 0.01
+    gdal_calc.py --quiet -A "$rhine" --outfile=codes_half.tif --type=Float32 \
+      --calc="where(A > 440, 1.5, 0)"
+    bads=("--set dem.elevation_limit=440" "--set initial.water_depth=negative.tif")
+    # (averaged, a block takes its most frequent whole code: 1.5 counts as 1, no error)
+    [ "$scenario" = dem_rows_coarse ] || bads+=("--set boundary.raster=codes_half.tif")
+    for bad in "${bads[@]}"; do
+      for n in 1 3 4; do
+        rc=0
+        if [ $n = 1 ]; then
+          "$erodem" run scenario.toml "${sets[@]}" $bad --output bad$n.h5 --overwrite \
+            >bad$n.log 2>&1 || rc=$?
+        else
+          "${mpi[@]}" -np $n "$erodem" run scenario.toml "${sets[@]}" $bad --output bad$n.h5 \
+            --overwrite >bad$n.log 2>&1 || rc=$?
+        fi
+        message=$(grep -m1 "^erodem:" bad$n.log || true)
+        [ $n = 1 ] && first="$message"
+        if [ $rc -ne 65 ] || [ -z "$message" ] || [ "$message" != "$first" ]; then
+          echo "FAIL $bad, np $n: exit $rc, '$message' (one process: exit 65, '$first')"
+          failed=1
+        else
+          echo "$bad, np $n: exit 65, $message"
+        fi
+      done
+    done
+  fi
   echo "$("$erodem" --version): $([ ${#tmp[@]} -gt 0 ] && echo "one file written by the ranks together, no scratch file (TMPDIR names no folder)" || echo "rank 0 writes, the others into scratch files")"
 fi
 exit $failed

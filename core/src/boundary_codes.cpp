@@ -7,6 +7,7 @@
 
 #include "erodem/error.hpp"
 #include "erodem/simulation.hpp"
+#include "erodem/terrain_rows.hpp"
 
 namespace erodem {
 
@@ -14,7 +15,7 @@ namespace {
 
 int code_at(const Terrain& t, std::size_t i) {
   if (t.boundary_code.empty()) return kBoundaryAsEdge;
-  const double v = t.boundary_code[i];  // a nodata cell's may be anything
+  const double v = t.boundary_code[t.held(i)];  // a nodata cell's may be anything
   return v == 1 ? kBoundaryClosed : v == 2 ? kBoundaryOpen : v == 3 ? kBoundaryFixed : 0;
 }
 
@@ -23,25 +24,41 @@ int code_at(const Terrain& t, std::size_t i) {
 void apply_boundary_codes(Terrain& t, const std::string& source) {
   if (t.boundary_code.empty()) return;
   const auto& g = t.grid;
+  const auto code = [&t](std::size_t i) { return t.boundary_code[t.held(i)]; };
+  const auto edge = [&g](std::size_t i) {
+    const auto c = static_cast<int>(i % static_cast<std::size_t>(g.nx)),
+               r = static_cast<int>(i / static_cast<std::size_t>(g.nx));
+    return c == 0 || r == 0 || c == g.nx - 1 || r == g.ny - 1;
+  };
+  const BadCell bad = first_bad_cell(t, code, [&](std::size_t i, double v) {
+    return (v == 0 || v == 1 || v == 2 || v == 3) && !(v == kBoundaryOpen && !edge(i));
+  });
+  if (bad.cell >= 0) {
+    const auto c = bad.cell % g.nx, r = bad.cell / g.nx;
+    const double v = bad.value;
+    if (!(v == 0 || v == 1 || v == 2 || v == 3))
+      throw Error(ExitCode::data,
+                  fmt::format("{}: 'boundary.raster' value {} at cell {}, {} is not a boundary "
+                              "code (0 as the edge says, 1 closed, 2 open, 3 fixed_level)",
+                              source, v, c, r));
+    throw Error(ExitCode::data,
+                fmt::format("{}: 'boundary.raster' code 2 (open) at cell {}, {}, inside the "
+                            "grid: open applies to the grid's edge cells only",
+                            source, c, r));
+  }
+  // interior cells coded closed or fixed_level leave the domain: on the rows this process owns,
+  // the mask of the others' rows from them where the terrain is banded
   if (t.mask.empty()) t.mask.assign(g.cells(), 1);
-  for (int r = 0; r < g.ny; ++r)
-    for (int c = 0; c < g.nx; ++c) {
-      const auto i = static_cast<std::size_t>(r) * g.nx + c;
-      if (!t.active(i)) continue;
-      const double v = t.boundary_code[i];
-      const bool edge = c == 0 || r == 0 || c == g.nx - 1 || r == g.ny - 1;
-      if (!(v == 0 || v == 1 || v == 2 || v == 3))
-        throw Error(ExitCode::data,
-                    fmt::format("{}: 'boundary.raster' value {} at cell {}, {} is not a boundary "
-                                "code (0 as the edge says, 1 closed, 2 open, 3 fixed_level)",
-                                source, v, c, r));
-      if (v == kBoundaryOpen && !edge)
-        throw Error(ExitCode::data,
-                    fmt::format("{}: 'boundary.raster' code 2 (open) at cell {}, {}, inside the "
-                                "grid: open applies to the grid's edge cells only",
-                                source, c, r));
-      if (!edge && (v == kBoundaryClosed || v == kBoundaryFixed)) t.mask[i] = 0;
-    }
+  const parallel::Band own = own_rows(t);
+  const auto nx = static_cast<std::size_t>(g.nx);
+  for (std::size_t i = static_cast<std::size_t>(own.row0) * nx;
+       i < static_cast<std::size_t>(own.row1) * nx; ++i)
+    if (t.active(i) && !edge(i) && (code(i) == kBoundaryClosed || code(i) == kBoundaryFixed))
+      t.mask[i] = 0;
+  if (t.banded)
+    t.mask = gathered_mask(std::vector<std::uint8_t>(
+        t.mask.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(own.row0) * nx),
+        t.mask.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(own.row1) * nx)));
 }
 
 BoundaryKind ghost_condition(const Terrain& t, const Params& p, int col, int row, Side side) {
@@ -78,7 +95,7 @@ bool held_at_level(const Terrain& t, const Params& p, std::size_t i) {
 }
 
 bool held_on_own_bed(const Terrain& t, std::size_t i) {
-  return code_at(t, i) == kBoundaryFixed && std::isfinite(t.bed[i]);
+  return code_at(t, i) == kBoundaryFixed && std::isfinite(t.bed[t.held(i)]);
 }
 
 namespace {
@@ -105,11 +122,13 @@ bool repeats_first_column(const Grid& g) {
 }
 
 void drop_last_column(Terrain& t) {
-  const int nx = t.grid.nx, ny = t.grid.ny;
+  const int nx = t.grid.nx;
+  // every row an array holds (the whole grid's, or a band's: Terrain::row0), each nx long
   auto trim = [&](auto& v) {
-    if (v.size() != static_cast<std::size_t>(nx) * ny) return;  // empty: not given
+    if (v.empty()) return;  // not given
+    const std::size_t rows = v.size() / static_cast<std::size_t>(nx);
     std::size_t k = 0;
-    for (int r = 0; r < ny; ++r)
+    for (std::size_t r = 0; r < rows; ++r)
       for (int c = 0; c < nx - 1; ++c) v[k++] = v[static_cast<std::size_t>(r) * nx + c];
     v.resize(k);
   };
@@ -143,11 +162,12 @@ int apply_latitude_cap(Terrain& t, const Params& p) {
     if (!(std::fabs(g.cell_center(0, r)[1]) > cap)) continue;
     ++capped;
     if (t.mask.empty()) t.mask.assign(g.cells(), 1);
-    if (t.boundary_code.empty()) t.boundary_code.assign(g.cells(), kBoundaryAsEdge);
+    // (the codes on the rows the terrain holds: an MPI rank's band's, Terrain::banded)
+    if (t.boundary_code.empty()) t.boundary_code.assign(t.held_cells(), kBoundaryAsEdge);
     for (int c = 0; c < g.nx; ++c) {
       const auto i = static_cast<std::size_t>(r) * g.nx + c;
       t.mask[i] = 0;
-      t.boundary_code[i] = kBoundaryClosed;
+      if (t.holds_row(r)) t.boundary_code[t.held(i)] = kBoundaryClosed;
     }
   }
   if (capped == g.ny)

@@ -166,6 +166,35 @@ bool any(bool yes) {
   return yes;
 }
 
+std::vector<double> sums_in_rank_order(std::size_t n,
+                                       const std::function<void(std::vector<double>&)>& add) {
+  std::vector<double> sums(n, 0.0);
+#ifdef ERODEM_HAVE_MPI
+  const int ranks = size(), r = rank();
+  if (ranks > 1) {
+    const int count = count_of(n * sizeof(double));
+    if (r > 0) MPI_Recv(sums.data(), count, MPI_BYTE, r - 1, 3, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    add(sums);
+    if (r + 1 < ranks) MPI_Send(sums.data(), count, MPI_BYTE, r + 1, 3, MPI_COMM_WORLD);
+    MPI_Bcast(sums.data(), count, MPI_BYTE, ranks - 1, MPI_COMM_WORLD);
+    return sums;
+  }
+#endif
+  add(sums);
+  return sums;
+}
+
+double max_over_ranks(double mine) {
+#ifdef ERODEM_HAVE_MPI
+  if (size() > 1) {
+    double top = mine;
+    MPI_Allreduce(&mine, &top, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return top;
+  }
+#endif
+  return mine;
+}
+
 std::string root_string(const std::string& text) {
   const bool root = rank() == 0;
   const std::vector<unsigned char> all =

@@ -300,14 +300,14 @@ double bed_slope_degrees(const Terrain& t, int c, int r) {
   const auto usable = [&](int cc, int rr) {
     return cc >= 0 && cc < g.nx && rr >= 0 && rr < g.ny && t.active(at(cc, rr));
   };
-  const auto bed = [&](int cc, int rr) { return usable(cc, rr) ? t.bed[at(cc, rr)] : 0.0; };
+  const auto bed = [&](int cc, int rr) { return usable(cc, rr) ? t.bed[t.held(at(cc, rr))] : 0.0; };
   const auto dy_between = [&](int r0, int r1) {
     return 0.5 * (g.dy[static_cast<std::size_t>(r0)] + g.dy[static_cast<std::size_t>(r1)]);
   };
   const int north = usable(c, r - 1), south = usable(c, r + 1);
   const double slope = cell::bed_slope_cell<double>(
-      t.bed[at(c, r)], bed(c - 1, r), bed(c + 1, r), bed(c, r - 1), bed(c, r + 1), usable(c - 1, r),
-      usable(c + 1, r), north, south, g.dx[static_cast<std::size_t>(r)],
+      t.bed[t.held(at(c, r))], bed(c - 1, r), bed(c + 1, r), bed(c, r - 1), bed(c, r + 1),
+      usable(c - 1, r), usable(c + 1, r), north, south, g.dx[static_cast<std::size_t>(r)],
       north ? dy_between(r - 1, r) : 0.0, south ? dy_between(r, r + 1) : 0.0);
   const double pi = 3.14159265358979323846;
   return std::atan(slope) * 180.0 / pi;
@@ -332,8 +332,9 @@ std::vector<InitialField> snow_initial(const Terrain& t, const Params& p) {
              const int c = static_cast<int>(i % static_cast<std::size_t>(t.grid.nx)),
                        r = static_cast<int>(i / static_cast<std::size_t>(t.grid.nx));
              if (sn.max_slope && !(bed_slope_degrees(t, c, r) < *sn.max_slope)) return 0.0;
-             const double share = snow_line_share(t.bed[i], sn);
-             const double s0 = t.snow_initial.empty() ? sn.initial.value : t.snow_initial[i];
+             const double share = snow_line_share(t.bed[t.held(i)], sn);
+             const double s0 =
+                 t.snow_initial.empty() ? sn.initial.value : t.snow_initial[t.held(i)];
              return share > 0 ? (share == 1.0 ? s0 : s0 * share) : 0.0;
            }}};
 }
@@ -355,9 +356,8 @@ std::vector<SweepInfo> infiltration_sweeps(const Params&) {
 /// L delta theta (unlimited: the largest float), each from its uniform value or raster.
 std::vector<InitialField> infiltration_initial(const Terrain& t, const Params& p) {
   const auto& in = p.infiltration;
-  const auto value = [](const std::vector<double>& raster, const ScalarOrRaster& s, std::size_t i) {
-    return raster.empty() ? s.value : raster[i];
-  };
+  const auto value = [&t](const std::vector<double>& raster, const ScalarOrRaster& s,
+                          std::size_t i) { return raster.empty() ? s.value : raster[t.held(i)]; };
   const auto deficit = [&t, &in, value](std::size_t i) {
     return value(t.moisture_deficit, in.moisture_deficit, i);
   };
@@ -380,8 +380,8 @@ std::vector<InitialField> erosion_initial(const Terrain& t, const Params& p) {
   const auto& e = p.erosion;
   return {{FieldId::soil_thickness, [&t, &e](std::size_t i) {
              if (!t.active(i)) return 0.0;
-             if (e.bedrock_level) return std::max(t.bed[i] - *e.bedrock_level, 0.0);
-             return t.soil_thickness.empty() ? e.soil_thickness.value : t.soil_thickness[i];
+             if (e.bedrock_level) return std::max(t.bed[t.held(i)] - *e.bedrock_level, 0.0);
+             return t.soil_thickness.empty() ? e.soil_thickness.value : t.soil_thickness[t.held(i)];
            }}};
 }
 

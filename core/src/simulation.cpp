@@ -4,13 +4,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
 
 #include "erodem/boundary_codes.hpp"
 #include "erodem/error.hpp"
+#include "erodem/parallel.hpp"
 #include "erodem/process.hpp"
+#include "erodem/terrain_rows.hpp"
 
 namespace erodem {
 
@@ -130,35 +133,60 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   passes_ = step_passes(params_, params_.numerics.fused_sweeps);
   describe_grid();
   const auto& g = terrain_.grid;
-  for (int r = 0; r < g.ny; ++r)
-    for (int c = 0; c < g.nx; ++c) {
-      const auto i = static_cast<std::size_t>(r) * g.nx + c;
-      if (!terrain_.active(i)) continue;
-      const double factor = terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[i];
-      rain_area_ += g.area[r] * factor;
-      rain_factor_max_ = std::max(rain_factor_max_, factor);
-    }
+  // The sums over the active cells (the rain factor's area, each rain band's volume) add the
+  // terms of every row, or on a rank holding its band's rows (Terrain::banded) those of its own
+  // rows to the running sums carried through the ranks in row order (the bits of one process:
+  // parallel::sums_in_rank_order); the maxima the largest over the ranks.
+  const parallel::Band own = own_rows(terrain_);
+  const auto sums = [&](std::size_t n, const std::function<void(std::vector<double>&)>& add) {
+    if (terrain_.banded) return parallel::sums_in_rank_order(n, add);
+    std::vector<double> all(n, 0.0);  // every rank adds every row
+    add(all);
+    return all;
+  };
+  const auto factor = [this](std::size_t i) {
+    return terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[terrain_.held(i)];
+  };
+  rain_area_ = sums(1, [&](std::vector<double>& area) {
+    for (int r = own.row0; r < own.row1; ++r)
+      for (int c = 0; c < g.nx; ++c) {
+        const auto i = static_cast<std::size_t>(r) * g.nx + c;
+        if (!terrain_.active(i)) continue;
+        area[0] += g.area[r] * factor(i);
+        rain_factor_max_ = std::max(rain_factor_max_, factor(i));
+      }
+  })[0];
+  if (terrain_.banded) rain_factor_max_ = parallel::max_over_ranks(rain_factor_max_);
+  // a row-major loop over the active cells of rows [r0, r1): f(cell, row)
+  const auto each_active = [&](int r0, int r1, const auto& f) {
+    for (int r = r0; r < r1; ++r)
+      for (int c = 0; c < g.nx; ++c) {
+        const auto i = static_cast<std::size_t>(r) * g.nx + c;
+        if (terrain_.active(i)) f(i, r);
+      }
+  };
   if (!terrain_.rain_grids.empty()) {
     const double scale = params_.rain.grid_scale;
-    std::vector<std::vector<double>> rates;
+    std::vector<std::vector<double>> rates;  // on the rows the terrain holds, 0 off the active
     for (const auto& band : terrain_.rain_grids) {
-      if (band.size() != terrain_.bed.size())
+      if (band.size() != terrain_.held_cells())
         throw Error(ExitCode::data, "rain.grids: a band's size differs from the grid's");
       std::vector<double> rate(band.size(), 0.0);
-      double volume = 0.0, top = 0.0;
-      for (int r = 0; r < g.ny; ++r)
-        for (int c = 0; c < g.nx; ++c) {
-          const auto i = static_cast<std::size_t>(r) * g.nx + c;
-          if (!terrain_.active(i)) continue;
-          rate[i] =
-              band[i] * scale * (terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[i]);
-          volume += rate[i] * g.area[r];
-          top = std::max(top, rate[i]);
-        }
+      each_active(terrain_.row0, terrain_.end_row(), [&](std::size_t i, int) {
+        rate[terrain_.held(i)] = band[terrain_.held(i)] * scale * factor(i);
+      });
+      double top = 0.0;
+      each_active(own.row0, own.row1,
+                  [&](std::size_t i, int) { top = std::max(top, rate[terrain_.held(i)]); });
       rates.push_back(std::move(rate));
-      rain_band_volume_.push_back(volume);
-      rain_band_max_.push_back(top);
+      rain_band_max_.push_back(terrain_.banded ? parallel::max_over_ranks(top) : top);
     }
+    rain_band_volume_ = sums(rates.size(), [&](std::vector<double>& volume) {
+      for (std::size_t k = 0; k < rates.size(); ++k)
+        each_active(own.row0, own.row1, [&](std::size_t i, int r) {
+          volume[k] += rates[k][terrain_.held(i)] * g.area[r];
+        });
+    });
     const auto& rain = params_.rain;
     rain_grid_ =
         BandSeries(std::move(rates),
@@ -171,14 +199,16 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     if (terrain_.temperature_grids.empty())
       throw Error(ExitCode::data, "snow.temperature_grids: " + sn.temperature_grids +
                                       ": the terrain holds none of its bands");
-    std::vector<std::vector<double>> bands;  // 0 off the active cells (nodata there)
+    // on the rows the terrain holds, 0 off the active cells (nodata there)
+    std::vector<std::vector<double>> bands;
     for (const auto& band : terrain_.temperature_grids) {
-      if (band.size() != terrain_.bed.size())
+      if (band.size() != terrain_.held_cells())
         throw Error(ExitCode::data,
                     "snow.temperature_grids: a band's size differs from the grid's");
       bands.emplace_back(band.size(), 0.0);
-      for (std::size_t i = 0; i < band.size(); ++i)
-        if (terrain_.active(i)) bands.back()[i] = band[i];
+      each_active(terrain_.row0, terrain_.end_row(), [&](std::size_t i, int) {
+        bands.back()[terrain_.held(i)] = band[terrain_.held(i)];
+      });
     }
     temperature_grid_ =
         BandSeries(std::move(bands),
@@ -191,17 +221,22 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   sections_ = layout_sections(terrain_, params_);
   section_state_.assign(sections_.names.size(), SectionState{});
   if (!sections_.faces.empty()) backend_->set_faces(sections_.faces);
-  find_coast_cells();
+  std::vector<double> coast_bed;  // the coast cells' beds
+  find_coast_cells(coast_bed);
   // the initial values of the fields the processes own (process.hpp ProcessInfo::initial)
   // (a strip of rows at a time: a whole field in double would be 8 B per cell beside the
   // state, the setup's peak)
+  // (a terrain of a band's rows: those of them whose neighbours it holds too, which hold the
+  // backend's rows: io::load_terrain)
+  const int first_row = terrain_.row0 == 0 ? 0 : terrain_.row0 + 1,
+            end_row = terrain_.end_row() == g.ny ? g.ny : terrain_.end_row() - 1;
   for (const Process p : step_sequence(params_))
     if (const auto initial = process_info(p).initial)
       for (const InitialField& f : initial(terrain_, params_)) {
         constexpr int kStrip = 256;  // rows
         std::vector<double> values;
-        for (int row0 = 0; row0 < g.ny; row0 += kStrip) {
-          const int row1 = std::min(g.ny, row0 + kStrip);
+        for (int row0 = first_row; row0 < end_row; row0 += kStrip) {
+          const int row1 = std::min(end_row, row0 + kStrip);
           const std::size_t first = static_cast<std::size_t>(row0) * g.nx;
           values.resize(static_cast<std::size_t>(row1 - row0) * g.nx);
           for (std::size_t i = 0; i < values.size(); ++i) values[i] = f.value(first + i);
@@ -216,9 +251,6 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     backend_->end_step();
   }
   stats_ = backend_->stats();
-  std::vector<double> coast_bed;
-  for (const auto cell : coast_cells_)
-    coast_bed.push_back(terrain_.bed[static_cast<std::size_t>(cell)]);
   coast_depth_ = coast_depth(coast_bed);
   if (stats_.bad_cell >= 0)
     throw Error(ExitCode::data, "initial state: cell " + cell_name(stats_.bad_cell) +
@@ -343,7 +375,7 @@ void Simulation::resolve_inflows() {
     }
 }
 
-void Simulation::find_coast_cells() {
+void Simulation::find_coast_cells(std::vector<double>& coast_bed) {
   const auto& g = terrain_.grid;
   constexpr BoundaryKind fixed_level = BoundaryKind::fixed_level;
   // Whether active cell (c, r)'s neighbour (c + dc, r + dr) is a fixed-level cell: the ghost of
@@ -356,13 +388,24 @@ void Simulation::find_coast_cells() {
     const auto n = static_cast<std::size_t>(nr) * g.nx + nc;
     return !terrain_.active(n) && held_at_level(terrain_, params_, n);
   };
-  for (int r = 0; r < g.ny; ++r)
+  // on the rows this process owns (a banded terrain holds the rows beside them too), each
+  // with its bed (in double, as read); the ranks' lists in rank order are the grid's, in
+  // row-major order
+  const parallel::Band own = own_rows(terrain_);
+  for (int r = own.row0; r < own.row1; ++r)
     for (int c = 0; c < g.nx; ++c) {
       const auto i = static_cast<std::size_t>(r) * g.nx + c;
-      if (terrain_.active(i) && (fixed(c, r, -1, 0, Side::west) || fixed(c, r, 1, 0, Side::east) ||
-                                 fixed(c, r, 0, -1, Side::north) || fixed(c, r, 0, 1, Side::south)))
+      if (terrain_.active(i) &&
+          (fixed(c, r, -1, 0, Side::west) || fixed(c, r, 1, 0, Side::east) ||
+           fixed(c, r, 0, -1, Side::north) || fixed(c, r, 0, 1, Side::south))) {
         coast_cells_.push_back(static_cast<std::int64_t>(i));
+        coast_bed.push_back(terrain_.bed[terrain_.held(i)]);
+      }
     }
+  if (terrain_.banded) {
+    coast_cells_ = parallel::allgather(coast_cells_);
+    coast_bed = parallel::allgather(coast_bed);
+  }
 }
 
 double Simulation::coast_depth(const std::vector<double>& coast_bed) const {
@@ -389,7 +432,8 @@ double Simulation::set_rain_grid(double t) {
   const auto [k, w] = rain_grid_.at(t);
   const double volume =
       w > 0 ? (1 - w) * rain_band_volume_[k] + w * rain_band_volume_[k + 1] : rain_band_volume_[k];
-  if (auto rate = rain_grid_.values_if_changed(t)) backend_->set_field(FieldId::rain_factor, *rate);
+  if (auto rate = rain_grid_.values_if_changed(t))
+    backend_->set_field_rows(FieldId::rain_factor, terrain_.row0, terrain_.end_row(), *rate);
   return volume;
 }
 
@@ -587,7 +631,7 @@ void Simulation::step() {
   // gridded air temperature: the bands at the step's midpoint in the air_temperature field
   if (!temperature_grid_.empty())
     if (auto T = temperature_grid_.values_if_changed(time_ + 0.5 * dt))
-      backend_->set_field(FieldId::air_temperature, *T);
+      backend_->set_field_rows(FieldId::air_temperature, terrain_.row0, terrain_.end_row(), *T);
   backend_->begin_step(in);
   for (const auto& pass : passes())
     if (pass.front() != Process::terrain_class || class_pass) backend_->run_pass(pass);

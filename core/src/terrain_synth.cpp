@@ -15,6 +15,8 @@
 
 #include "erodem/terrain_synth.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -164,11 +166,13 @@ std::vector<double> perlin_octaves(int nx, int ny, int octaves, double freq0, st
 
 /// The terrain generators' octaves, in cells: the first octave with a period of half the
 /// larger grid side, the last with a period of about 4 cells.
-std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged) {
+/// Rows [r0, r1) of them (all by default), row-major.
+std::vector<double> octave_noise(int nx, int ny, std::uint64_t seed, bool ridged, int r0 = 0,
+                                 int r1 = -1) {
   const int side = std::max(nx, ny);
   return perlin_octaves(
       nx, ny, std::max(1, ilog2(side) - 2), 2.0 / side, seed ^ 0x5DEECE66DULL, ridged,
-      [](int c, int) { return c + 0.5; }, [](int r) { return r + 0.5; });
+      [](int c, int) { return c + 0.5; }, [](int r) { return r + 0.5; }, r0, r1);
 }
 
 /// Diamond-square midpoint displacement on an n x n grid, n = 2^k + 1 >= max(nx, ny),
@@ -222,81 +226,110 @@ struct Coords {
   double v(int r) const { return (r + 0.5) / ny; }
 };
 
-/// Adds `fraction` of unit-amplitude fbm (scaled to [-0.5, 0.5]) to `base`.
-void add_fbm(std::vector<double>& base, int nx, int ny, std::uint64_t seed, double fraction) {
-  const std::vector<double> n = octave_noise(nx, ny, seed, false);
-  const auto mm = std::minmax_element(n.begin(), n.end());
-  const double range = *mm.second - *mm.first;
-  if (!(range > 0.0)) return;
-  for (std::size_t i = 0; i < base.size(); ++i)
-    base[i] += fraction * ((n[i] - *mm.first) / range - 0.5);
-}
-
-std::vector<double> hill(int nx, int ny, std::uint64_t seed) {
-  const Coords g{nx, ny};
-  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+/// The smooth shapes under the fbm of the hill, lake, valley and ridge terrains at cell (c, r),
+/// and the fraction of fbm each adds (below).
+double hill_at(const Coords& g, int c, int r) {
   const double sigma = 0.2;  // of the grid extent
-  for (int r = 0; r < ny; ++r)
-    for (int c = 0; c < nx; ++c) {
-      const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
-      h[static_cast<std::size_t>(r) * nx + c] =
-          det_exp(-(du * du + dv * dv) / (2.0 * sigma * sigma));
-    }
-  add_fbm(h, nx, ny, seed, 0.05);
-  return h;
+  const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
+  return det_exp(-(du * du + dv * dv) / (2.0 * sigma * sigma));
 }
 
-std::vector<double> lake(int nx, int ny, std::uint64_t seed) {
-  const Coords g{nx, ny};
-  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+double lake_at(const Coords& g, int c, int r) {
   const double rim = 0.3;  // rim radius, of the grid extent
-  for (int r = 0; r < ny; ++r)
-    for (int c = 0; c < nx; ++c) {
-      const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
-      const double d = std::sqrt(du * du + dv * dv) / rim;  // 1 on the rim crest
-      double z;
-      if (d <= 1.0) {
-        z = d * d;  // parabolic bowl, 0 at the centre, 1 on the crest
-      } else {
-        const double t = std::min(1.0, (d - 1.0) / 0.5);  // outer flank, then a plain
-        z = 1.0 - 0.5 * t * t * (3.0 - 2.0 * t);
-      }
-      h[static_cast<std::size_t>(r) * nx + c] = z;
-    }
-  add_fbm(h, nx, ny, seed, 0.04);
-  return h;
+  const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
+  const double d = std::sqrt(du * du + dv * dv) / rim;  // 1 on the rim crest
+  if (d <= 1.0) return d * d;                           // parabolic bowl, 0 at the centre
+  const double t = std::min(1.0, (d - 1.0) / 0.5);      // outer flank, then a plain
+  return 1.0 - 0.5 * t * t * (3.0 - 2.0 * t);
 }
 
-std::vector<double> valley(int nx, int ny, std::uint64_t seed) {
-  const Coords g{nx, ny};
-  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+double valley_at(const Coords& g, int c, int r) {
   const double width = 0.03;  // channel half-width, of the grid height
-  for (int r = 0; r < ny; ++r)
-    for (int c = 0; c < nx; ++c) {
-      const double u = g.u(c);
-      const double d = std::fabs(g.v(r) - 0.5) * 2.0;  // 0 on the axis, 1 at the edges
-      const double thalweg = 0.5 * (1.0 - u);          // down towards +x (east)
-      const double sides = 0.5 * d * std::sqrt(d);     // between a V (d) and a U (d^2)
-      const double channel = 0.03 * det_exp(-(d * d) / (width * width));
-      h[static_cast<std::size_t>(r) * nx + c] = thalweg + sides - channel;
+  const double u = g.u(c);
+  const double d = std::fabs(g.v(r) - 0.5) * 2.0;  // 0 on the axis, 1 at the edges
+  const double thalweg = 0.5 * (1.0 - u);          // down towards +x (east)
+  const double sides = 0.5 * d * std::sqrt(d);     // between a V (d) and a U (d^2)
+  const double channel = 0.03 * det_exp(-(d * d) / (width * width));
+  return thalweg + sides - channel;
+}
+
+double ridge_at(const Coords& g, int c, int r) {
+  // Distance from the diagonal u = v, in units of its distance to the far corners.
+  const double d = std::fabs(g.u(c) - g.v(r));
+  const double t = std::max(0.0, 1.0 - d);
+  return t * std::sqrt(t);
+}
+
+/// The least and largest of `v`'s rows [o0, o1) of the rows [r0, ...) it holds (nx each),
+/// over every process through `reduce`.
+std::pair<double, double> rows_range(const std::vector<double>& v, int nx, int r0, int o0, int o1,
+                                     const RangeReduce& reduce) {
+  const auto first = v.begin() + static_cast<std::ptrdiff_t>(o0 - r0) * nx;
+  const auto last = v.begin() + static_cast<std::ptrdiff_t>(o1 - r0) * nx;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  if (first != last) {
+    const auto mm = std::minmax_element(first, last);
+    lo = *mm.first;
+    hi = *mm.second;
+  }
+  if (reduce) reduce(lo, hi);
+  return {lo, hi};
+}
+
+}  // namespace
+
+std::vector<double> generate_terrain_rows(SynthKind kind, int nx, int ny, double relief_m,
+                                          std::uint64_t seed, int r0, int r1, int o0, int o1,
+                                          const RangeReduce& reduce) {
+  if (!(0 <= r0 && r0 <= o0 && o0 <= o1 && o1 <= r1 && r1 <= ny))
+    throw Error(
+        ExitCode::internal,
+        fmt::format("synthetic terrain: rows [{}, {}) owning [{}, {}) of {}", r0, r1, o0, o1, ny));
+  if (kind == SynthKind::diamond_square)
+    throw Error(ExitCode::internal, "synthetic terrain: diamond_square is made whole");
+  const bool noise_only = kind == SynthKind::fbm || kind == SynthKind::ridged;
+  std::vector<double> h = octave_noise(nx, ny, seed, kind == SynthKind::ridged, r0, r1);
+  if (!noise_only) {
+    // the shape plus `fraction` of the fbm, scaled to [-0.5, 0.5] by the whole grid's range
+    const Coords g{nx, ny};
+    double (*shape)(const Coords&, int, int) = nullptr;
+    double fraction = 0.0;
+    switch (kind) {
+      case SynthKind::hill:
+        shape = hill_at, fraction = 0.05;
+        break;
+      case SynthKind::lake:
+        shape = lake_at, fraction = 0.04;
+        break;
+      case SynthKind::valley:
+        shape = valley_at, fraction = 0.02;
+        break;
+      case SynthKind::ridge:
+        shape = ridge_at, fraction = 0.05;
+        break;
+      default:
+        throw Error(ExitCode::internal, "synthetic terrain: unknown kind");
     }
-  add_fbm(h, nx, ny, seed, 0.02);
+    const auto [lo, hi] = rows_range(h, nx, r0, o0, o1, reduce);
+    const double range = hi - lo;
+    for (int r = r0; r < r1; ++r)
+      for (int c = 0; c < nx; ++c) {
+        double& z = h[static_cast<std::size_t>(r - r0) * nx + c];
+        const double base = shape(g, c, r);
+        z = range > 0.0 ? base + fraction * ((z - lo) / range - 0.5) : base;
+      }
+  }
+  // mapped linearly onto [0, relief] by the whole grid's range; a constant field becomes 0
+  const auto [lo, hi] = rows_range(h, nx, r0, o0, o1, reduce);
+  const double range = hi - lo;
+  for (double& z : h) {
+    z = range > 0.0 ? (z - lo) / range * relief_m : 0.0;
+    z = std::min(relief_m, std::max(0.0, z));
+  }
   return h;
 }
 
-std::vector<double> ridge(int nx, int ny, std::uint64_t seed) {
-  const Coords g{nx, ny};
-  std::vector<double> h(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
-  for (int r = 0; r < ny; ++r)
-    for (int c = 0; c < nx; ++c) {
-      // Distance from the diagonal u = v, in units of its distance to the far corners.
-      const double d = std::fabs(g.u(c) - g.v(r));
-      const double t = std::max(0.0, 1.0 - d);
-      h[static_cast<std::size_t>(r) * nx + c] = t * std::sqrt(t);
-    }
-  add_fbm(h, nx, ny, seed, 0.05);
-  return h;
-}
+namespace {
 
 /// Maps `h` linearly onto [0, relief]; a constant field becomes 0.
 void normalise(std::vector<double>& h, double relief) {
@@ -342,32 +375,9 @@ std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell
   if (!(std::isfinite(relief_m) && relief_m > 0.0))
     throw Error(ExitCode::usage, "synthetic terrain: relief must be a positive number of m");
 
-  std::vector<double> h;
-  switch (kind) {
-    case SynthKind::fbm:
-      h = octave_noise(nx, ny, seed, false);
-      break;
-    case SynthKind::ridged:
-      h = octave_noise(nx, ny, seed, true);
-      break;
-    case SynthKind::diamond_square:
-      h = diamond_square(nx, ny, seed);
-      break;
-    case SynthKind::hill:
-      h = hill(nx, ny, seed);
-      break;
-    case SynthKind::lake:
-      h = lake(nx, ny, seed);
-      break;
-    case SynthKind::valley:
-      h = valley(nx, ny, seed);
-      break;
-    case SynthKind::ridge:
-      h = ridge(nx, ny, seed);
-      break;
-    default:
-      throw Error(ExitCode::internal, "synthetic terrain: unknown kind");
-  }
+  if (kind != SynthKind::diamond_square)
+    return generate_terrain_rows(kind, nx, ny, relief_m, seed, 0, ny, 0, ny, nullptr);
+  std::vector<double> h = diamond_square(nx, ny, seed);
   normalise(h, relief_m);
   return h;
 }
@@ -459,7 +469,7 @@ std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Er
   return r;
 }
 
-Terrain make_synthetic_terrain(const Params::Dem& dem) {
+Terrain make_synthetic_terrain(const Params::Dem& dem, const SynthRows& rows) {
   SynthKind kind;
   try {
     kind = synth_kind_from_string(dem.synthetic);
@@ -479,7 +489,14 @@ Terrain make_synthetic_terrain(const Params::Dem& dem) {
   t.grid = Grid::uniform(dem.size, dem.size, cell);
   // The seed is an int in the configuration; its two's-complement bits seed the PRNG.
   const auto seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(dem.seed));
-  t.bed = generate_terrain(kind, dem.size, dem.size, cell, dem.relief, seed);
+  if (rows.row1 < 0) {
+    t.bed = generate_terrain(kind, dem.size, dem.size, cell, dem.relief, seed);
+  } else {
+    t.bed = generate_terrain_rows(kind, dem.size, dem.size, dem.relief, seed, rows.row0, rows.row1,
+                                  rows.own0, rows.own1, rows.reduce);
+    t.row0 = rows.row0;
+    t.row1 = rows.row1;
+  }
   std::ostringstream src;
   src << "synthetic:" << to_string(kind) << " size=" << dem.size << " seed=" << dem.seed
       << " relief=" << dem.relief << " m cell=" << cell << " m";

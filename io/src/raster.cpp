@@ -142,6 +142,15 @@ std::vector<double> read_band(GDALDatasetH ds, const std::array<int, 4>& w,
   return v;
 }
 
+std::array<int, 4> rows_of_window(const std::array<int, 4>& w, std::array<int, 2> rows) {
+  if (rows[1] < 0) return w;
+  if (!(0 <= rows[0] && rows[0] < rows[1] && rows[1] <= w[3]))
+    throw Error(ExitCode::internal, "rows [" + std::to_string(rows[0]) + ", " +
+                                        std::to_string(rows[1]) + ") of a window of " +
+                                        std::to_string(w[3]) + " rows");
+  return {w[0], w[1] + rows[0], w[2], rows[1] - rows[0]};
+}
+
 std::array<double, 6> shifted(const std::array<double, 6>& t, int col, int row) {
   return {t[0] + col * t[1] + row * t[2], t[1], t[2], t[3] + col * t[4] + row * t[5], t[4], t[5]};
 }
@@ -180,7 +189,7 @@ RasterHeader read_raster_header(const std::string& path) {
 
 std::vector<std::vector<double>> read_raster_bands_on_grid(
     const std::string& path, const Grid& grid, const std::optional<std::array<int, 4>>& window,
-    const std::string& what, bool all_bands) {
+    const std::string& what, bool all_bands, std::array<int, 2> rows) {
   ensure_gdal();
   QuietGdal quiet;
   const std::string prefix = what + ": ";
@@ -211,14 +220,15 @@ std::vector<std::vector<double>> read_raster_bands_on_grid(
   std::vector<std::uint8_t> valid;
   std::vector<std::vector<double>> bands;
   const int count = all_bands ? GDALGetRasterCount(h) : 1;
-  for (int b = 1; b <= count; ++b) bands.push_back(read_band(h, w, valid, prefix, path, b));
+  const std::array<int, 4> read = rows_of_window(w, rows);
+  for (int b = 1; b <= count; ++b) bands.push_back(read_band(h, read, valid, prefix, path, b));
   return bands;
 }
 
 std::vector<double> read_raster_on_grid(const std::string& path, const Grid& grid,
                                         const std::optional<std::array<int, 4>>& window,
-                                        const std::string& what) {
-  return std::move(read_raster_bands_on_grid(path, grid, window, what, false).front());
+                                        const std::string& what, std::array<int, 2> rows) {
+  return std::move(read_raster_bands_on_grid(path, grid, window, what, false, rows).front());
 }
 
 }  // namespace erodem::io

@@ -9,6 +9,7 @@
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/parameter_rasters.hpp"
+#include "erodem/terrain_rows.hpp"
 #include "raster_gdal.hpp"
 
 namespace erodem::io {
@@ -43,9 +44,20 @@ Terrain coarsen(const Terrain& fine, int factor) {
                                            " leaves no cell of the " + std::to_string(g.nx) +
                                            " x " + std::to_string(g.ny) + " grid");
   Terrain t;
+  // a band's rows (an MPI rank's: Terrain::banded): those coarse rows whose blocks it holds,
+  // and it owns those of its own blocks (load_terrain reads whole blocks)
+  if (fine.banded) {
+    t.banded = true;
+    t.row0 = fine.row0 / factor;
+    t.row1 = std::min(ny, fine.end_row() / factor);
+    t.own0 = fine.own0 / factor;
+    t.own1 = std::min(ny, fine.own1 / factor);
+  }
+  const int r0 = t.row0, r1 = t.banded ? t.row1 : ny;
   t.source =
       fine.source + " (averaged " + std::to_string(factor) + "x" + std::to_string(factor) + ")";
   t.source_sha256 = fine.source_sha256;
+  t.notes = fine.notes;
   Grid& c = t.grid;
   c.nx = nx;
   c.ny = ny;
@@ -78,18 +90,18 @@ Terrain coarsen(const Terrain& fine, int factor) {
       for (int j = 0; j < factor; ++j) {
         const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
         if (!fine.active(k)) continue;
-        sum += v[k];
+        sum += v[fine.held(k)];
         ++n;
       }
     mean = n > 0 ? sum / n : 0.0;
     return n > 0;
   };
-  t.bed.assign(c.cells(), std::nan(""));
-  std::vector<std::uint8_t> mask(c.cells(), 0);
+  t.bed.assign(t.held_cells(), std::nan(""));
+  std::vector<std::uint8_t> mask(t.held_cells(), 0);
   bool any_masked = false;
-  for (int r = 0; r < ny; ++r)
+  for (int r = r0; r < r1; ++r)
     for (int col = 0; col < nx; ++col) {
-      const auto o = static_cast<std::size_t>(r) * nx + col;
+      const auto o = static_cast<std::size_t>(r - r0) * nx + col;
       double mean = 0;
       if (block_mean(fine.bed, r, col, mean)) {
         t.bed[o] = mean;
@@ -98,15 +110,20 @@ Terrain coarsen(const Terrain& fine, int factor) {
         any_masked = true;
       }
     }
-  if (any_masked) t.mask = std::move(mask);
+  if (t.banded)  // the whole grid's, from the ranks' own rows
+    t.mask = gathered_mask(
+        std::vector<std::uint8_t>(mask.begin() + static_cast<std::ptrdiff_t>(t.own0 - r0) * nx,
+                                  mask.begin() + static_cast<std::ptrdiff_t>(t.own1 - r0) * nx));
+  else if (any_masked)
+    t.mask = std::move(mask);
   // Parameter rasters on the fine grid (0 where a block has no valid cell).
   auto average = [&](const std::vector<double>& v) {
     std::vector<double> out;
     if (v.empty()) return out;
-    out.assign(c.cells(), 0.0);
-    for (int r = 0; r < ny; ++r)
+    out.assign(t.held_cells(), 0.0);
+    for (int r = r0; r < r1; ++r)
       for (int col = 0; col < nx; ++col)
-        block_mean(v, r, col, out[static_cast<std::size_t>(r) * nx + col]);
+        block_mean(v, r, col, out[static_cast<std::size_t>(r - r0) * nx + col]);
     return out;
   };
   // Codes (boundary.raster) are not averaged: a block takes its most frequent code over its
@@ -114,19 +131,19 @@ Terrain coarsen(const Terrain& fine, int factor) {
   auto mode = [&](const std::vector<double>& v) {
     std::vector<double> out;
     if (v.empty()) return out;
-    out.assign(c.cells(), 0.0);
-    for (int r = 0; r < ny; ++r)
+    out.assign(t.held_cells(), 0.0);
+    for (int r = r0; r < r1; ++r)
       for (int col = 0; col < nx; ++col) {
         int count[4] = {0, 0, 0, 0};
         for (int i = 0; i < factor; ++i)
           for (int j = 0; j < factor; ++j) {
             const auto k = static_cast<std::size_t>(r * factor + i) * g.nx + (col * factor + j);
-            if (fine.active(k)) ++count[std::clamp(static_cast<int>(v[k]), 0, 3)];
+            if (fine.active(k)) ++count[std::clamp(static_cast<int>(v[fine.held(k)]), 0, 3)];
           }
         int best = 0;
         for (int code = 1; code < 4; ++code)
           if (count[code] >= count[best]) best = code;
-        out[static_cast<std::size_t>(r) * nx + col] = count[best] > 0 ? best : 0;
+        out[static_cast<std::size_t>(r - r0) * nx + col] = count[best] > 0 ? best : 0;
       }
     return out;
   };

@@ -23,7 +23,7 @@ void set_uniform_rows(Grid& g, double dx, double dy) {
 
 }  // namespace
 
-Terrain read_dem(const Params::Dem& dem) {
+Terrain read_dem(const Params::Dem& dem, std::array<int, 2> rows) {
   ensure_gdal();
   QuietGdal quiet;
   const std::string& path = dem.path;
@@ -125,9 +125,16 @@ Terrain read_dem(const Params::Dem& dem) {
   }
   g.validate();
 
-  // Elevations.
+  // Elevations (of the rows asked for).
+  const bool some_rows = rows[1] >= 0;
+  if (some_rows) {
+    if (resample_factor(dem, g) > 1)
+      throw Error(ExitCode::internal, path + ": a band of rows of a DEM to resample");
+    t.row0 = rows[0];
+    t.row1 = rows[1];
+  }
   std::vector<std::uint8_t> valid;
-  t.bed = read_band(h, w, valid, "", path);
+  t.bed = read_band(h, rows_of_window(w, rows), valid, "", path);
   std::size_t n_valid = 0;
   for (std::size_t i = 0; i < t.bed.size(); ++i) {
     // dem.nodata_value marks cells of a file that declares no nodata (e.g. sea at 0).
@@ -139,13 +146,16 @@ Terrain read_dem(const Params::Dem& dem) {
       t.bed[i] = std::nan("");
     }
   }
+  ds.reset();
+  t.source = path;
+  if (some_rows) {  // the whole grid's mask and the checksum are load_terrain's
+    t.mask = std::move(valid);
+    return t;
+  }
   if (n_valid == 0)
     throw Error(ExitCode::data, path + ": no valid (non-nodata) cells" +
                                     (dem.window ? " in window " + window_text(*dem.window) : ""));
   if (n_valid < t.bed.size()) t.mask = std::move(valid);
-  ds.reset();
-
-  t.source = path;
   t.source_sha256 = file_sha256(path);
   const int factor = resample_factor(dem, g);
   return factor > 1 ? coarsen(t, factor) : t;

@@ -72,6 +72,10 @@ Dataset open_raster(const std::string& path, const std::string& prefix);
 std::vector<std::string> subdataset_variables(GDALDatasetH ds);
 std::vector<std::string> netcdf_variables(const std::string& file);
 
+/// The rows [rows[0], rows[1]) of window `w` (col, row, width, height) as a window of their
+/// own; `w` itself where rows[1] < 0. Error(internal) for rows outside it.
+std::array<int, 4> rows_of_window(const std::array<int, 4>& w, std::array<int, 2> rows);
+
 /// The pixel window to read: the whole raster, or `window` checked against it.
 std::array<int, 4> checked_window(GDALDatasetH ds, const std::optional<std::array<int, 4>>& window,
                                   const std::string& prefix, const std::string& path);

@@ -2,39 +2,132 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "erodem/backends.hpp"
 #include "erodem/boundary_codes.hpp"
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
+#include "erodem/parallel.hpp"
 #include "erodem/parameter_rasters.hpp"
+#include "erodem/terrain_rows.hpp"
 #include "erodem/terrain_synth.hpp"
 
 namespace erodem::io {
 
 namespace {
 
+/// Rows of DEM around a band's own that a rank reads beside them: the halo (2 rows), the row
+/// beside it that the padded state's fixed-level cells read (initial_state.cpp), and the row
+/// beyond that which the bed's slope reads (the initial snow, process_table.cpp).
+constexpr int kBandMargin = 4;
+
 /// Checks that the active cells of `v`, read from `path` for `key` (`what`: "value", or
 /// "band k value"), hold finite values in [lo, hi]; Error(data) naming the first that does not.
 void check_raster_values(const std::vector<double>& v, const Terrain& t, const std::string& path,
                          const std::string& key, const std::string& what, double lo, double hi) {
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!t.active(i)) continue;
-    if (!(std::isfinite(v[i]) && v[i] >= lo && v[i] <= hi))
-      throw Error(ExitCode::data, path + ": '" + key + "' " + what + " " + std::to_string(v[i]) +
-                                      " at cell " + std::to_string(i % t.grid.nx) + ", " +
-                                      std::to_string(i / t.grid.nx) + " is outside [" +
-                                      std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  const BadCell bad = first_bad_cell(
+      t, [&](std::size_t i) { return v[t.held(i)]; },
+      [&](std::size_t, double x) { return std::isfinite(x) && x >= lo && x <= hi; });
+  if (bad.cell >= 0) {
+    const auto i = static_cast<std::size_t>(bad.cell);
+    throw Error(ExitCode::data, path + ": '" + key + "' " + what + " " + std::to_string(bad.value) +
+                                    " at cell " + std::to_string(i % t.grid.nx) + ", " +
+                                    std::to_string(i / t.grid.nx) + " is outside [" +
+                                    std::to_string(lo) + ", " + std::to_string(hi) + "]");
   }
+}
+
+/// The rows of a raster on the terrain's grid to read: those the terrain holds.
+std::array<int, 2> held_rows(const Terrain& t) {
+  return t.banded ? std::array<int, 2>{t.row0, t.end_row()} : std::array<int, 2>{0, -1};
 }
 
 /// Reads a parameter raster and checks its active cells hold finite values in [lo, hi].
 std::vector<double> parameter_raster(const std::string& path, const Terrain& t, const Params& p,
                                      const std::string& key, double lo, double hi) {
-  auto v = read_raster_on_grid(path, t.grid, p.dem.window, key);
+  auto v = read_raster_on_grid(path, t.grid, p.dem.window, key, held_rows(t));
   check_raster_values(v, t, path, key, "value", lo, hi);
   return v;
+}
+
+/// Whether each rank of this run reads or makes only its band's rows of the terrain (the DEM
+/// or a synthetic terrain, every parameter raster, boundary.raster's codes, the gridded rain
+/// and air temperature: docs/mpi.md): under MPI with more than one rank, but for a
+/// diamond-square terrain (made whole, as in one process).
+bool reads_band(const Params& p) {
+  return parallel::size() > 1 && p.dem.synthetic != "diamond_square";
+}
+
+/// The rows of a grid of `ny` rows this rank reads or makes: its own and kBandMargin more each
+/// way, of the rows coarsened by `factor` (dem.resample) when it is above 1, as rows of the
+/// grid read (factor of them a coarse row; the last rank's also the rows beyond the last
+/// whole block, which coarsening drops but reading checks).
+struct BandRead {
+  parallel::Band held, own;
+};
+BandRead band_read(int ny, int factor) {
+  const int coarse = ny / factor;
+  const parallel::Band own = parallel::band(coarse, parallel::rank(), parallel::size());
+  const int h0 = std::max(0, own.row0 - kBandMargin), h1 = std::min(coarse, own.row1 + kBandMargin);
+  const auto fine = [&](int row) { return row == coarse ? ny : row * factor; };
+  return {{fine(h0), fine(h1)}, {fine(own.row0), fine(own.row1)}};
+}
+
+/// The note a rank's terrain of its rows leaves in the log (the same on every rank but its
+/// rows).
+std::string band_note(const Terrain& t, int ny, const char* what) {
+  return fmt::format(
+      "{}: each of the {} ranks {} its own rows and {} beside them, and those of the parameter "
+      "rasters and gridded forcing (rank {}: rows {} to {} of {})",
+      t.source, parallel::size(), what, kBandMargin, parallel::rank(), t.row0, t.end_row() - 1, ny);
+}
+
+/// The synthetic terrain of `dem` made by this rank (band_read's rows), scaled by the ranges
+/// of the whole grid (the ranks' own rows' ranges combined).
+Terrain make_synthetic_band(const Params::Dem& dem) {
+  const BandRead band = band_read(dem.size, 1);
+  SynthRows rows;
+  rows.row0 = band.held.row0;
+  rows.row1 = band.held.row1;
+  rows.own0 = band.own.row0;
+  rows.own1 = band.own.row1;
+  rows.reduce = [](double& lo, double& hi) {
+    lo = -parallel::max_over_ranks(-lo);
+    hi = parallel::max_over_ranks(hi);
+  };
+  Terrain t = make_synthetic_terrain(dem, rows);
+  t.banded = true;
+  t.own0 = band.own.row0;
+  t.own1 = band.own.row1;
+  t.notes.push_back(band_note(t, dem.size, "made"));
+  return t;
+}
+
+/// The DEM of `dem` (read at full resolution: `full`) read by this rank (band_read's rows of
+/// the factor dem.resample asks for), with the whole grid's mask gathered from the ranks' own
+/// rows and the file's checksum rank 0's.
+Terrain read_dem_band(const Params::Dem& dem, const Params::Dem& full) {
+  const int ny = dem.window ? (*dem.window)[3] : read_raster_header(dem.path).ny;
+  int factor = 1;  // of the grid of the DEM's first row, as read_dem's grid would give it
+  if (dem.resample > 0.0 || dem.resample_factor > 1)
+    factor = std::max(1, resample_factor(dem, read_dem(full, {0, 1}).grid));
+  const BandRead band = band_read(ny, factor);
+  Terrain t = read_dem(full, {band.held.row0, band.held.row1});
+  t.banded = true;
+  t.own0 = band.own.row0;
+  t.own1 = band.own.row1;
+  const std::size_t nx = static_cast<std::size_t>(t.grid.nx);
+  const auto at = [&](int row) {
+    return t.mask.begin() +
+           static_cast<std::ptrdiff_t>(static_cast<std::size_t>(row - t.row0) * nx);
+  };
+  t.mask = gathered_mask(std::vector<std::uint8_t>(at(t.own0), at(t.own1)));
+  t.source_sha256 = parallel::root_string(parallel::rank() == 0 ? file_sha256(dem.path) : "");
+  t.notes.push_back(band_note(t, ny, "read"));
+  return t;
 }
 
 /// The bands of a gridded forcing (`key`: rain.grids, snow.temperature_grids) read from
@@ -46,7 +139,7 @@ void load_band_series(const std::string& path, const std::string& key,
                       const std::vector<double>& times, const std::string& times_key, double start,
                       double offset, double lo, double hi, const Terrain& t, const Params& p,
                       std::vector<std::vector<double>>& bands, std::vector<double>& band_times) {
-  bands = read_raster_bands_on_grid(path, t.grid, p.dem.window, key);
+  bands = read_raster_bands_on_grid(path, t.grid, p.dem.window, key, true, held_rows(t));
   if (offset != 0.0)
     for (auto& band : bands)
       for (double& v : band) v += offset;
@@ -83,23 +176,26 @@ Terrain load_terrain(const Params& p) {
   Params::Dem full = p.dem;
   full.resample = 0.0;
   full.resample_factor = 0;
-  Terrain t = full.synthetic.empty() ? read_dem(full) : make_synthetic_terrain(full);
+  Terrain t = !reads_band(p)
+                  ? (full.synthetic.empty() ? read_dem(full) : make_synthetic_terrain(full))
+              : full.synthetic.empty() ? read_dem_band(p.dem, full)
+                                       : make_synthetic_band(full);
   bool any_active = false;
   for (std::size_t i = 0; i < t.grid.cells() && !any_active; ++i) any_active = t.active(i);
   if (!any_active)
     throw Error(ExitCode::data, t.source + ": every cell is nodata; nothing to simulate");
   // a broken value (a float fill of -3.4e38, a wrong z_scale) stops here, naming the cell,
   // not as a NaN after the first step
-  for (int r = 0; r < t.grid.ny; ++r)
-    for (int c = 0; c < t.grid.nx; ++c) {
-      const std::size_t i = static_cast<std::size_t>(r) * t.grid.nx + c;
-      if (t.active(i) && !(std::abs(t.bed[i]) <= p.dem.elevation_limit))
-        throw Error(ExitCode::data,
-                    fmt::format("{}: cell (col {}, row {}) has elevation {:.6g} m, beyond "
-                                "dem.elevation_limit = {:.6g} m (check dem.z_scale, its nodata "
-                                "value, or raise the limit)",
-                                t.source, c, r, t.bed[i], p.dem.elevation_limit));
-    }
+  const BadCell high = first_bad_cell(
+      t, [&](std::size_t i) { return t.bed[t.held(i)]; },
+      [&](std::size_t, double z) { return std::abs(z) <= p.dem.elevation_limit; });
+  if (high.cell >= 0)
+    throw Error(ExitCode::data,
+                fmt::format("{}: cell (col {}, row {}) has elevation {:.6g} m, beyond "
+                            "dem.elevation_limit = {:.6g} m (check dem.z_scale, its nodata "
+                            "value, or raise the limit)",
+                            t.source, high.cell % t.grid.nx, high.cell / t.grid.nx, high.value,
+                            p.dem.elevation_limit));
   for (const auto& r : parameter_rasters()) {
     const std::string path = parameter_raster_path(r, p);
     if (!path.empty()) t.*r.values = parameter_raster(path, t, p, r.key, r.lo, r.hi);

@@ -75,7 +75,31 @@ struct Terrain {
   /// rows of boundary.latitude_cap): one line each.
   std::vector<std::string> notes;
 
+  /// The grid rows [row0, row1) the per-cell arrays hold (the bed, the parameter rasters, the
+  /// initial fields; the mask is the whole grid's always): every row, but on a rank of an MPI
+  /// run that read only its band's rows (`banded`, io::load_terrain, docs/mpi.md). row1 < 0:
+  /// grid.ny.
+  int row0 = 0;
+  int row1 = -1;
+  /// Whether this process read only its band's rows (every rank of the run alike), and the
+  /// rows [own0, own1) it owns then (inside [row0, row1); the ranks' own rows cover the grid
+  /// once, in rank order: terrain_rows.hpp own_rows).
+  bool banded = false;
+  int own0 = 0, own1 = 0;
+
   bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
+  /// The last row (exclusive) the per-cell arrays hold.
+  int end_row() const { return row1 < 0 ? grid.ny : row1; }
+  /// Whether the per-cell arrays hold grid row `r`.
+  bool holds_row(int r) const { return r >= row0 && r < end_row(); }
+  /// The index in the per-cell arrays of grid cell `i` (global, row-major), of a row they hold.
+  std::size_t held(std::size_t i) const {
+    return i - static_cast<std::size_t>(row0) * static_cast<std::size_t>(grid.nx);
+  }
+  /// The cells the per-cell arrays hold (their size where given).
+  std::size_t held_cells() const {
+    return static_cast<std::size_t>(end_row() - row0) * static_cast<std::size_t>(grid.nx);
+  }
 
   /// Frees the per-cell inputs (the bed, the parameter rasters, the rain and temperature
   /// bands, the initial snow) once a backend holds them: the grid, the mask, the band times,

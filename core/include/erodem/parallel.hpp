@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -57,15 +58,31 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes);
 template <class T>
 std::vector<T> allgather(const std::vector<T>& mine) {
   static_assert(std::is_trivially_copyable_v<T>);
-  const std::vector<unsigned char> raw = allgather_bytes(mine.data(), mine.size() * sizeof(T));
-  std::vector<T> out(raw.size() / sizeof(T));
-  if (!raw.empty()) std::memcpy(out.data(), raw.data(), raw.size());
-  return out;
+  if constexpr (std::is_same_v<T, unsigned char>) {  // no second copy (a whole grid's mask)
+    return allgather_bytes(mine.data(), mine.size());
+  } else {
+    const std::vector<unsigned char> raw = allgather_bytes(mine.data(), mine.size() * sizeof(T));
+    std::vector<T> out(raw.size() / sizeof(T));
+    if (!raw.empty()) std::memcpy(out.data(), raw.data(), raw.size());
+    return out;
+  }
 }
 
 /// Whether `yes` holds on any rank (a decision every rank must take alike: to stop, to store
 /// again). Collective (in one process: `yes`).
 bool any(bool yes);
+
+/// Running sums carried through the ranks in rank order: rank 0 calls `add` on `n` zeros,
+/// each other rank on the previous rank's result, and every rank returns the last rank's.
+/// With `add` adding this rank's own rows' terms to each sum it is given, one after another,
+/// each result has the bits of one process adding every term in global order (sums split into
+/// per-rank partials would not). Collective; the ranks wait for each other in turn (for sums
+/// made once, at setup). In one process: `add` on `n` zeros.
+std::vector<double> sums_in_rank_order(std::size_t n,
+                                       const std::function<void(std::vector<double>&)>& add);
+
+/// The largest of every rank's `mine`. Collective (in one process: `mine`).
+double max_over_ranks(double mine);
 
 /// Rank 0's `text` on every rank (what each rank's own may differ in: a time, a process id).
 /// Collective (in one process: `text`).

@@ -178,7 +178,8 @@ class Simulation {
     std::size_t spec = 0;             ///< index into params.inflow
   };
   void resolve_inflows();
-  void find_coast_cells();
+  /// The active cells beside a cell held at the level (coast_cells_), and their beds (m).
+  void find_coast_cells(std::vector<double>& coast_bed);
   /// The statistics of the current state (taken again when state_changed() was called).
   const FieldStats& current_stats() const;
   /// The largest face depth a fixed-level cell presents to an active cell beside it, less

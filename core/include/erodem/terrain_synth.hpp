@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,29 @@ SynthKind synth_kind_from_string(const std::string& name);
 std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell_size_m,
                                      double relief_m, std::uint64_t seed);
 
+/// Combines this process's least and largest value (`lo`, `hi`) with every other process's:
+/// the MPI ranks', each of its own rows (io::load_terrain). nullptr: this process's are the
+/// grid's.
+using RangeReduce = std::function<void(double& lo, double& hi)>;
+
+/// Rows [r0, r1) of generate_terrain(kind, nx, ny, ..., relief_m, seed) (row-major,
+/// (r1 - r0) x nx) for every kind but diamond_square (which is made whole: Error(internal)),
+/// those rows of the whole grid bit for bit without making the others: each cell's shape and
+/// noise are its own, and the ranges that scale the noise and the heights are those of the
+/// rows [o0, o1) this process owns (inside [r0, r1)) combined by `reduce` into the whole
+/// grid's. The sizes, relief and seed are as generate_terrain checks them.
+std::vector<double> generate_terrain_rows(SynthKind kind, int nx, int ny, double relief_m,
+                                          std::uint64_t seed, int r0, int r1, int o0, int o1,
+                                          const RangeReduce& reduce);
+
+/// The rows of a synthetic terrain one process makes (make_synthetic_terrain): rows
+/// [row0, row1) (row1 < 0: all), of which it owns [own0, own1), with `reduce` as
+/// generate_terrain_rows takes it.
+struct SynthRows {
+  int row0 = 0, row1 = -1, own0 = 0, own1 = -1;
+  RangeReduce reduce;
+};
+
 /// Fractal Brownian motion of 2-D Perlin gradient noise sampled at the cell centres of
 /// `grid`, in metres: `octaves` octaves, the first with a lattice spacing (wavelength) of
 /// `scale_m`, each next one with half the wavelength and half the amplitude (lacunarity 2,
@@ -102,6 +126,8 @@ std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Er
 /// when 0), relief `dem.relief` (m), seed `dem.seed`. All cells active; `source` describes
 /// the generator, e.g. "synthetic:fbm size=256 seed=1 relief=100 m cell=10 m".
 /// Throws erodem::Error(ExitCode::config) naming the key for invalid settings.
-Terrain make_synthetic_terrain(const Params::Dem& dem);
+/// With `rows` of some rows only (rows.row1 >= 0; not diamond_square): the bed of those rows
+/// (Terrain::row0, row1), as generate_terrain_rows makes them.
+Terrain make_synthetic_terrain(const Params::Dem& dem, const SynthRows& rows = {});
 
 }  // namespace erodem

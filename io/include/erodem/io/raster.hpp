@@ -57,7 +57,14 @@ namespace erodem::io {
 ///
 /// `source` is the path and `source_sha256` the SHA-256 of the file's bytes (lower-case
 /// hex). Only `grid`, `bed`, `mask`, `source` and `source_sha256` are filled.
-Terrain read_dem(const Params::Dem& dem);
+///
+/// `rows` = [row0, row1) (row1 >= 0; rows of the window): only those rows' elevations are
+/// read (an MPI rank's band: load_terrain); the grid stays the whole window's, `bed` and
+/// `mask` hold those rows only (the mask always, Terrain::row0 and row1 say which), nothing is
+/// checked for valid cells (load_terrain checks the whole mask) and no checksum is taken
+/// (load_terrain takes rank 0's). Resampling is refused there (Error(internal): load_terrain
+/// coarsens the rows read).
+Terrain read_dem(const Params::Dem& dem, std::array<int, 2> rows = {0, -1});
 
 /// The averaging factor that `dem.resample` / `dem.resample_factor` ask for on `grid`
 /// (1 = none). A cell size that is not a whole multiple of the grid's, or a cell size in
@@ -67,6 +74,9 @@ int resample_factor(const Params::Dem& dem, const Grid& grid);
 /// Averages `factor` x `factor` blocks of valid cells into one coarser cell (a block with no
 /// valid cell is nodata); cell sizes and areas grow accordingly (recomputed exactly on the
 /// ellipsoid for a geographic grid), partial blocks at the east and south edges are dropped.
+/// The notes are kept. A band's rows (`fine.banded`, whole blocks of them: load_terrain) give
+/// the coarse rows of those blocks, the whole grid's mask gathered from the ranks' own rows
+/// (collective).
 Terrain coarsen(const Terrain& fine, int factor);
 
 /// What a raster file says about itself, without reading its values (`erodem info`).
@@ -110,15 +120,16 @@ CrsInfo describe_crs(const std::string& crs);
 /// Error(ExitCode::data). Values are in the file's units (times the band's scale, plus its
 /// offset); nodata and non-finite cells are NaN. Missing file -> Error(ExitCode::no_input),
 /// unreadable -> Error(ExitCode::data); messages start with `what` and the path.
+/// `rows` = [row0, row1) (row1 >= 0): the grid's rows [row0, row1) only, row-major.
 std::vector<double> read_raster_on_grid(const std::string& path, const Grid& grid,
                                         const std::optional<std::array<int, 4>>& window,
-                                        const std::string& what);
+                                        const std::string& what, std::array<int, 2> rows = {0, -1});
 
 /// Every band of a raster on `grid` (as read_raster_on_grid reads band 1), in band order; with
 /// `all_bands` false, band 1 only.
 std::vector<std::vector<double>> read_raster_bands_on_grid(
     const std::string& path, const Grid& grid, const std::optional<std::array<int, 4>>& window,
-    const std::string& what, bool all_bands = true);
+    const std::string& what, bool all_bands = true, std::array<int, 2> rows = {0, -1});
 
 /// A netCDF variable named in GDAL's syntax: NETCDF:"file.nc":var (or NETCDF:file.nc:var).
 struct NetcdfName {
