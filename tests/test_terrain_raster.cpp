@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -110,6 +111,62 @@ TEST(TerrainSynth, ReproducibleAndSeedDependent) {
         {"valley", 0x2330c7f4d68cdeb8ULL},
         {"ridge", 0xb465b808701f6a02ULL}};
     EXPECT_EQ(hash, golden.at(name)) << name << ": output bits changed";
+  }
+}
+
+// generate_terrain_rows (an MPI rank's band of a synthetic terrain, docs/mpi.md): each band's
+// rows, scaled by the whole grid's ranges combined from every band's own rows, must be the
+// whole grid's rows bit for bit, for every kind made by rows and for bands with and without
+// the grid's first or last row. The ranks' combination (an allreduce of min and max) is
+// played here in passes: the k-th range a band reports is combined over the bands, then given
+// back to every band as its k-th range in the next pass. A band scaled by its own range
+// instead differs (checked below), so the bound 0 catches a range taken from the band alone.
+TEST(TerrainSynth, RowsAreTheWholeGridsRows) {
+  const int nx = 97, ny = 64, margin = 4;
+  const std::vector<std::array<int, 2>> own{{0, 21}, {21, 42}, {42, 64}};
+  for (const auto& name : erodem::synth_kind_names()) {
+    const SynthKind k = erodem::synth_kind_from_string(name);
+    if (k == SynthKind::diamond_square) continue;  // made whole
+    const auto whole = erodem::generate_terrain(k, nx, ny, 10.0, 100.0, 42);
+    std::vector<std::pair<double, double>> known;  // the grid's ranges, in call order
+    std::vector<std::vector<double>> rows(own.size());
+    for (int pass = 0; pass < 3; ++pass) {
+      std::pair<double, double> next{HUGE_VAL, -HUGE_VAL};  // the next range, combined
+      for (std::size_t b = 0; b < own.size(); ++b) {
+        std::size_t call = 0;
+        const erodem::RangeReduce reduce = [&](double& lo, double& hi) {
+          if (call < known.size()) {
+            lo = known[call].first;
+            hi = known[call].second;
+          } else if (call == known.size()) {
+            next = {std::min(next.first, lo), std::max(next.second, hi)};
+          }
+          ++call;
+        };
+        rows[b] = erodem::generate_terrain_rows(
+            k, nx, ny, 100.0, 42, std::max(0, own[b][0] - margin), std::min(ny, own[b][1] + margin),
+            own[b][0], own[b][1], reduce);
+      }
+      if (next.first <= next.second) known.push_back(next);
+    }
+    std::size_t differ = 0;  // values of the bands' rows that differ from the grid's
+    for (std::size_t b = 0; b < own.size(); ++b) {
+      const int r0 = std::max(0, own[b][0] - margin), r1 = std::min(ny, own[b][1] + margin);
+      ASSERT_EQ(rows[b].size(), static_cast<std::size_t>(r1 - r0) * nx) << name;
+      for (std::size_t i = 0; i < rows[b].size(); ++i)
+        differ += std::memcmp(&rows[b][i], &whole[static_cast<std::size_t>(r0) * nx + i],
+                              sizeof(double)) != 0;
+    }
+    EXPECT_EQ(differ, 0u) << name;
+    // scaled by its own rows' ranges alone, the middle band is not the grid's
+    const auto alone = erodem::generate_terrain_rows(k, nx, ny, 100.0, 42, 17, 46, 21, 42, nullptr);
+    std::size_t differ_alone = 0;
+    for (std::size_t i = 0; i < alone.size(); ++i) differ_alone += alone[i] != whole[17 * nx + i];
+    EXPECT_GT(differ_alone, alone.size() / 2) << name;
+    std::printf(
+        "  %-7s rows by 3 bands: %zu ranges combined, %zu values differ (bound 0); "
+        "scaled by the middle band's own ranges: %zu of %zu differ\n",
+        name.c_str(), known.size(), differ, differ_alone, alone.size());
   }
 }
 
