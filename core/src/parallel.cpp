@@ -1,5 +1,6 @@
 #include "erodem/parallel.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 
@@ -138,17 +139,47 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) 
 #ifdef ERODEM_HAVE_MPI
   const int n = size();
   if (n > 1) {
-    const int mine = count_of(bytes);
-    std::vector<int> counts(static_cast<std::size_t>(n)), offsets(static_cast<std::size_t>(n));
-    MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
-    std::size_t total = 0;
-    for (int r = 0; r < n; ++r) {
-      offsets[static_cast<std::size_t>(r)] = count_of(total);
-      total += static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+    // every rank's count, then the bytes in rounds of at most INT_MAX in all (MPI's counts and
+    // displacements are ints; a whole grid's mask may be larger: docs/mpi.md)
+    const auto mine = static_cast<unsigned long long>(bytes);
+    std::vector<unsigned long long> counts(static_cast<std::size_t>(n));
+    MPI_Allgather(&mine, 1, MPI_UNSIGNED_LONG_LONG, counts.data(), 1, MPI_UNSIGNED_LONG_LONG,
+                  MPI_COMM_WORLD);
+    std::vector<std::size_t> offsets(static_cast<std::size_t>(n));
+    std::size_t total = 0, largest = 0;
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+      offsets[r] = total;
+      total += counts[r];
+      largest = std::max<std::size_t>(largest, counts[r]);
     }
     std::vector<unsigned char> out(total);
-    MPI_Allgatherv(p, mine, MPI_BYTE, out.data(), counts.data(), offsets.data(), MPI_BYTE,
-                   MPI_COMM_WORLD);
+    // (ERODEM_MPI_GATHER_BYTES lowers a rank's bytes per round: tests/mpi.sh runs many rounds)
+    std::size_t chunk = static_cast<std::size_t>(INT_MAX) / static_cast<std::size_t>(n);
+    if (const char* v = std::getenv("ERODEM_MPI_GATHER_BYTES"); v && std::atol(v) > 0)
+      chunk = std::min(chunk, static_cast<std::size_t>(std::atol(v)));
+    std::vector<int> round_counts(static_cast<std::size_t>(n)), round_offsets(counts.size());
+    std::vector<unsigned char> round;
+    for (std::size_t done = 0; done == 0 || done < largest; done += chunk) {
+      int at = 0;
+      for (std::size_t r = 0; r < counts.size(); ++r) {
+        round_counts[r] =
+            static_cast<int>(counts[r] > done ? std::min<std::size_t>(counts[r] - done, chunk) : 0);
+        round_offsets[r] = at;
+        at += round_counts[r];
+      }
+      const int own = round_counts[static_cast<std::size_t>(rank())];
+      if (largest <= chunk) {  // one round, straight into the result
+        MPI_Allgatherv(p, own, MPI_BYTE, out.data(), round_counts.data(), round_offsets.data(),
+                       MPI_BYTE, MPI_COMM_WORLD);
+        break;
+      }
+      round.resize(static_cast<std::size_t>(at));
+      MPI_Allgatherv(p + std::min(done, bytes), own, MPI_BYTE, round.data(), round_counts.data(),
+                     round_offsets.data(), MPI_BYTE, MPI_COMM_WORLD);
+      for (std::size_t r = 0; r < counts.size(); ++r)
+        std::copy_n(round.begin() + round_offsets[r], round_counts[r],
+                    out.begin() + static_cast<std::ptrdiff_t>(offsets[r] + done));
+    }
     return out;
   }
 #endif

@@ -14,6 +14,7 @@
 #include "erodem/parameter_rasters.hpp"
 #include "erodem/terrain_rows.hpp"
 #include "erodem/terrain_synth.hpp"
+#include "raster_gdal.hpp"
 
 namespace erodem::io {
 
@@ -85,10 +86,9 @@ std::string band_note(const Terrain& t, int ny, const char* what) {
       t.source, parallel::size(), what, kBandMargin, parallel::rank(), t.row0, t.end_row() - 1, ny);
 }
 
-/// The synthetic terrain of `dem` made by this rank (band_read's rows), scaled by the ranges
-/// of the whole grid (the ranks' own rows' ranges combined).
-Terrain make_synthetic_band(const Params::Dem& dem) {
-  const BandRead band = band_read(dem.size, 1);
+/// The synthetic terrain of `dem` made by this rank (`band`'s rows), scaled by the ranges of
+/// the whole grid (the ranks' own rows' ranges combined).
+Terrain make_synthetic_band(const Params::Dem& dem, const BandRead& band) {
   SynthRows rows;
   rows.row0 = band.held.row0;
   rows.row1 = band.held.row1;
@@ -106,15 +106,9 @@ Terrain make_synthetic_band(const Params::Dem& dem) {
   return t;
 }
 
-/// The DEM of `dem` (read at full resolution: `full`) read by this rank (band_read's rows of
-/// the factor dem.resample asks for), with the whole grid's mask gathered from the ranks' own
-/// rows and the file's checksum rank 0's.
-Terrain read_dem_band(const Params::Dem& dem, const Params::Dem& full) {
-  const int ny = dem.window ? (*dem.window)[3] : read_raster_header(dem.path).ny;
-  int factor = 1;  // of the grid of the DEM's first row, as read_dem's grid would give it
-  if (dem.resample > 0.0 || dem.resample_factor > 1)
-    factor = std::max(1, resample_factor(dem, read_dem(full, {0, 1}).grid));
-  const BandRead band = band_read(ny, factor);
+/// The DEM of `dem` (read at full resolution: `full`) read by this rank (`band`'s rows), with
+/// the whole grid's mask gathered from the ranks' own rows and the file's checksum rank 0's.
+Terrain read_dem_band(const Params::Dem& dem, const Params::Dem& full, const BandRead& band) {
   Terrain t = read_dem(full, {band.held.row0, band.held.row1});
   t.banded = true;
   t.own0 = band.own.row0;
@@ -125,9 +119,36 @@ Terrain read_dem_band(const Params::Dem& dem, const Params::Dem& full) {
            static_cast<std::ptrdiff_t>(static_cast<std::size_t>(row - t.row0) * nx);
   };
   t.mask = gathered_mask(std::vector<std::uint8_t>(at(t.own0), at(t.own1)));
+  if (std::none_of(t.mask.begin(), t.mask.end(), [](std::uint8_t v) { return v != 0; }) &&
+      !t.mask.empty())  // read_dem's message for a whole grid of nodata
+    throw Error(ExitCode::data, dem.path + ": no valid (non-nodata) cells" +
+                                    (dem.window ? " in window " + window_text(*dem.window) : ""));
   t.source_sha256 = parallel::root_string(parallel::rank() == 0 ? file_sha256(dem.path) : "");
-  t.notes.push_back(band_note(t, ny, "read"));
+  t.notes.push_back(band_note(t, t.grid.ny, "read"));
   return t;
+}
+
+/// The terrain of `dem` (at full resolution: `full`) this rank reads or makes: its band's rows
+/// (band_read, of the rows dem.resample coarsens the grid to), or the whole grid where the rows
+/// cannot be chosen before reading: a resample factor that is an error, or that leaves no
+/// row (one process meets that error after checking the data, and so does every rank).
+Terrain terrain_band(const Params::Dem& dem, const Params::Dem& full) {
+  const bool synthetic = !dem.synthetic.empty();
+  // the grid (of a DEM: its window's, from reading its first row), as one process would have it
+  const Grid grid = synthetic ? Grid::uniform(std::max(1, dem.size), std::max(1, dem.size),
+                                              dem.cell_size > 0.0 ? dem.cell_size : 10.0)
+                              : read_dem(full, {0, 1}).grid;
+  const int ny = synthetic ? dem.size : grid.ny;
+  int factor = 1;
+  try {
+    factor = resample_factor(dem, grid);
+  } catch (const Error&) {
+    factor = 0;
+  }
+  if (factor < 1 || ny / factor < 1)
+    return synthetic ? make_synthetic_terrain(full) : read_dem(full);
+  const BandRead band = band_read(ny, factor);
+  return synthetic ? make_synthetic_band(full, band) : read_dem_band(dem, full, band);
 }
 
 /// The bands of a gridded forcing (`key`: rain.grids, snow.temperature_grids) read from
@@ -171,15 +192,14 @@ double celsius_offset(const std::string& path, const std::string& key) {
 
 }  // namespace
 
-Terrain load_terrain(const Params& p) {
+Terrain load_terrain(const Params& p, bool by_rows) {
   // Read at full resolution, with the parameter rasters, then average everything together.
   Params::Dem full = p.dem;
   full.resample = 0.0;
   full.resample_factor = 0;
-  Terrain t = !reads_band(p)
-                  ? (full.synthetic.empty() ? read_dem(full) : make_synthetic_terrain(full))
-              : full.synthetic.empty() ? read_dem_band(p.dem, full)
-                                       : make_synthetic_band(full);
+  Terrain t = by_rows && reads_band(p) ? terrain_band(p.dem, full)
+              : full.synthetic.empty() ? read_dem(full)
+                                       : make_synthetic_terrain(full);
   bool any_active = false;
   for (std::size_t i = 0; i < t.grid.cells() && !any_active; ++i) any_active = t.active(i);
   if (!any_active)
@@ -234,7 +254,7 @@ Terrain load_terrain(const Params& p) {
 }
 
 Simulation make_simulation(const Params& p, const std::string& backend) {
-  Terrain t = load_terrain(p);
+  Terrain t = load_terrain(p, true);
   auto be = make_backend(backend, t, p);
   return Simulation(std::move(t), p, std::move(be));
 }
