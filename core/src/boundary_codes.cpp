@@ -30,13 +30,14 @@ void apply_boundary_codes(Terrain& t, const std::string& source) {
                r = static_cast<int>(i / static_cast<std::size_t>(g.nx));
     return c == 0 || r == 0 || c == g.nx - 1 || r == g.ny - 1;
   };
+  const auto is_code = [](double v) { return v == 0 || v == 1 || v == 2 || v == 3; };
   const BadCell bad = first_bad_cell(t, code, [&](std::size_t i, double v) {
-    return (v == 0 || v == 1 || v == 2 || v == 3) && !(v == kBoundaryOpen && !edge(i));
+    return is_code(v) && !(v == kBoundaryOpen && !edge(i));
   });
   if (bad.cell >= 0) {
     const auto c = bad.cell % g.nx, r = bad.cell / g.nx;
     const double v = bad.value;
-    if (!(v == 0 || v == 1 || v == 2 || v == 3))
+    if (!is_code(v))
       throw Error(ExitCode::data,
                   fmt::format("{}: 'boundary.raster' value {} at cell {}, {} is not a boundary "
                               "code (0 as the edge says, 1 closed, 2 open, 3 fixed_level)",
@@ -55,10 +56,7 @@ void apply_boundary_codes(Terrain& t, const std::string& source) {
        i < static_cast<std::size_t>(own.row1) * nx; ++i)
     if (t.active(i) && !edge(i) && (code(i) == kBoundaryClosed || code(i) == kBoundaryFixed))
       t.mask[i] = 0;
-  if (t.banded)
-    t.mask = gathered_mask(std::vector<std::uint8_t>(
-        t.mask.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(own.row0) * nx),
-        t.mask.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(own.row1) * nx)));
+  if (t.banded) t.mask = gathered_mask(t.mask, 0, own, g.nx);
 }
 
 BoundaryKind ghost_condition(const Terrain& t, const Params& p, int col, int row, Side side) {

@@ -144,19 +144,9 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
     add(all);
     return all;
   };
-  const auto factor = [this](std::size_t i) {
-    return terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[terrain_.held(i)];
+  const auto largest = [&](double mine) {
+    return terrain_.banded ? parallel::max_over_ranks(mine) : mine;
   };
-  rain_area_ = sums(1, [&](std::vector<double>& area) {
-    for (int r = own.row0; r < own.row1; ++r)
-      for (int c = 0; c < g.nx; ++c) {
-        const auto i = static_cast<std::size_t>(r) * g.nx + c;
-        if (!terrain_.active(i)) continue;
-        area[0] += g.area[r] * factor(i);
-        rain_factor_max_ = std::max(rain_factor_max_, factor(i));
-      }
-  })[0];
-  if (terrain_.banded) rain_factor_max_ = parallel::max_over_ranks(rain_factor_max_);
   // a row-major loop over the active cells of rows [r0, r1): f(cell, row)
   const auto each_active = [&](int r0, int r1, const auto& f) {
     for (int r = r0; r < r1; ++r)
@@ -165,6 +155,16 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
         if (terrain_.active(i)) f(i, r);
       }
   };
+  const auto factor = [this](std::size_t i) {
+    return terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[terrain_.held(i)];
+  };
+  rain_area_ = sums(1, [&](std::vector<double>& area) {
+    each_active(own.row0, own.row1, [&](std::size_t i, int r) {
+      area[0] += g.area[r] * factor(i);
+      rain_factor_max_ = std::max(rain_factor_max_, factor(i));
+    });
+  })[0];
+  rain_factor_max_ = largest(rain_factor_max_);
   if (!terrain_.rain_grids.empty()) {
     const double scale = params_.rain.grid_scale;
     std::vector<std::vector<double>> rates;  // on the rows the terrain holds, 0 off the active
@@ -179,7 +179,7 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
       each_active(own.row0, own.row1,
                   [&](std::size_t i, int) { top = std::max(top, rate[terrain_.held(i)]); });
       rates.push_back(std::move(rate));
-      rain_band_max_.push_back(terrain_.banded ? parallel::max_over_ranks(top) : top);
+      rain_band_max_.push_back(largest(top));
     }
     rain_band_volume_ = sums(rates.size(), [&](std::vector<double>& volume) {
       for (std::size_t k = 0; k < rates.size(); ++k)

@@ -226,8 +226,8 @@ struct Coords {
   double v(int r) const { return (r + 0.5) / ny; }
 };
 
-/// The smooth shapes under the fbm of the hill, lake, valley and ridge terrains at cell (c, r),
-/// and the fraction of fbm each adds (below).
+/// The smooth shapes under the fbm of the hill, lake, valley and ridge terrains at cell (c, r)
+/// (kShapes, below, gives the fraction of fbm each adds).
 double hill_at(const Coords& g, int c, int r) {
   const double sigma = 0.2;  // of the grid extent
   const double du = g.u(c) - 0.5, dv = g.v(r) - 0.5;
@@ -276,6 +276,27 @@ std::pair<double, double> rows_range(const std::vector<double>& v, int nx, int r
   return {lo, hi};
 }
 
+/// Maps `h` linearly onto [0, relief], `lo` and `hi` (the whole grid's least and largest value)
+/// onto its ends; a constant field becomes 0.
+void normalise(std::vector<double>& h, double relief, double lo, double hi) {
+  const double range = hi - lo;
+  for (double& z : h) {
+    z = range > 0.0 ? (z - lo) / range * relief : 0.0;
+    z = std::min(relief, std::max(0.0, z));
+  }
+}
+
+/// The smooth shape of a kind and the fraction of unit fbm (scaled to [-0.5, 0.5]) it adds.
+struct Shape {
+  SynthKind kind;
+  double (*at)(const Coords&, int, int);
+  double fraction;
+};
+constexpr Shape kShapes[] = {{SynthKind::hill, hill_at, 0.05},
+                             {SynthKind::lake, lake_at, 0.04},
+                             {SynthKind::valley, valley_at, 0.02},
+                             {SynthKind::ridge, ridge_at, 0.05}};
+
 }  // namespace
 
 std::vector<double> generate_terrain_rows(SynthKind kind, int nx, int ny, double relief_m,
@@ -287,61 +308,28 @@ std::vector<double> generate_terrain_rows(SynthKind kind, int nx, int ny, double
         fmt::format("synthetic terrain: rows [{}, {}) owning [{}, {}) of {}", r0, r1, o0, o1, ny));
   if (kind == SynthKind::diamond_square)
     throw Error(ExitCode::internal, "synthetic terrain: diamond_square is made whole");
-  const bool noise_only = kind == SynthKind::fbm || kind == SynthKind::ridged;
   std::vector<double> h = octave_noise(nx, ny, seed, kind == SynthKind::ridged, r0, r1);
-  if (!noise_only) {
-    // the shape plus `fraction` of the fbm, scaled to [-0.5, 0.5] by the whole grid's range
+  if (kind != SynthKind::fbm && kind != SynthKind::ridged) {
+    // the shape plus its fraction of the fbm, scaled to [-0.5, 0.5] by the whole grid's range
+    const Shape* shape = nullptr;
+    for (const Shape& k : kShapes)
+      if (k.kind == kind) shape = &k;
+    if (!shape) throw Error(ExitCode::internal, "synthetic terrain: unknown kind");
     const Coords g{nx, ny};
-    double (*shape)(const Coords&, int, int) = nullptr;
-    double fraction = 0.0;
-    switch (kind) {
-      case SynthKind::hill:
-        shape = hill_at, fraction = 0.05;
-        break;
-      case SynthKind::lake:
-        shape = lake_at, fraction = 0.04;
-        break;
-      case SynthKind::valley:
-        shape = valley_at, fraction = 0.02;
-        break;
-      case SynthKind::ridge:
-        shape = ridge_at, fraction = 0.05;
-        break;
-      default:
-        throw Error(ExitCode::internal, "synthetic terrain: unknown kind");
-    }
     const auto [lo, hi] = rows_range(h, nx, r0, o0, o1, reduce);
     const double range = hi - lo;
     for (int r = r0; r < r1; ++r)
       for (int c = 0; c < nx; ++c) {
         double& z = h[static_cast<std::size_t>(r - r0) * nx + c];
-        const double base = shape(g, c, r);
-        z = range > 0.0 ? base + fraction * ((z - lo) / range - 0.5) : base;
+        const double base = shape->at(g, c, r);
+        z = range > 0.0 ? base + shape->fraction * ((z - lo) / range - 0.5) : base;
       }
   }
-  // mapped linearly onto [0, relief] by the whole grid's range; a constant field becomes 0
+  // mapped onto [0, relief] by the whole grid's range
   const auto [lo, hi] = rows_range(h, nx, r0, o0, o1, reduce);
-  const double range = hi - lo;
-  for (double& z : h) {
-    z = range > 0.0 ? (z - lo) / range * relief_m : 0.0;
-    z = std::min(relief_m, std::max(0.0, z));
-  }
+  normalise(h, relief_m, lo, hi);
   return h;
 }
-
-namespace {
-
-/// Maps `h` linearly onto [0, relief]; a constant field becomes 0.
-void normalise(std::vector<double>& h, double relief) {
-  const auto mm = std::minmax_element(h.begin(), h.end());
-  const double lo = *mm.first, range = *mm.second - lo;
-  for (double& z : h) {
-    z = range > 0.0 ? (z - lo) / range * relief : 0.0;
-    z = std::min(relief, std::max(0.0, z));
-  }
-}
-
-}  // namespace
 
 const std::vector<std::string>& synth_kind_names() {
   static const std::vector<std::string> names{"fbm",  "ridged", "diamond_square", "hill",
@@ -378,7 +366,8 @@ std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell
   if (kind != SynthKind::diamond_square)
     return generate_terrain_rows(kind, nx, ny, relief_m, seed, 0, ny, 0, ny, nullptr);
   std::vector<double> h = diamond_square(nx, ny, seed);
-  normalise(h, relief_m);
+  const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
+  normalise(h, relief_m, *lo, *hi);
   return h;
 }
 

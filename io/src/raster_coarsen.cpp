@@ -111,9 +111,7 @@ Terrain coarsen(const Terrain& fine, int factor) {
       }
     }
   if (t.banded)  // the whole grid's, from the ranks' own rows
-    t.mask = gathered_mask(
-        std::vector<std::uint8_t>(mask.begin() + static_cast<std::ptrdiff_t>(t.own0 - r0) * nx,
-                                  mask.begin() + static_cast<std::ptrdiff_t>(t.own1 - r0) * nx));
+    t.mask = gathered_mask(mask, r0, own_rows(t), nx);
   else if (any_masked)
     t.mask = std::move(mask);
   // Parameter rasters on the fine grid (0 where a block has no valid cell).

@@ -113,12 +113,7 @@ Terrain read_dem_band(const Params::Dem& dem, const Params::Dem& full, const Ban
   t.banded = true;
   t.own0 = band.own.row0;
   t.own1 = band.own.row1;
-  const std::size_t nx = static_cast<std::size_t>(t.grid.nx);
-  const auto at = [&](int row) {
-    return t.mask.begin() +
-           static_cast<std::ptrdiff_t>(static_cast<std::size_t>(row - t.row0) * nx);
-  };
-  t.mask = gathered_mask(std::vector<std::uint8_t>(at(t.own0), at(t.own1)));
+  t.mask = gathered_mask(t.mask, t.row0, own_rows(t), t.grid.nx);
   if (std::none_of(t.mask.begin(), t.mask.end(), [](std::uint8_t v) { return v != 0; }) &&
       !t.mask.empty())  // read_dem's message for a whole grid of nodata
     throw Error(ExitCode::data, dem.path + ": no valid (non-nodata) cells" +

@@ -18,10 +18,16 @@ inline parallel::Band own_rows(const Terrain& t) {
   return t.banded ? parallel::Band{t.own0, t.own1} : parallel::Band{0, t.grid.ny};
 }
 
-/// The whole grid's mask from every rank's `own` rows of it (in rank order, which is row
-/// order), or none where every cell is valid (Terrain::mask). Collective.
-inline std::vector<std::uint8_t> gathered_mask(const std::vector<std::uint8_t>& own) {
-  std::vector<std::uint8_t> all = parallel::allgather(own);
+/// The whole grid's mask (nx cells a row) from every rank's `own` rows of `mask`, which holds
+/// the rows from `mask_row0` on (ranks in rank order, which is row order), or none where every
+/// cell is valid (Terrain::mask). Collective.
+inline std::vector<std::uint8_t> gathered_mask(const std::vector<std::uint8_t>& mask, int mask_row0,
+                                               parallel::Band own, int nx) {
+  const auto at = [&](int row) {
+    return mask.begin() + static_cast<std::ptrdiff_t>(row - mask_row0) * nx;
+  };
+  std::vector<std::uint8_t> all =
+      parallel::allgather(std::vector<std::uint8_t>(at(own.row0), at(own.row1)));
   for (const std::uint8_t v : all)
     if (v == 0) return all;
   return {};
