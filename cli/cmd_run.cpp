@@ -270,10 +270,7 @@ int run(const RunOptions& o) {
   std::printf("%s", sim.ledger().format().c_str());
   if (p.erosion.enabled && p.erosion.law == ErosionLaw::physical) {
     // the solid volumes as masses, and the yield over the active area (docs/model.md 3.5)
-    const Terrain& t = sim.terrain();
-    double area = 0;
-    for (std::size_t i = 0; i < t.grid.cells(); ++i)
-      if (t.active(i)) area += t.grid.area[i / static_cast<std::size_t>(t.grid.nx)];
+    const double area = sim.active_area();
     const Ledger& L = sim.ledger();
     const double tonnes = p.erosion.sediment_density / 1000.0;
     std::printf(

@@ -47,16 +47,14 @@ void apply_boundary_codes(Terrain& t, const std::string& source) {
                             "grid: open applies to the grid's edge cells only",
                             source, c, r));
   }
-  // interior cells coded closed or fixed_level leave the domain: on the rows this process owns,
-  // the mask of the others' rows from them where the terrain is banded
-  if (t.mask.empty()) t.mask.assign(g.cells(), 1);
-  const parallel::Band own = own_rows(t);
+  // interior cells coded closed or fixed_level leave the domain (on the rows the terrain
+  // holds, as it holds their codes: an MPI rank's band's, Terrain::banded)
+  if (t.mask.empty()) t.mask.assign(t.held_cells(), 1);
   const auto nx = static_cast<std::size_t>(g.nx);
-  for (std::size_t i = static_cast<std::size_t>(own.row0) * nx;
-       i < static_cast<std::size_t>(own.row1) * nx; ++i)
+  for (std::size_t i = static_cast<std::size_t>(t.row0) * nx;
+       i < static_cast<std::size_t>(t.end_row()) * nx; ++i)
     if (t.active(i) && !edge(i) && (code(i) == kBoundaryClosed || code(i) == kBoundaryFixed))
-      t.mask[i] = 0;
-  if (t.banded) t.mask = gathered_mask(t.mask, 0, own, g.nx);
+      t.mask[t.held(i)] = 0;
 }
 
 BoundaryKind ghost_condition(const Terrain& t, const Params& p, int col, int row, Side side) {
@@ -159,13 +157,16 @@ int apply_latitude_cap(Terrain& t, const Params& p) {
   for (int r = 0; r < g.ny; ++r) {
     if (!(std::fabs(g.cell_center(0, r)[1]) > cap)) continue;
     ++capped;
-    if (t.mask.empty()) t.mask.assign(g.cells(), 1);
-    // (the codes on the rows the terrain holds: an MPI rank's band's, Terrain::banded)
+    // (the mask and the codes of the rows the terrain holds: an MPI rank's band's,
+    // Terrain::banded; every rank has codes once a row is capped, so every rank checks them
+    // together: apply_boundary_codes)
     if (t.boundary_code.empty()) t.boundary_code.assign(t.held_cells(), kBoundaryAsEdge);
+    if (!t.holds_row(r)) continue;
+    if (t.mask.empty()) t.mask.assign(t.held_cells(), 1);
     for (int c = 0; c < g.nx; ++c) {
-      const auto i = static_cast<std::size_t>(r) * g.nx + c;
+      const auto i = t.held(static_cast<std::size_t>(r) * g.nx + c);
       t.mask[i] = 0;
-      if (t.holds_row(r)) t.boundary_code[t.held(i)] = kBoundaryClosed;
+      t.boundary_code[i] = kBoundaryClosed;
     }
   }
   if (capped == g.ny)

@@ -58,4 +58,12 @@ void Grid::validate() const {
                   "grid: row " + std::to_string(r) + " has a non-positive or non-finite cell size");
 }
 
+void Terrain::not_held(std::size_t i) const {
+  const auto nx = static_cast<std::size_t>(grid.nx);
+  throw Error(ExitCode::internal,
+              "terrain: cell (col " + std::to_string(i % nx) + ", row " + std::to_string(i / nx) +
+                  ") asked of a band holding rows " + std::to_string(row0) + " to " +
+                  std::to_string(end_row() - 1) + " (terrain_rows.hpp answers for the grid)");
+}
+
 }  // namespace erodem

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cstdlib>
+#include <limits>
 
 #include "erodem/error.hpp"
 
@@ -140,7 +141,7 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes) 
   const int n = size();
   if (n > 1) {
     // every rank's count, then the bytes in rounds of at most INT_MAX in all (MPI's counts and
-    // displacements are ints; a whole grid's mask may be larger: docs/mpi.md)
+    // displacements are ints; a whole grid's bytes may be more: docs/mpi.md)
     const auto mine = static_cast<unsigned long long>(bytes);
     std::vector<unsigned long long> counts(static_cast<std::size_t>(n));
     MPI_Allgather(&mine, 1, MPI_UNSIGNED_LONG_LONG, counts.data(), 1, MPI_UNSIGNED_LONG_LONG,
@@ -195,6 +196,19 @@ bool any(bool yes) {
   }
 #endif
   return yes;
+}
+
+std::vector<unsigned char> any_each(std::vector<unsigned char> flags) {
+#ifdef ERODEM_HAVE_MPI
+  if (size() > 1) {
+    constexpr std::size_t kRound = std::numeric_limits<int>::max();  // MPI's counts are ints
+    for (std::size_t k = 0; k < flags.size(); k += kRound)
+      MPI_Allreduce(MPI_IN_PLACE, flags.data() + k,
+                    static_cast<int>(std::min(kRound, flags.size() - k)), MPI_UNSIGNED_CHAR,
+                    MPI_BOR, MPI_COMM_WORLD);
+  }
+#endif
+  return flags;
 }
 
 std::vector<double> sums_in_rank_order(std::size_t n,

@@ -6,8 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "erodem/error.hpp"
+#include "erodem/terrain_rows.hpp"
 
 namespace erodem {
 namespace {
@@ -92,10 +95,22 @@ void add_section(const Grid& g, const SectionSpec& spec, const std::string& key,
 void add_outlet(const Terrain& terrain, const OutletSpec& spec, const std::string& key, int index,
                 SectionLayout& out) {
   const Grid& g = terrain.grid;
-  auto active = [&](int col, int row) {
-    return col >= 0 && row >= 0 && col < g.nx && row < g.ny &&
-           terrain.active(static_cast<std::size_t>(row) * g.nx + col);
+  // whether each cell it asks about is active, asked of every rank's rows at once (a terrain
+  // read by rows holds its band's mask alone: terrain_rows.hpp)
+  const auto inside = [&](int col, int row) {
+    return col >= 0 && row >= 0 && col < g.nx && row < g.ny;
   };
+  const auto cell = [&](int col, int row) { return static_cast<std::int64_t>(row) * g.nx + col; };
+  std::vector<std::int64_t> asked;
+  std::map<std::int64_t, bool> on;
+  const auto ask = [&](int col, int row) {
+    if (inside(col, row)) asked.push_back(cell(col, row));
+  };
+  const auto answer = [&] {
+    const std::vector<std::uint8_t> a = cells_active(terrain, asked);
+    for (std::size_t k = 0; k < asked.size(); ++k) on[asked[k]] = a[k] != 0;
+  };
+  auto active = [&](int col, int row) { return inside(col, row) && on.at(cell(col, row)); };
   auto add = [&](int col, int row, int axis, double sign) {
     out.faces.push_back(Face{col, row, axis});
     out.section.push_back(index);
@@ -106,11 +121,15 @@ void add_outlet(const Terrain& terrain, const OutletSpec& spec, const std::strin
     if (spec.edge == "east" || spec.edge == "west") {
       const bool east = spec.edge == "east";
       const int col = east ? g.nx - 1 : 0;
+      for (int row = 0; row < g.ny; ++row) ask(col, row);
+      answer();
       for (int row = 0; row < g.ny; ++row)
         if (active(col, row)) add(east ? col : -1, row, 0, east ? 1.0 : -1.0);
     } else {
       const bool south = spec.edge == "south";
       const int row = south ? g.ny - 1 : 0;
+      for (int col = 0; col < g.nx; ++col) ask(col, row);
+      answer();
       for (int col = 0; col < g.nx; ++col)
         if (active(col, row)) add(col, south ? row : -1, 1, south ? 1.0 : -1.0);
     }
@@ -122,6 +141,9 @@ void add_outlet(const Terrain& terrain, const OutletSpec& spec, const std::strin
   if (!g.locate(spec.point[0], spec.point[1], col, row))
     throw config_error(key + ".point", fmt::format("({:.10g}, {:.10g}) is outside the grid ({})",
                                                    spec.point[0], spec.point[1], extent_text(g)));
+  for (const auto& [dc, dr] : {std::pair{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1}})
+    ask(col + dc, row + dr);
+  answer();
   if (!active(col, row))
     throw config_error(key + ".point",
                        fmt::format("the cell under it (col {}, row {}) is nodata", col, row));

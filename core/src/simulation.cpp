@@ -158,12 +158,15 @@ Simulation::Simulation(Terrain terrain, Params params, std::unique_ptr<Backend> 
   const auto factor = [this](std::size_t i) {
     return terrain_.rain_factor.empty() ? 1.0 : terrain_.rain_factor[terrain_.held(i)];
   };
-  rain_area_ = sums(1, [&](std::vector<double>& area) {
+  const std::vector<double> areas = sums(2, [&](std::vector<double>& area) {
     each_active(own.row0, own.row1, [&](std::size_t i, int r) {
       area[0] += g.area[r] * factor(i);
+      area[1] += g.area[r];
       rain_factor_max_ = std::max(rain_factor_max_, factor(i));
     });
-  })[0];
+  });
+  rain_area_ = areas[0];
+  active_area_ = areas[1];
   rain_factor_max_ = largest(rain_factor_max_);
   if (!terrain_.rain_grids.empty()) {
     const double scale = params_.rain.grid_scale;
@@ -272,12 +275,11 @@ void Simulation::describe_grid() {
   area_min_ = HUGE_VAL;
   for (double a : g.area) area_min_ = std::min(area_min_, a);
   // the rows with an active cell: the narrowest and the widest of them
+  const std::vector<std::uint8_t> rows = rows_with_active(terrain_);
+  const auto any = [&rows](int r) { return rows[static_cast<std::size_t>(r)] != 0; };
   int narrow = -1, wide = -1;
   for (int r = 0; r < g.ny; ++r) {
-    bool any = false;
-    for (int c = 0; c < g.nx && !any; ++c)
-      any = terrain_.active(static_cast<std::size_t>(r) * g.nx + c);
-    if (!any) continue;
+    if (!any(r)) continue;
     if (narrow < 0 || g.dx[r] < g.dx[narrow]) narrow = r;
     if (wide < 0 || g.dx[r] > g.dx[wide]) wide = r;
   }
@@ -285,10 +287,7 @@ void Simulation::describe_grid() {
     dx_min_ = HUGE_VAL;
     area_min_ = HUGE_VAL;
     for (int r = 0; r < g.ny; ++r) {
-      bool any = false;
-      for (int c = 0; c < g.nx && !any; ++c)
-        any = terrain_.active(static_cast<std::size_t>(r) * g.nx + c);
-      if (!any) continue;
+      if (!any(r)) continue;
       dx_min_ = std::min({dx_min_, g.dx[r], g.dy[r]});
       area_min_ = std::min(area_min_, g.area[r]);
     }
@@ -336,13 +335,13 @@ void Simulation::resolve_inflows() {
     const std::string key = fmt::format("inflow[{}]", k);
     InflowCells ic;
     ic.spec = k;
-    std::set<std::int64_t> seen;
+    // the cells under its points in order, then those of them active, each once
+    std::vector<std::int64_t> under;
     auto add_point = [&](double x, double y) {
       int col = 0, row = 0;
       if (!g.locate(x, y, col, row)) return;
       const std::int64_t cell = static_cast<std::int64_t>(row) * g.nx + col;
-      if (terrain_.active(static_cast<std::size_t>(cell)) && seen.insert(cell).second)
-        ic.cells.push_back(cell);
+      if (under.empty() || under.back() != cell) under.push_back(cell);
     };
     if (spec.vertices.size() == 1) {
       add_point(spec.vertices[0][0], spec.vertices[0][1]);
@@ -360,6 +359,10 @@ void Simulation::resolve_inflows() {
         }
       }
     }
+    const std::vector<std::uint8_t> on = cells_active(terrain_, under);
+    std::set<std::int64_t> seen;
+    for (std::size_t j = 0; j < under.size(); ++j)
+      if (on[j] && seen.insert(under[j]).second) ic.cells.push_back(under[j]);
     if (ic.cells.empty())
       throw config_error(key,
                          "no active DEM cell under its point/line (check the coordinates "

@@ -23,6 +23,8 @@
 #include <sstream>
 
 #include "erodem/error.hpp"
+#include "erodem/parallel.hpp"
+#include "erodem/terrain_rows.hpp"
 
 namespace erodem {
 namespace {
@@ -424,8 +426,11 @@ std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Er
   // The seed is an int in the configuration; its two's-complement bits seed the PRNG.
   const auto seed = static_cast<std::uint64_t>(static_cast<std::int64_t>(erosion.noise_seed));
   // The range of the whole grid's active cells, a block of rows at a time (the rows asked
-  // for kept as they pass), so that a band of rows holds no field of the whole grid.
+  // for kept as they pass), so that a band of rows holds no field of the whole grid; on a
+  // terrain read by rows (an MPI rank's band) each rank's own rows' range, combined (the
+  // smallest and the largest value: the same whatever the split).
   const Grid& g = terrain.grid;
+  const parallel::Band own = own_rows(terrain);
   if (row0 < 0 || row1 > g.ny || row1 < row0)
     throw Error(ExitCode::internal, "hardness noise: rows [" + std::to_string(row0) + ", " +
                                         std::to_string(row1) + ") of a grid of " +
@@ -437,17 +442,24 @@ std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Er
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (int b0 = 0; b0 < g.ny; b0 += kBlockRows) {
     const int b1 = std::min(g.ny, b0 + kBlockRows);
+    const int o0 = std::max(b0, own.row0), o1 = std::min(b1, own.row1);  // own rows in it
+    const int k0 = std::max(b0, row0), k1 = std::min(b1, row1);          // rows asked for
+    if (o1 <= o0 && k1 <= k0) continue;
     const std::vector<double> block =
         fbm_rows(g, erosion.noise_scale, erosion.noise_octaves, seed, b0, b1);
-    for (std::size_t k = 0; k < block.size(); ++k) {
+    for (std::size_t k = static_cast<std::size_t>(std::max(o0 - b0, 0)) * nx;
+         k < static_cast<std::size_t>(std::max(o1 - b0, 0)) * nx; ++k) {
       if (!terrain.active(static_cast<std::size_t>(b0) * nx + k)) continue;
       lo = std::min(lo, block[k]);
       hi = std::max(hi, block[k]);
     }
-    const int k0 = std::max(b0, row0), k1 = std::min(b1, row1);
     if (k1 > k0)
       r.insert(r.end(), block.begin() + static_cast<std::ptrdiff_t>(k0 - b0) * g.nx,
                block.begin() + static_cast<std::ptrdiff_t>(k1 - b0) * g.nx);
+  }
+  if (terrain.banded) {
+    lo = -parallel::max_over_ranks(-lo);
+    hi = parallel::max_over_ranks(hi);
   }
   const double range = hi - lo;
   for (std::size_t k = 0; k < r.size(); ++k) {

@@ -9,7 +9,6 @@
 #include "erodem/error.hpp"
 #include "erodem/io/raster.hpp"
 #include "erodem/parameter_rasters.hpp"
-#include "erodem/terrain_rows.hpp"
 #include "raster_gdal.hpp"
 
 namespace erodem::io {
@@ -110,10 +109,7 @@ Terrain coarsen(const Terrain& fine, int factor) {
         any_masked = true;
       }
     }
-  if (t.banded)  // the whole grid's, from the ranks' own rows
-    t.mask = gathered_mask(mask, r0, own_rows(t), nx);
-  else if (any_masked)
-    t.mask = std::move(mask);
+  if (any_masked) t.mask = std::move(mask);  // of the rows it holds (a band's on a banded one)
   // Parameter rasters on the fine grid (0 where a block has no valid cell).
   auto average = [&](const std::vector<double>& v) {
     std::vector<double> out;

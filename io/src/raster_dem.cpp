@@ -148,7 +148,7 @@ Terrain read_dem(const Params::Dem& dem, std::array<int, 2> rows) {
   }
   ds.reset();
   t.source = path;
-  if (some_rows) {  // the whole grid's mask and the checksum are load_terrain's
+  if (some_rows) {  // whether any cell is valid, and the checksum, are load_terrain's
     t.mask = std::move(valid);
     return t;
   }

@@ -28,6 +28,7 @@
 #include "erodem/parallel.hpp"
 #include "erodem/process.hpp"
 #include "erodem/schema.hpp"
+#include "erodem/terrain_rows.hpp"
 #include "h5.hpp"
 #include "xdmf.hpp"
 
@@ -66,10 +67,23 @@ bool for_strips(int ny, const F& f) {
 
 /// The rows of strip [row0, row1) of field `id` that this process writes: in an MPI run that
 /// writes one file together (collective_files()) the rows of its band, none where the band
-/// misses the strip (no field is gathered to every rank); otherwise the whole strip.
-OwnRows rows_to_write(const Simulation& sim, FieldId id, int row0, int row1) {
-  if (collective_files()) return sim.own_field_rows(id, row0, row1);
-  return {row0, row1, sim.field_rows(id, row0, row1)};
+/// misses the strip (no field is gathered to every rank); otherwise the whole strip. With
+/// `nodata_nan`, NaN on the cells outside the DEM, set by the rank that owns them (a terrain
+/// read by rows holds the mask of its band's rows alone).
+OwnRows rows_to_write(const Simulation& sim, FieldId id, int row0, int row1, bool nodata_nan) {
+  OwnRows r = sim.own_field_rows(id, row0, row1);
+  if (nodata_nan) {
+    const Terrain& terrain = sim.terrain();
+    const std::size_t first = static_cast<std::size_t>(r.row0) * sim.grid().nx;
+    for (std::size_t i = 0; i < r.values.size(); ++i)
+      if (!terrain.active(first + i)) r.values[i] = std::nan("");
+  }
+  if (collective_files() || parallel::size() <= 1) return r;
+  // MPI with one writer (serial HDF5): every rank's rows in rank order, which is row order
+  std::vector<double> all = parallel::allgather(r.values);
+  if (all.size() != static_cast<std::size_t>(row1 - row0) * sim.grid().nx)
+    throw Error(ExitCode::internal, "result file: the ranks' rows of a strip do not tile it");
+  return {row0, row1, std::move(all)};
 }
 
 std::string iso_utc_now() {
@@ -168,6 +182,9 @@ struct ResultWriter::Impl {
   std::vector<std::int64_t> pending_steps;
   // gauges/
   std::vector<std::int64_t> gauge_cells;
+  /// whether each gauge's cell is active (record_step's first call: terrain_rows.hpp, every
+  /// rank's rows asked at once)
+  std::vector<std::uint8_t> gauge_active;
   std::vector<FieldId> gauge_fields;  // depth, velocities, and the bed when it changes
   H5Id gauge_step, gauge_time;
   std::array<H5Id, 3> gauge;
@@ -659,7 +676,7 @@ void ResultWriter::store_state(const Simulation& sim) {
     }
     const hsize_t index = grow_row(ds, partial_, name);
     for_strips(ny, [&](int row0, int row1) {
-      const OwnRows r = rows_to_write(sim, id, row0, row1);
+      const OwnRows r = rows_to_write(sim, id, row0, row1, false);
       write_strip(ds, H5T_NATIVE_DOUBLE, index, r.row0, r.row1 - r.row0, r.values.data(), partial_,
                   name);
       return true;
@@ -700,15 +717,11 @@ void ResultWriter::take_snapshot(const Simulation& sim, bool last) {
   const Grid& g = sim.grid();
   if (g.nx != m.grid.nx || g.ny != m.grid.ny)
     throw Error(ExitCode::internal, path_ + ": snapshot of a simulation on another grid");
-  const auto& terrain = sim.terrain();
   for (auto& [info, ds] : m.fields) {
     // NaN on the cells outside the DEM; HDF5 rounds the doubles to the dataset's floats
     const hsize_t index = grow_row(ds, partial_, info.name);
     for_strips(g.ny, [&](int row0, int row1) {
-      OwnRows r = rows_to_write(sim, info.id, row0, row1);
-      const std::size_t first = static_cast<std::size_t>(r.row0) * g.nx;
-      for (std::size_t i = 0; i < r.values.size(); ++i)
-        if (!terrain.active(first + i)) r.values[i] = std::nan("");
+      const OwnRows r = rows_to_write(sim, info.id, row0, row1, true);
       write_strip(ds, H5T_NATIVE_DOUBLE, index, r.row0, r.row1 - r.row0, r.values.data(), partial_,
                   info.name);
       return true;
@@ -762,8 +775,9 @@ void ResultWriter::record_step(const Simulation& sim) {
   const auto& bed = m.bed;
   m.pending_gauge_time.push_back(sim.time());
   m.pending_gauge_steps.push_back(sim.steps_done());
+  if (m.gauge_active.size() != n) m.gauge_active = cells_active(sim.terrain(), m.gauge_cells);
   for (std::size_t j = 0; j < n; ++j) {
-    const bool on = sim.terrain().active(static_cast<std::size_t>(m.gauge_cells[j]));
+    const bool on = m.gauge_active[j] != 0;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     m.pending_gauge[0].push_back(on ? depth[j] : nan);
     m.pending_gauge[1].push_back(on ? bed[j] + depth[j] : nan);

@@ -106,16 +106,15 @@ Terrain make_synthetic_band(const Params::Dem& dem, const BandRead& band) {
   return t;
 }
 
-/// The DEM of `dem` (read at full resolution: `full`) read by this rank (`band`'s rows), with
-/// the whole grid's mask gathered from the ranks' own rows and the file's checksum rank 0's.
+/// The DEM of `dem` (read at full resolution: `full`) read by this rank (`band`'s rows), its
+/// mask of those rows, and the file's checksum rank 0's.
 Terrain read_dem_band(const Params::Dem& dem, const Params::Dem& full, const BandRead& band) {
   Terrain t = read_dem(full, {band.held.row0, band.held.row1});
   t.banded = true;
   t.own0 = band.own.row0;
   t.own1 = band.own.row1;
-  t.mask = gathered_mask(t.mask, t.row0, own_rows(t), t.grid.nx);
-  if (std::none_of(t.mask.begin(), t.mask.end(), [](std::uint8_t v) { return v != 0; }) &&
-      !t.mask.empty())  // read_dem's message for a whole grid of nodata
+  t.mask = rows_mask(std::move(t.mask));
+  if (!any_active(t))  // read_dem's message for a whole grid of nodata
     throw Error(ExitCode::data, dem.path + ": no valid (non-nodata) cells" +
                                     (dem.window ? " in window " + window_text(*dem.window) : ""));
   t.source_sha256 = parallel::root_string(parallel::rank() == 0 ? file_sha256(dem.path) : "");
@@ -195,9 +194,7 @@ Terrain load_terrain(const Params& p, bool by_rows) {
   Terrain t = by_rows && reads_band(p) ? terrain_band(p.dem, full)
               : full.synthetic.empty() ? read_dem(full)
                                        : make_synthetic_terrain(full);
-  bool any_active = false;
-  for (std::size_t i = 0; i < t.grid.cells() && !any_active; ++i) any_active = t.active(i);
-  if (!any_active)
+  if (!any_active(t))
     throw Error(ExitCode::data, t.source + ": every cell is nodata; nothing to simulate");
   // a broken value (a float fill of -3.4e38, a wrong z_scale) stops here, naming the cell,
   // not as a NaN after the first step

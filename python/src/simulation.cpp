@@ -20,6 +20,7 @@
 #include "erodem/io/run_session.hpp"
 #include "erodem/parameter_rasters.hpp"
 #include "erodem/schema.hpp"
+#include "erodem/terrain_rows.hpp"
 #include "terrain.hpp"
 
 namespace py = pybind11;
@@ -157,12 +158,12 @@ class PySimulation {
   std::pair<double, double> erosion_volumes() const {
     const std::vector<double> e = sim().field(FieldId::erosion);
     const Grid& g = sim().grid();
-    const Terrain& t = sim().terrain();
+    const std::vector<std::uint8_t> on = active_grid(sim().terrain());
     double eroded = 0.0, deposited = 0.0;
     for (int r = 0; r < g.ny; ++r) {
       for (int c = 0; c < g.nx; ++c) {
         const std::size_t i = static_cast<std::size_t>(r) * g.nx + c;
-        if (!t.active(i) || !std::isfinite(e[i])) continue;
+        if (!on[i] || !std::isfinite(e[i])) continue;
         if (e[i] > 0)
           eroded += e[i] * g.area[r];
         else
@@ -328,10 +329,10 @@ void add_simulation_bindings(py::module_& m) {
           "active",
           [](const PySimulation& s) {
             const Grid& g = s.sim().grid();
-            const Terrain& t = s.sim().terrain();
+            const std::vector<std::uint8_t> on = active_grid(s.sim().terrain());
             py::array_t<bool> a({static_cast<py::ssize_t>(g.ny), static_cast<py::ssize_t>(g.nx)});
             bool* out = a.mutable_data();
-            for (std::size_t i = 0; i < g.cells(); ++i) out[i] = t.active(i);
+            for (std::size_t i = 0; i < g.cells(); ++i) out[i] = on[i] != 0;
             return a;
           },
           "Active cells: bool (ny, nx), False at the DEM's nodata cells. A copy.");

@@ -75,8 +75,8 @@ struct Terrain {
   /// rows of boundary.latitude_cap): one line each.
   std::vector<std::string> notes;
 
-  /// The grid rows [row0, row1) the per-cell arrays hold (the bed, the parameter rasters, the
-  /// initial fields; the mask is the whole grid's always): every row, but on a rank of an MPI
+  /// The grid rows [row0, row1) the per-cell arrays hold (the bed, the mask, the parameter
+  /// rasters, the initial fields): every row, but on a rank of an MPI
   /// run that read only its band's rows (`banded`, io::load_terrain, docs/mpi.md). row1 < 0:
   /// grid.ny.
   int row0 = 0;
@@ -87,7 +87,13 @@ struct Terrain {
   bool banded = false;
   int own0 = 0, own1 = 0;
 
-  bool active(std::size_t i) const { return mask.empty() || mask[i] != 0; }
+  /// Whether grid cell `i` (global, row-major) is active: of a row the terrain holds (a banded
+  /// terrain's mask holds its rows alone; the whole grid's answers come from terrain_rows.hpp,
+  /// collectively). Throws ExitCode::internal for a row a banded terrain does not hold.
+  bool active(std::size_t i) const {
+    if (banded && held(i) >= held_cells()) not_held(i);
+    return mask.empty() || mask[held(i)] != 0;
+  }
   /// The last row (exclusive) the per-cell arrays hold.
   int end_row() const { return row1 < 0 ? grid.ny : row1; }
   /// Whether the per-cell arrays hold grid row `r`.
@@ -100,6 +106,9 @@ struct Terrain {
   std::size_t held_cells() const {
     return static_cast<std::size_t>(end_row() - row0) * static_cast<std::size_t>(grid.nx);
   }
+
+  /// Throws the internal error of active() asked about a row this terrain does not hold.
+  [[noreturn]] void not_held(std::size_t i) const;
 
   /// Frees the per-cell inputs (the bed, the parameter rasters, the rain and temperature
   /// bands, the initial snow) once a backend holds them: the grid, the mask, the band times,

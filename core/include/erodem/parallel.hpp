@@ -58,7 +58,7 @@ std::vector<unsigned char> allgather_bytes(const void* data, std::size_t bytes);
 template <class T>
 std::vector<T> allgather(const std::vector<T>& mine) {
   static_assert(std::is_trivially_copyable_v<T>);
-  if constexpr (std::is_same_v<T, unsigned char>) {  // no second copy (a whole grid's mask)
+  if constexpr (std::is_same_v<T, unsigned char>) {  // no second copy (a whole grid's bytes)
     return allgather_bytes(mine.data(), mine.size());
   } else {
     const std::vector<unsigned char> raw = allgather_bytes(mine.data(), mine.size() * sizeof(T));
@@ -71,6 +71,10 @@ std::vector<T> allgather(const std::vector<T>& mine) {
 /// Whether `yes` holds on any rank (a decision every rank must take alike: to stop, to store
 /// again). Collective (in one process: `yes`).
 bool any(bool yes);
+
+/// Each of `flags` (0 or 1) set where it is set on any rank (every rank gives as many).
+/// Collective (in one process: `flags`).
+std::vector<unsigned char> any_each(std::vector<unsigned char> flags);
 
 /// Running sums carried through the ranks in rank order: rank 0 calls `add` on `n` zeros,
 /// each other rank on the previous rank's result, and every rank returns the last rank's.

@@ -134,9 +134,13 @@ class Simulation {
   const Params& params() const { return params_; }
   /// The grid, mask, source and notes of the terrain it was made from; its per-cell inputs
   /// (the bed, the rasters, the bands) are freed once the backend holds them
-  /// (Terrain::release_cell_inputs): read the state through field().
+  /// (Terrain::release_cell_inputs): read the state through field(). Under MPI with a terrain
+  /// read by rows (Terrain::banded) its mask is the band's rows': ask terrain_rows.hpp about
+  /// other cells.
   const Terrain& terrain() const { return terrain_; }
   const Grid& grid() const { return terrain_.grid; }
+  /// The area of the active cells (m^2), summed in row-major order on every rank.
+  double active_area() const { return active_area_; }
   /// The backend, to change the state with: the statistics are taken again before the next
   /// step (state_changed()).
   Backend& backend() {
@@ -215,6 +219,7 @@ class Simulation {
   };
   std::vector<SourceCell> source_cells_;
   double rain_area_ = 0.0;        ///< sum(rain_factor * area) over active cells (m^2)
+  double active_area_ = 0.0;      ///< sum(area) over active cells (m^2)
   double rain_factor_max_ = 0.0;  ///< largest rain_factor over active cells (1)
   /// rain.grids: each band's rate (m/s) times the rain factor on the DEM cells in time, its
   /// volume rate sum(rate area) over the active cells (m^3/s) and its largest rate (m/s).

@@ -61,8 +61,8 @@ namespace erodem::io {
 /// `rows` = [row0, row1) (row1 >= 0; rows of the window): only those rows' elevations are
 /// read (an MPI rank's band: load_terrain); the grid stays the whole window's, `bed` and
 /// `mask` hold those rows only (the mask always, Terrain::row0 and row1 say which), nothing is
-/// checked for valid cells (load_terrain checks the whole mask) and no checksum is taken
-/// (load_terrain takes rank 0's). Resampling is refused there (Error(internal): load_terrain
+/// checked for valid cells (load_terrain asks every rank: terrain_rows.hpp) and no checksum is
+/// taken (load_terrain takes rank 0's). Resampling is refused there (Error(internal): load_terrain
 /// coarsens the rows read).
 Terrain read_dem(const Params::Dem& dem, std::array<int, 2> rows = {0, -1});
 
@@ -75,8 +75,7 @@ int resample_factor(const Params::Dem& dem, const Grid& grid);
 /// valid cell is nodata); cell sizes and areas grow accordingly (recomputed exactly on the
 /// ellipsoid for a geographic grid), partial blocks at the east and south edges are dropped.
 /// The notes are kept. A band's rows (`fine.banded`, whole blocks of them: load_terrain) give
-/// the coarse rows of those blocks, the whole grid's mask gathered from the ranks' own rows
-/// (collective).
+/// the coarse rows of those blocks and their mask.
 Terrain coarsen(const Terrain& fine, int factor);
 
 /// What a raster file says about itself, without reading its values (`erodem info`).
