@@ -17,7 +17,8 @@
 #  - erosion: local inertial + erosion (conservative transport) + thermal, a point inflow,
 #    three gauges, an open east edge, a fixed-level south edge, two sections (one along a row,
 #    one down a column across every band) and outlets on both open edges (/sections too);
-#  - pipes: the pipe model with erosion and thermal;
+#  - pipes: the pipe model with erosion and thermal, on a diamond-square terrain (each rank
+#    makes the lattices of its rows);
 #  - shallow_water: second-order shallow water (two stages a step, 2-row halo) with
 #    boundary.periodic_x (the periodic columns and the bands' rows together);
 #  - water_cycle: every other process that reads or writes across cells, each of whose halo
@@ -155,7 +156,7 @@ name = "south"
 edge = "south"
 EOF
     ;;
-  pipes) sets=(--set flow.scheme=pipes --set boundary.east=open) ;;
+  pipes) sets=(--set flow.scheme=pipes --set boundary.east=open --set dem.synthetic=diamond_square) ;;
   water_cycle)
     sets=(--set erosion.law=mei --set erosion.hardness=noise --set erosion.noise_scale=100
       --set snow.enabled=true --set snow.initial=0.05 --set snow.air_temperature=3
@@ -543,8 +544,13 @@ else
         fi
         message=$(grep -m1 "^erodem:" bad$n.log || true)
         [ $n = 1 ] && first="$message"
+        # (and no file is left behind: no result, no partial file of any rank)
+        left=$(ls -A | grep -E "^(bad$n\.(h5|xmf)|\.bad$n\.h5\..*partial)$" || true)
         if [ $rc -ne "$code" ] || [ -z "$message" ] || [ "$message" != "$first" ]; then
           echo "FAIL ${args[*]}, np $n: exit $rc, '$message' (one process: exit $code, '$first')"
+          failed=1
+        elif [ -n "$left" ]; then
+          echo "FAIL ${args[*]}, np $n: left $left behind"
           failed=1
         else
           echo "${args[*]}, np $n: exit $code, $message"

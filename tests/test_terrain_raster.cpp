@@ -126,7 +126,6 @@ TEST(TerrainSynth, RowsAreTheWholeGridsRows) {
   const std::vector<std::array<int, 2>> own{{0, 21}, {21, 42}, {42, 64}};
   for (const auto& name : erodem::synth_kind_names()) {
     const SynthKind k = erodem::synth_kind_from_string(name);
-    if (k == SynthKind::diamond_square) continue;  // made whole
     const auto whole = erodem::generate_terrain(k, nx, ny, 10.0, 100.0, 42);
     std::vector<std::pair<double, double>> known;  // the grid's ranges, in call order
     std::vector<std::vector<double>> rows(own.size());
@@ -168,6 +167,43 @@ TEST(TerrainSynth, RowsAreTheWholeGridsRows) {
         "scaled by the middle band's own ranges: %zu of %zu differ\n",
         name.c_str(), known.size(), differ, differ_alone, alone.size());
   }
+}
+
+// Diamond-square by rows makes each level's lattice on the rows the finer levels read only,
+// with each point's displacement drawn by its index in the whole grid's order: any window of
+// rows must be the whole grid's rows bit for bit (bound 0: one misplaced draw, a row of a
+// lattice not made, a neighbour read from the wrong level changes values), on grids that
+// fill their 2^k + 1 lattice or are cropped from it, thin in either direction. The whole
+// grid's range (which scales the heights) is taken from the rows version over every row and
+// given to each window.
+TEST(TerrainSynth, DiamondSquareRowsOfAnyWindow) {
+  std::size_t windows = 0, compared = 0, differ = 0;
+  for (const auto& [nx, ny] : std::vector<std::array<int, 2>>{
+           {1, 1}, {3, 200}, {200, 3}, {97, 64}, {129, 129}, {130, 40}, {33, 65}}) {
+    const auto whole = erodem::generate_terrain(SynthKind::diamond_square, nx, ny, 10.0, 80.0, 9);
+    double lo = 0, hi = 0;
+    const erodem::RangeReduce keep = [&](double& l, double& h) { lo = l, hi = h; };
+    const auto all = erodem::generate_terrain_rows(SynthKind::diamond_square, nx, ny, 80.0, 9, 0,
+                                                   ny, 0, ny, keep);
+    ASSERT_EQ(all.size(), whole.size());
+    for (std::size_t i = 0; i < all.size(); ++i) differ += all[i] != whole[i];
+    const erodem::RangeReduce give = [&](double& l, double& h) { l = lo, h = hi; };
+    for (const int r0 : {0, 1, 2, ny / 2 - 1, ny / 2, ny / 2 + 1, ny - 2, ny - 1})
+      for (const int len : {1, 2, 5, 30}) {
+        if (r0 < 0 || r0 + len > ny) continue;
+        const auto rows = erodem::generate_terrain_rows(SynthKind::diamond_square, nx, ny, 80.0, 9,
+                                                        r0, r0 + len, r0, r0 + len, give);
+        ASSERT_EQ(rows.size(), static_cast<std::size_t>(len) * nx);
+        ++windows;
+        for (std::size_t i = 0; i < rows.size(); ++i, ++compared)
+          differ += std::memcmp(&rows[i], &whole[static_cast<std::size_t>(r0) * nx + i],
+                                sizeof(double)) != 0;
+      }
+  }
+  std::printf("  diamond-square: %zu windows of rows, %zu values, %zu differ (bound 0)\n", windows,
+              compared, differ);
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GE(windows, 140u);
 }
 
 TEST(TerrainSynth, RangeAndErrors) {

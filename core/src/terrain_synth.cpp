@@ -43,6 +43,8 @@ class SplitMix64 {
  public:
   explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
   std::uint64_t next() { return mix64(state_ += 0x9E3779B97F4A7C15ULL); }
+  /// The generator `k` draws on (the state after k calls to next()).
+  SplitMix64 after(std::uint64_t k) const { return SplitMix64(state_ + k * 0x9E3779B97F4A7C15ULL); }
   /// Uniform in [0, 1) with 53 random bits.
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
   /// Uniform in [-1, 1).
@@ -220,6 +222,98 @@ std::vector<double> diamond_square(int nx, int ny, std::uint64_t seed) {
   return out;
 }
 
+/// Rows [r0, r1) of diamond_square(nx, ny, seed), bit for bit, without its whole grid: each
+/// level's lattice (the points of spacing h, both coordinates multiples of h) is made only on
+/// the rows the finer levels read of it, from the coarser lattice's rows those read, with each
+/// point's displacement the draw diamond_square takes for it (SplitMix64 draws by index: the
+/// k-th of a level is the generator after the draws of the coarser levels and of the points
+/// before it in diamond_square's loops). A level with spacing h holds about
+/// ((r1 - r0) / h + 10) (n / h + 1) values: 1.33 (r1 - r0) n in all, the band's share of the
+/// grid (an MPI rank's band: io::load_terrain).
+std::vector<double> diamond_square_rows(int nx, int ny, std::uint64_t seed, int r0, int r1) {
+  int n = 2;
+  while (n + 1 < std::max(nx, ny)) n *= 2;
+  // The rows [lo, hi] of a lattice (multiples of its spacing h within), each n / h + 1 points.
+  struct Lattice {
+    int h = 0, lo = 0, hi = -1;
+    std::vector<double> v;
+    int width(int n) const { return n / h + 1; }
+    double& at(int n, int c, int r) {
+      return v[static_cast<std::size_t>((r - lo) / h) * width(n) + static_cast<std::size_t>(c / h)];
+    }
+    void make(int n, int spacing, int first, int last) {
+      h = spacing, lo = first, hi = last;
+      v.assign(static_cast<std::size_t>((hi - lo) / h + 1) * width(n), 0.0);
+    }
+  };
+  // The rows each level must give, from the finest (h = 1: rows r0 .. r1 - 1) to the coarsest
+  // (h = n): a level's diamond points read the coarser lattice h beyond its rows, and the
+  // square points of its first and last rows read diamond points h beyond those.
+  std::vector<std::pair<int, int>> need;  // need[j]: spacing 2^j
+  need.emplace_back(r0, r1 - 1);
+  for (int h = 1; h < n; h *= 2) {
+    const int s = 2 * h;
+    const auto [a, b] = need.back();
+    need.emplace_back(std::max(0, (a - s) / s * s), std::min(n, (b + s + s - 1) / s * s));
+  }
+  const SplitMix64 rng(seed ^ 0x2545F4914F6CDD1DULL);
+  const auto draw = [&rng](std::uint64_t k) { return rng.after(k).symmetric(); };
+  Lattice coarse, fine;
+  coarse.make(n, n, 0, n);  // the corners, draws 0 .. 3
+  coarse.at(n, 0, 0) = draw(0);
+  coarse.at(n, n, 0) = draw(1);
+  coarse.at(n, 0, n) = draw(2);
+  coarse.at(n, n, n) = draw(3);
+  std::uint64_t base = 4;  // the draws of the coarser levels
+  double scale = 1.0;
+  for (int step = n, level = static_cast<int>(need.size()) - 2; step > 1; step /= 2, --level) {
+    const int half = step / 2;
+    const auto per = static_cast<std::uint64_t>(n / step);  // squares a side
+    const auto [a, b] = need[static_cast<std::size_t>(level)];
+    // this level's lattice, with the diamond rows beside [a, b] that its square points read
+    fine.make(n, half, std::max(0, a - half), std::min(n, b + half));
+    for (int r = fine.lo; r <= fine.hi; r += half)  // the coarser lattice's points
+      if ((r / half) % 2 == 0)
+        for (int c = 0; c <= n; c += step) fine.at(n, c, r) = coarse.at(n, c, r);
+    // Diamond step: centres of squares (diamond_square's order: row by row, then column).
+    for (int r = fine.lo; r <= fine.hi; r += half) {
+      if ((r / half) % 2 == 0) continue;
+      const std::uint64_t row_k = base + static_cast<std::uint64_t>((r - half) / step) * per;
+      for (int c = half; c <= n; c += step)
+        fine.at(n, c, r) =
+            0.25 * (coarse.at(n, c - half, r - half) + coarse.at(n, c + half, r - half) +
+                    coarse.at(n, c - half, r + half) + coarse.at(n, c + half, r + half)) +
+            scale * draw(row_k + static_cast<std::uint64_t>((c - half) / step));
+    }
+    base += per * per;
+    // Square step: edge midpoints on the rows [a, b], averaging the neighbours that exist.
+    for (int r = a; r <= b; r += half) {
+      const auto j = static_cast<std::uint64_t>(r / half);
+      const bool even = j % 2 == 0;
+      const std::uint64_t row_k = base + (j + 1) / 2 * per + j / 2 * (per + 1);
+      for (int c = even ? half : 0; c <= n; c += step) {
+        double sum = 0.0;
+        int count = 0;
+        if (c >= half) sum += fine.at(n, c - half, r), ++count;
+        if (c + half <= n) sum += fine.at(n, c + half, r), ++count;
+        if (r >= half) sum += fine.at(n, c, r - half), ++count;
+        if (r + half <= n) sum += fine.at(n, c, r + half), ++count;
+        fine.at(n, c, r) =
+            sum / count +
+            scale * draw(row_k + static_cast<std::uint64_t>(even ? (c - half) / step : c / step));
+      }
+    }
+    base += 2 * per * (per + 1);
+    scale *= 0.55;
+    std::swap(coarse, fine);
+  }
+  std::vector<double> out(static_cast<std::size_t>(nx) * static_cast<std::size_t>(r1 - r0));
+  for (int r = r0; r < r1; ++r)
+    for (int c = 0; c < nx; ++c)
+      out[static_cast<std::size_t>(r - r0) * nx + c] = coarse.at(n, c, r);
+  return out;
+}
+
 /// Normalised cell-centre coordinates: u = x / width, v = y / height, both in (0, 1),
 /// v growing southwards (row order).
 struct Coords {
@@ -308,8 +402,12 @@ std::vector<double> generate_terrain_rows(SynthKind kind, int nx, int ny, double
     throw Error(
         ExitCode::internal,
         fmt::format("synthetic terrain: rows [{}, {}) owning [{}, {}) of {}", r0, r1, o0, o1, ny));
-  if (kind == SynthKind::diamond_square)
-    throw Error(ExitCode::internal, "synthetic terrain: diamond_square is made whole");
+  if (kind == SynthKind::diamond_square) {  // its lattices on the rows these read alone
+    std::vector<double> h = diamond_square_rows(nx, ny, seed, r0, r1);
+    const auto [lo, hi] = rows_range(h, nx, r0, o0, o1, reduce);
+    normalise(h, relief_m, lo, hi);
+    return h;
+  }
   std::vector<double> h = octave_noise(nx, ny, seed, kind == SynthKind::ridged, r0, r1);
   if (kind != SynthKind::fbm && kind != SynthKind::ridged) {
     // the shape plus its fraction of the fbm, scaled to [-0.5, 0.5] by the whole grid's range

@@ -56,10 +56,9 @@ std::vector<double> parameter_raster(const std::string& path, const Terrain& t, 
 
 /// Whether each rank of this run reads or makes only its band's rows of the terrain (the DEM
 /// or a synthetic terrain, every parameter raster, boundary.raster's codes, the gridded rain
-/// and air temperature: docs/mpi.md): under MPI with more than one rank, but for a
-/// diamond-square terrain (made whole, as in one process).
-bool reads_band(const Params& p) {
-  return parallel::size() > 1 && p.dem.synthetic != "diamond_square";
+/// and air temperature: docs/mpi.md): under MPI with more than one rank.
+bool reads_band() {
+  return parallel::size() > 1;
 }
 
 /// The rows of a grid of `ny` rows this rank reads or makes: its own and kBandMargin more each
@@ -191,7 +190,7 @@ Terrain load_terrain(const Params& p, bool by_rows) {
   Params::Dem full = p.dem;
   full.resample = 0.0;
   full.resample_factor = 0;
-  Terrain t = by_rows && reads_band(p) ? terrain_band(p.dem, full)
+  Terrain t = by_rows && reads_band()  ? terrain_band(p.dem, full)
               : full.synthetic.empty() ? read_dem(full)
                                        : make_synthetic_terrain(full);
   if (!any_active(t))

@@ -63,9 +63,10 @@ std::vector<double> generate_terrain(SynthKind kind, int nx, int ny, double cell
 using RangeReduce = std::function<void(double& lo, double& hi)>;
 
 /// Rows [r0, r1) of generate_terrain(kind, nx, ny, ..., relief_m, seed) (row-major,
-/// (r1 - r0) x nx) for every kind but diamond_square (which is made whole: Error(internal)),
-/// those rows of the whole grid bit for bit without making the others: each cell's shape and
-/// noise are its own, and the ranges that scale the noise and the heights are those of the
+/// (r1 - r0) x nx), those rows of the whole grid bit for bit without making the others: each
+/// cell's shape and noise are its own (diamond-square's lattices are made on the rows these
+/// read of them: about 1.33 (r1 - r0) n values, n + 1 the lattice's side), and the ranges
+/// that scale the noise and the heights are those of the
 /// rows [o0, o1) this process owns (inside [r0, r1)) combined by `reduce` into the whole
 /// grid's. The sizes, relief and seed are as generate_terrain checks them.
 std::vector<double> generate_terrain_rows(SynthKind kind, int nx, int ny, double relief_m,
@@ -126,7 +127,7 @@ std::vector<double> hardness_noise_rows(const Terrain& terrain, const Params::Er
 /// when 0), relief `dem.relief` (m), seed `dem.seed`. All cells active; `source` describes
 /// the generator, e.g. "synthetic:fbm size=256 seed=1 relief=100 m cell=10 m".
 /// Throws erodem::Error(ExitCode::config) naming the key for invalid settings.
-/// With `rows` of some rows only (rows.row1 >= 0; not diamond_square): the bed of those rows
+/// With `rows` of some rows only (rows.row1 >= 0): the bed of those rows
 /// (Terrain::row0, row1), as generate_terrain_rows makes them.
 Terrain make_synthetic_terrain(const Params::Dem& dem, const SynthRows& rows = {});
 
