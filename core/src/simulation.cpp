@@ -78,14 +78,36 @@ void Simulation::restore(const RestartPoint& point) {
   if (point.fields.size() != ids.size())
     throw Error(ExitCode::data, fmt::format("restart state: {} fields, expected {}",
                                             point.fields.size(), ids.size()));
-  for (std::size_t k = 0; k < ids.size(); ++k) {
+  for (std::size_t k = 0; k < ids.size(); ++k)
     if (point.fields[k].size() != terrain_.grid.cells())
       throw Error(ExitCode::data,
                   fmt::format("restart state: field '{}' has {} values for a grid of {} x {}",
                               field_info(ids[k]).name, point.fields[k].size(), terrain_.grid.nx,
                               terrain_.grid.ny));
-    backend_->set_field(ids[k], point.fields[k]);
-  }
+  const auto nx = static_cast<std::ptrdiff_t>(terrain_.grid.nx);
+  restore(point, [&](FieldId id, int row0, int row1) {
+    const std::size_t k =
+        static_cast<std::size_t>(std::find(ids.begin(), ids.end(), id) - ids.begin());
+    const auto& f = point.fields.at(k);
+    return std::vector<double>(f.begin() + row0 * nx, f.begin() + row1 * nx);
+  });
+}
+
+void Simulation::restore(const RestartPoint& point, const StateRows& rows) {
+  // each state field in turn (the bed before its residual, as set_field_rows asks), a strip at
+  // a time, of the rows the terrain holds (the backend's band and halo lie within them)
+  const int first = terrain_.row0, last = terrain_.end_row();
+  const auto nx = static_cast<std::size_t>(terrain_.grid.nx);
+  for (FieldId id : state_fields())
+    for (int r0 = first; r0 < last; r0 += kRestoreStrip) {
+      const int r1 = std::min(last, r0 + kRestoreStrip);
+      const std::vector<double> v = rows(id, r0, r1);
+      if (v.size() != static_cast<std::size_t>(r1 - r0) * nx)
+        throw Error(ExitCode::internal,
+                    fmt::format("restart state: {} values of field '{}' for rows [{}, {})",
+                                v.size(), field_info(id).name, r0, r1));
+      backend_->set_field_rows(id, r0, r1, v);
+    }
   time_ = point.time;
   steps_ = point.steps;
   ledger_ = point.ledger;

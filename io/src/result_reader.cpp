@@ -192,7 +192,52 @@ std::vector<double> ResultReader::restart_times() const {
   return {times_.begin(), times_.begin() + std::min(times_.size(), steps.size())};
 }
 
+namespace {
+
+/// A state field's dataset in a result file and its row at restart state `index`; no dataset
+/// where the file lacks a field that may start at zeros. Not erodem's (Error(data), naming the
+/// dataset) where it is missing or does not fit the grid and the stored times.
+struct RestartDataset {
+  H5Id dataset;
+  hsize_t row = 0;
+};
+
+RestartDataset restart_dataset(hid_t file, const std::string& path, const Grid& grid,
+                               std::size_t index, FieldId id) {
+  RestartDataset out;
+  const std::string name = std::string("restart/") + field_info(id).name;
+  if (field_info(id).restart_zero_if_absent && !exists(file, name)) return out;  // zeros
+  // a field stored once per value: its row at this time in NAME_row
+  hsize_t row = index;
+  if (exists(file, name + "_row")) {
+    const auto rows = read_doubles(file, name + "_row", path);
+    if (index >= rows.size() || !(rows[index] >= 0))
+      not_ours(path, name + "_row does not cover the stored times");
+    row = static_cast<hsize_t>(rows[index]);
+  }
+  H5Id ds(H5Dopen2(file, name.c_str(), H5P_DEFAULT));
+  if (!ds.valid()) not_ours(path, "no dataset " + name);
+  H5Id space(H5Dget_space(ds));
+  std::array<hsize_t, 3> dims{};
+  if (H5Sget_simple_extent_ndims(space) != 3) not_ours(path, name + " is not (time, y, x)");
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  if (dims[1] != static_cast<hsize_t>(grid.ny) || dims[2] != static_cast<hsize_t>(grid.nx) ||
+      dims[0] <= row)
+    not_ours(path, name + " does not match the grid and the stored times");
+  out.dataset = std::move(ds);
+  out.row = row;
+  return out;
+}
+
+}  // namespace
+
 RestartPoint ResultReader::restart_point(std::size_t index) const {
+  RestartPoint p = restart_header(index);
+  for (FieldId id : state_fields()) p.fields.push_back(restart_rows(index, id, 0, grid_.ny));
+  return p;
+}
+
+RestartPoint ResultReader::restart_header(std::size_t index) const {
   QuietH5 quiet;
   if (!has_restart_state())
     throw Error(ExitCode::data, path_ +
@@ -217,38 +262,29 @@ RestartPoint ResultReader::restart_point(std::size_t index) const {
   // Before the pack held liquid water (snowfall, 2026-11-26) its melt went straight into the
   // depth: what such a file calls snow_melted is the pack's runoff of the water closure now.
   if (!exists(file_, "restart/ledger_snow_runoff")) p.ledger.snow_runoff = p.ledger.snow_melted;
-  for (FieldId id : state_fields()) {
-    const std::string name = std::string("restart/") + field_info(id).name;
-    if (field_info(id).restart_zero_if_absent && !exists(file_, name)) {
-      p.fields.emplace_back(grid_.cells(), 0.0);
-      continue;
-    }
-    // a field stored once per value: its row at this time in NAME_row
-    hsize_t row = index;
-    if (exists(file_, name + "_row")) {
-      const auto rows = read_doubles(file_, name + "_row", path_);
-      if (index >= rows.size() || !(rows[index] >= 0))
-        not_ours(path_, name + "_row does not cover the stored times");
-      row = static_cast<hsize_t>(rows[index]);
-    }
-    H5Id ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
-    if (!ds.valid()) not_ours(path_, "no dataset " + name);
-    H5Id space(H5Dget_space(ds));
-    std::array<hsize_t, 3> dims{};
-    if (H5Sget_simple_extent_ndims(space) != 3) not_ours(path_, name + " is not (time, y, x)");
-    H5Sget_simple_extent_dims(space, dims.data(), nullptr);
-    if (dims[1] != static_cast<hsize_t>(grid_.ny) || dims[2] != static_cast<hsize_t>(grid_.nx) ||
-        dims[0] <= row)
-      not_ours(path_, name + " does not match the grid and the stored times");
-    const std::array<hsize_t, 3> start{row, 0, 0}, count{1, dims[1], dims[2]};
-    H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
-    H5Id mem(H5Screate_simple(3, count.data(), nullptr));
-    std::vector<double> values(grid_.cells());
-    if (H5Dread(ds, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, values.data()) < 0)
-      throw Error(ExitCode::io, path_ + ": reading " + name + " failed" + h5_reason());
-    p.fields.push_back(std::move(values));
-  }
+  // every field's dataset there and fitting the grid before any is read (restart_rows)
+  for (FieldId id : state_fields()) restart_dataset(file_, path_, grid_, index, id);
   return p;
+}
+
+std::vector<double> ResultReader::restart_rows(std::size_t index, FieldId id, int row0,
+                                               int row1) const {
+  QuietH5 quiet;
+  if (row0 < 0 || row1 > grid_.ny || row1 < row0)
+    throw Error(ExitCode::internal, fmt::format("{}: restart rows [{}, {}) of a grid of {} rows",
+                                                path_, row0, row1, grid_.ny));
+  const RestartDataset d = restart_dataset(file_, path_, grid_, index, id);
+  std::vector<double> values(static_cast<std::size_t>(row1 - row0) * grid_.nx, 0.0);
+  if (!d.dataset.valid() || values.empty()) return values;  // a field the file may lack: zeros
+  H5Id space(H5Dget_space(d.dataset));
+  const std::array<hsize_t, 3> start{d.row, static_cast<hsize_t>(row0), 0},
+      count{1, static_cast<hsize_t>(row1 - row0), static_cast<hsize_t>(grid_.nx)};
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  H5Id mem(H5Screate_simple(3, count.data(), nullptr));
+  if (H5Dread(d.dataset, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, values.data()) < 0)
+    throw Error(ExitCode::io,
+                path_ + ": reading restart/" + field_info(id).name + " failed" + h5_reason());
+  return values;
 }
 
 std::vector<Diagnostics> ResultReader::diagnostics() const {

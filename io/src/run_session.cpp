@@ -40,7 +40,7 @@ std::size_t restart_index(const ResultReader& reader, std::optional<double> time
   const auto times = reader.restart_times();
   if (times.empty()) {
     if (reader.times().empty()) throw Error(ExitCode::data, reader.path() + ": holds no snapshot");
-    reader.restart_point(0);  // throws: no restart state, and how to get one
+    reader.restart_header(0);  // throws: no restart state, and how to get one
   }
   if (!time) return times.size() - 1;
   std::size_t i = 0;
@@ -160,7 +160,9 @@ void RunSession::restore(const std::string& arg) {
                     "{} x {}",
                     options_.restart_label, file, g.nx, g.ny, sim.grid().nx, sim.grid().ny));
   const std::size_t index = restart_index(reader, time, options_.restart_label);
-  sim.restore(reader.restart_point(index));
+  sim.restore(reader.restart_header(index), [&reader, index](FieldId id, int row0, int row1) {
+    return reader.restart_rows(index, id, row0, row1);
+  });
   const auto changed = changed_keys(reader.attribute("config_toml"), dump_toml(sim.params()));
   if (!changed.empty())
     warnings_.push_back(

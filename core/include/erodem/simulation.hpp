@@ -83,6 +83,16 @@ class Simulation {
   /// sets the backend's state fields, the time, the step count and the ledger. Throws
   /// Error(ExitCode::data) when the point does not fit the grid.
   void restore(const RestartPoint& point);
+  /// Rows [row0, row1) of a state field, row-major ((row1 - row0), nx): a restart state read
+  /// a strip at a time (io::ResultReader::restart_rows).
+  using StateRows = std::function<std::vector<double>(FieldId id, int row0, int row1)>;
+  /// Continues from `header` (a RestartPoint without fields: time, steps, ledger) with each
+  /// state field given by `rows` a strip of kRestoreStrip rows at a time, only the strips of
+  /// the rows the terrain holds (an MPI rank's band), so no state field of the whole grid is
+  /// held (19 of them in double were 152 B per cell of the grid on every rank). The same
+  /// state as restore() with the whole fields.
+  void restore(const RestartPoint& header, const StateRows& rows);
+  static constexpr int kRestoreStrip = 512;
 
   /// The time step the next step will take (s).
   double next_dt() const;

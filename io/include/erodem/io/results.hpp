@@ -197,6 +197,13 @@ class ResultReader {
   /// index out of range -> Error(ExitCode::usage). Reads both layouts: restart/time with
   /// once-per-value fields (NAME_row), and the older one, a row per snapshot.
   RestartPoint restart_point(std::size_t index) const;
+  /// restart_point(index) without its fields (time, steps, ledger), after checking that every
+  /// state field's dataset is there and fits the grid (the errors restart_point gives), to
+  /// read them a strip at a time with restart_rows (Simulation::restore: no whole field).
+  RestartPoint restart_header(std::size_t index) const;
+  /// Rows [row0, row1) of state field `id` at restart_times()[index], row-major ((row1 - row0),
+  /// nx): those rows of restart_point(index)'s field, the same values.
+  std::vector<double> restart_rows(std::size_t index, FieldId id, int row0, int row1) const;
   /// Gauge series (empty when the run had none).
   GaugeSeries gauges() const;
   /// Root attributes (text), e.g. "config_toml", "erodem_version", "created".
