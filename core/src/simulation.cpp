@@ -95,12 +95,14 @@ void Simulation::restore(const RestartPoint& point) {
 
 void Simulation::restore(const RestartPoint& point, const StateRows& rows) {
   // each state field in turn (the bed before its residual, as set_field_rows asks), a strip at
-  // a time, of the rows the terrain holds (the backend's band and halo lie within them)
+  // a time, of the rows the terrain holds (the backend's band and halo lie within them); the
+  // strips end on multiples of kRestoreStrip, the result files' chunk height, so that no chunk
+  // is read (and decompressed) for two strips
   const int first = terrain_.row0, last = terrain_.end_row();
   const auto nx = static_cast<std::size_t>(terrain_.grid.nx);
   for (FieldId id : state_fields())
-    for (int r0 = first; r0 < last; r0 += kRestoreStrip) {
-      const int r1 = std::min(last, r0 + kRestoreStrip);
+    for (int r0 = first, r1 = 0; r0 < last; r0 = r1) {
+      r1 = std::min(last, (r0 / kRestoreStrip + 1) * kRestoreStrip);
       const std::vector<double> v = rows(id, r0, r1);
       if (v.size() != static_cast<std::size_t>(r1 - r0) * nx)
         throw Error(ExitCode::internal,

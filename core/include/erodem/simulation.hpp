@@ -87,7 +87,8 @@ class Simulation {
   /// a strip at a time (io::ResultReader::restart_rows).
   using StateRows = std::function<std::vector<double>(FieldId id, int row0, int row1)>;
   /// Continues from `header` (a RestartPoint without fields: time, steps, ledger) with each
-  /// state field given by `rows` a strip of kRestoreStrip rows at a time, only the strips of
+  /// state field given by `rows` a strip of kRestoreStrip rows at a time (the result files'
+  /// chunk height: io/src/result_writer.cpp kChunkSide), only the strips of
   /// the rows the terrain holds (an MPI rank's band), so no state field of the whole grid is
   /// held (19 of them in double were 152 B per cell of the grid on every rank). The same
   /// state as restore() with the whole fields.
