@@ -15,6 +15,7 @@
 #
 # Usage: bash experiments/benchmarks/gpu_check.sh [BUILD_DIR [OUT [SHARDS]]]
 #   (defaults: build, build/gpu_check, 4). ERODEM_OPENCL_DEVICE selects another device.
+# On a GPU machine without erodem's packages, gpu_bundle.sh carries the binaries and libraries.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 B=${1:-build}
