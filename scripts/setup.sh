@@ -53,6 +53,13 @@ if ! python3 -c 'import scikit_build_core, pybind11, pandas, dask, distributed, 
   python3 -m pip install -q scikit-build-core pybind11 pandas dask distributed tqdm matplotlib pytest pyarrow
 fi
 
+# mpi4py: Python scripts under mpirun, each process a member of an ensemble
+# (tests/python/test_mpi.py, docs/python.md "Under mpirun"); its wheel loads the MPI above.
+if command -v mpirun > /dev/null && ! python3 -c 'import mpi4py' 2>/dev/null; then
+  echo "setup: installing Python packages: mpi4py"
+  python3 -m pip install -q mpi4py
+fi
+
 # PoCL compiles kernels into a cache; keep it in a writable place.
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$PWD/$BUILD_DIR/pocl-cache}
 mkdir -p "$POCL_CACHE_DIR"

@@ -16,6 +16,10 @@ namespace erodem::parallel {
 namespace {
 #ifdef ERODEM_HAVE_MPI
 bool g_started = false;  // init() called MPI_Init
+// init() found this process started by a launcher: it is one rank of a decomposed run, and
+// rank() and size() are MPI's. Where something else initialised MPI (mpi4py in a Python
+// process) they stay 0 and 1: each process runs its whole grid (docs/mpi.md).
+bool g_decomposed = false;
 
 bool running() {
   int on = 0, off = 0;
@@ -58,7 +62,9 @@ void init(int* argc, char*** argv) {
   // started by a launcher: OpenMPI's mpirun, or a PMI/PMIx one (MPICH's, Slurm's srun)
   const bool launched =
       std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
-  if (!launched || running()) return;
+  if (!launched) return;
+  g_decomposed = true;
+  if (running()) return;
   MPI_Init(argc, argv);
   g_started = true;
 #else
@@ -83,10 +89,10 @@ void abort_all(int code) {
 
 #ifdef ERODEM_HAVE_MPI
 int rank() {
-  return running() ? world(MPI_Comm_rank) : 0;
+  return g_decomposed && running() ? world(MPI_Comm_rank) : 0;
 }
 int size() {
-  return running() ? world(MPI_Comm_size) : 1;
+  return g_decomposed && running() ? world(MPI_Comm_size) : 1;
 }
 #else
 int rank() {
@@ -98,14 +104,14 @@ int size() {
 #endif
 
 int local_size() {
-  if (size() <= 1) return 1;
+  if (launched_size() <= 1) return 1;
   for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"})
     if (const char* v = std::getenv(name); v && std::atoi(v) > 0) return std::atoi(v);
   return 1;
 }
 
 int local_rank() {
-  if (size() <= 1) return 0;
+  if (launched_size() <= 1) return 0;
   for (const char* name : {"OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID"})
     if (const char* v = std::getenv(name); v && std::atoi(v) >= 0 && *v) return std::atoi(v);
   return 0;

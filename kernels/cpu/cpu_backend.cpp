@@ -45,8 +45,9 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 #ifdef _OPENMP
   threads_ = params.numerics.threads > 0 ? params.numerics.threads : omp_get_max_threads();
-  // MPI: the ranks on this machine share its cores (unless OMP_NUM_THREADS says otherwise)
-  if (band_.banded && params.numerics.threads <= 0 && !std::getenv("OMP_NUM_THREADS"))
+  // the processes a launcher started on this machine (the ranks of an MPI run, an ensemble's
+  // members) share its cores, unless numerics.threads or OMP_NUM_THREADS says otherwise
+  if (parallel::local_size() > 1 && params.numerics.threads <= 0 && !std::getenv("OMP_NUM_THREADS"))
     threads_ = std::max(1, threads_ / parallel::local_size());
 #else
   threads_ = 1;

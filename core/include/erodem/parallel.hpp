@@ -22,7 +22,9 @@ bool built_with_mpi();
 /// (OMPI_COMM_WORLD_SIZE, PMI_SIZE); 1 without one. Known with or without MPI built in.
 int launched_size();
 /// Initialises MPI when this process was started by mpirun (OpenMPI's or a PMI launcher's
-/// environment); nothing otherwise.
+/// environment), and makes it a rank of a decomposed run (rank(), size()); nothing otherwise.
+/// Only `erodem`'s main calls it: a process where something else initialised MPI (mpi4py in
+/// Python) runs its whole grid, as one process of an ensemble.
 void init(int* argc, char*** argv);
 /// Finalises MPI where init started it.
 void finalize();
@@ -30,15 +32,17 @@ void finalize();
 /// rank: one rank's error must not leave the others waiting in a collective. Returns
 /// otherwise.
 void abort_all(int code);
-/// This process's rank and the number of ranks (0 and 1 without MPI running).
+/// This process's rank and the number of ranks of the decomposed run (0 and 1 without MPI
+/// running, or where init() did not make this process a rank).
 int rank();
 int size();
-/// The ranks on this machine (the launcher's OMPI_COMM_WORLD_LOCAL_SIZE or MPI_LOCALNRANKS;
-/// 1 where neither says), to share its cores among them.
+/// The processes the launcher started on this machine (its OMPI_COMM_WORLD_LOCAL_SIZE or
+/// MPI_LOCALNRANKS; 1 where neither says or without a launcher), to share its cores among
+/// them: the ranks of a decomposed run, or the members of an ensemble (Python under mpirun).
 int local_size();
-/// This rank's index among the ranks on its machine (the launcher's
-/// OMPI_COMM_WORLD_LOCAL_RANK or MPI_LOCALRANKID; 0 where neither says or without MPI
-/// running), e.g. to give each its own GPU.
+/// This process's index among them (the launcher's OMPI_COMM_WORLD_LOCAL_RANK or
+/// MPI_LOCALRANKID; 0 where neither says or without a launcher), e.g. to give each its own
+/// GPU.
 int local_rank();
 
 /// The DEM rows [row0, row1) rank `r` of `n` holds (bands as equal as the rows allow, in rank
