@@ -156,6 +156,8 @@ class Progress {
 };
 
 int run(const RunOptions& o) {
+  // under mpirun, each process a rank of the one run (docs/mpi.md); other commands are not
+  parallel::decompose();
   Params p = load_config(o.config);
   for (const auto& s : o.sets) apply_setting(p, s);
   if (o.output_given) {

@@ -350,6 +350,19 @@ if [ "$scenario" = refusals ]; then
   fi
   refused "bands thinner than the halo" 2 "each rank needs at least 2" -np 4 --backend cpu \
     --set dem.size=7
+  # Only `erodem run` is decomposed: `erodem bench` under mpirun runs its whole grid in each
+  # process (before 2026-11-29 each ran a band and reported it as the whole grid's rate).
+  rc=0
+  timeout 120 "${mpi[@]}" -np 2 "$erodem" bench --size 48 --steps 1 --backends cpu \
+    --stream-floats 65536 >bench.log 2>&1 || rc=$?
+  if [ $rc -ne 0 ] || [ "$(grep -c "^  cpu/all    CPU reference" bench.log)" != 2 ] ||
+    grep -q "MPI ranks in bands" bench.log; then
+    echo "FAIL erodem bench under mpirun -np 2: exit $rc (expected 0, two whole-grid benches), log:"
+    grep -m2 "cpu/all    CPU\|erodem" bench.log
+    failed=1
+  else
+    echo "erodem bench under mpirun -np 2: exit 0, each process the whole grid: $(grep -m1 "cpu/all    CPU" bench.log | sed 's/^ *//')"
+  fi
   # `--backend auto` where one rank would pick OpenCL and the other the CPU reference (rank 1
   # names PoCL in ERODEM_OPENCL_DEVICE): every rank must run the CPU reference, and say why
   # (the two backends' collectives differ: mixed, the ranks wait for each other for ever).

@@ -15,10 +15,11 @@ namespace erodem::parallel {
 
 namespace {
 #ifdef ERODEM_HAVE_MPI
-bool g_started = false;  // init() called MPI_Init
-// init() found this process started by a launcher: it is one rank of a decomposed run, and
-// rank() and size() are MPI's. Where something else initialised MPI (mpi4py in a Python
-// process) they stay 0 and 1: each process runs its whole grid (docs/mpi.md).
+bool g_started = false;   // init() called MPI_Init
+bool g_launched = false;  // init() found this process started by a launcher
+// decompose() made this launched process one rank of a decomposed run (`erodem run`): rank()
+// and size() are MPI's. Elsewhere (other commands; Python, also where mpi4py initialised MPI)
+// they stay 0 and 1, and each process runs its whole grid (docs/mpi.md).
 bool g_decomposed = false;
 
 bool running() {
@@ -63,13 +64,19 @@ void init(int* argc, char*** argv) {
   const bool launched =
       std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
   if (!launched) return;
-  g_decomposed = true;
+  g_launched = true;
   if (running()) return;
   MPI_Init(argc, argv);
   g_started = true;
 #else
   (void)argc;
   (void)argv;
+#endif
+}
+
+void decompose() {
+#ifdef ERODEM_HAVE_MPI
+  g_decomposed = g_launched;
 #endif
 }
 

@@ -22,10 +22,13 @@ bool built_with_mpi();
 /// (OMPI_COMM_WORLD_SIZE, PMI_SIZE); 1 without one. Known with or without MPI built in.
 int launched_size();
 /// Initialises MPI when this process was started by mpirun (OpenMPI's or a PMI launcher's
-/// environment), and makes it a rank of a decomposed run (rank(), size()); nothing otherwise.
-/// Only `erodem`'s main calls it: a process where something else initialised MPI (mpi4py in
-/// Python) runs its whole grid, as one process of an ensemble.
+/// environment); nothing otherwise. Only `erodem`'s main calls it.
 void init(int* argc, char*** argv);
+/// Makes this process, if init() found it started by a launcher, a rank of a decomposed run:
+/// rank() and size() are MPI's from here on. Only `erodem run` calls it. Other commands, and
+/// Python (also where mpi4py initialised MPI), run the whole grid in every process, each as
+/// one process of an ensemble.
+void decompose();
 /// Finalises MPI where init started it.
 void finalize();
 /// Ends every rank with exit status `code` (MPI_Abort) where MPI runs with more than one
