@@ -245,6 +245,48 @@ TEST(FusedOpenCl, WaterUpdateAndErosionInOneKernelGiveTheSameBits) {
     }
 }
 
+// The OpenCL step's reads (the statistics' rows, the tallies, the transport's change, the
+// sections' faces) land in page-locked host memory on a GPU and are copied from there
+// (read_batch, ERODEM_OPENCL_PINNED; performance.md). The same run with and without it must
+// give the same bits in every field, the ledger, the statistics and the section's volumes:
+// they are the same device values read another way. Bound: 0 differing values; a read copied
+// from the wrong place in the staging area, or not copied, changes the ledger and the step's
+// statistics, and so (adaptive dt aside) the section's volumes and the probes.
+TEST(OpenClReads, PinnedStagingGivesTheSameBits) {
+  if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
+  const Target target{"opencl", Precision::float32};
+  struct Restore {
+    ~Restore() { unsetenv("ERODEM_OPENCL_PINNED"); }
+  } restore;
+  for (const FlowScheme flow : {FlowScheme::local_inertial, FlowScheme::pipes}) {
+    const Params p = valley_params(flow, Precision::float32, 2, true, true);
+    setenv("ERODEM_OPENCL_PINNED", "1", 1);
+    auto pinned = make_simulation(valley(), p, target);
+    setenv("ERODEM_OPENCL_PINNED", "0", 1);
+    auto pageable = make_simulation(valley(), p, target);
+    pinned.run();
+    pageable.run();
+    ASSERT_EQ(pinned.steps_done(), 40);
+    const auto [total, ledger] = compare_runs(pinned, pageable);
+    EXPECT_GT(pinned.ledger().boundary_out, 0.0) << "no outflow: the tallies would be idle";
+    EXPECT_NE(pinned.ledger().eroded, 0.0) << "no erosion: its tallies would be idle";
+    const FieldStats sa = pinned.last_stats(), sb = pageable.last_stats();
+    EXPECT_EQ(std::memcmp(&sa.water_volume, &sb.water_volume, sizeof(double)), 0);
+    EXPECT_EQ(std::memcmp(&sa.material_volume, &sb.material_volume, sizeof(double)), 0);
+    EXPECT_EQ(std::memcmp(&sa.max_speed, &sb.max_speed, sizeof(double)), 0);
+    EXPECT_EQ(sa.max_depth_cell, sb.max_depth_cell);
+    const double qa = pinned.sections()[0].volume, qb = pageable.sections()[0].volume;
+    EXPECT_NE(qa, 0.0) << "no water through the section: its faces would be idle";
+    EXPECT_EQ(std::memcmp(&qa, &qb, sizeof(double)), 0) << qa << " " << qb;
+    std::printf(
+        "[opencl reads] %s: page-locked staging against reads into pageable memory: %zu field "
+        "values differ, %zu ledger entries differ (bound 0); water out %.6g m^3, through the "
+        "section %.6g m^3, max depth %.6g m\n",
+        flow == FlowScheme::pipes ? "pipes" : "local inertial", total, ledger,
+        pinned.ledger().boundary_out, qa, sa.max_depth);
+  }
+}
+
 // Local inertial and pipes write the new outflows over the old ones (flow.cpp): a block of
 // rows takes the unit discharges it needs of its neighbours' rows before a barrier. Blocks
 // of every size, down to one row (31 threads for the 31 padded rows) and empty ones (40),

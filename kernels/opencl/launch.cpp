@@ -209,8 +209,11 @@ void OpenClBackend::flush_tallies() {
   enqueue_tally_reduction();
   tally_raw_.resize(tally_slots() * acc_size_);
   change_raw_.resize(reduce_groups_ * acc_size_);
-  if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
-  if (pending_ & tally_bits()) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  std::vector<ReadRequest> reads;
+  if (pending_ & kChangeBit) reads.push_back({&partial_b_, change_raw_.size(), change_raw_.data()});
+  if (pending_ & tally_bits())
+    reads.push_back({&tally_sums_, tally_raw_.size(), tally_raw_.data()});
+  read_batch(reads);
   check(clFinish(queue_.get()), "clFinish");
   deliver_tallies();
 }

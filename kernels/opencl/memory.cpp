@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 
 #include "common/compat.h"
 #include "common/erosion.h"
@@ -138,6 +139,43 @@ void OpenClBackend::read(const Buffer& b, std::size_t bytes, void* dst, bool blo
   check(clEnqueueReadBuffer(queue_.get(), b.get(), blocking ? CL_TRUE : CL_FALSE, 0, bytes, dst, 0,
                             nullptr, profile_event("read")),
         "clEnqueueReadBuffer");
+}
+
+void OpenClBackend::read_batch(const std::vector<ReadRequest>& reads) {
+  if (reads.empty()) return;
+  if (!pinned_reads_) {
+    for (std::size_t j = 0; j < reads.size(); ++j)
+      read(*reads[j].buffer, reads[j].bytes, reads[j].dst, j + 1 == reads.size());
+    return;
+  }
+  // each read's place in the staging area, on 64-byte boundaries
+  std::vector<std::size_t> at(reads.size());
+  std::size_t total = 0;
+  for (std::size_t j = 0; j < reads.size(); ++j) {
+    at[j] = total;
+    total += (reads[j].bytes + 63) / 64 * 64;
+  }
+  if (total > staging_bytes_) {  // grown (the last batch has completed: it blocked)
+    if (staging_ptr_)
+      check(
+          clEnqueueUnmapMemObject(queue_.get(), staging_.get(), staging_ptr_, 0, nullptr, nullptr),
+          "clEnqueueUnmapMemObject(staging)");
+    staging_ptr_ = nullptr;
+    staging_ = Buffer();
+    cl_int err = CL_SUCCESS;
+    staging_ = Buffer(clCreateBuffer(rt_->context.get(), CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR,
+                                     total, nullptr, &err));
+    check(err, "clCreateBuffer(staging, CL_MEM_ALLOC_HOST_PTR)");
+    staging_ptr_ = static_cast<unsigned char*>(
+        clEnqueueMapBuffer(queue_.get(), staging_.get(), CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0,
+                           total, 0, nullptr, nullptr, &err));
+    check(err, "clEnqueueMapBuffer(staging)");
+    staging_bytes_ = total;
+  }
+  for (std::size_t j = 0; j < reads.size(); ++j)
+    read(*reads[j].buffer, reads[j].bytes, staging_ptr_ + at[j], j + 1 == reads.size());
+  for (std::size_t j = 0; j < reads.size(); ++j)
+    if (reads[j].bytes) std::memcpy(reads[j].dst, staging_ptr_ + at[j], reads[j].bytes);
 }
 
 namespace {

@@ -80,6 +80,10 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                                       profiling_ ? CL_QUEUE_PROFILING_ENABLE : 0, &err));
   check(err, "clCreateCommandQueue");
   acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
+  // the step's reads into page-locked memory (read_batch) where ERODEM_OPENCL_PINNED=1: meant
+  // for GPUs, not yet measured on one (performance.md, "Page-locked reads"), so off by default
+  const char* pinned_env = std::getenv("ERODEM_OPENCL_PINNED");
+  pinned_reads_ = pinned_env && *pinned_env && std::string(pinned_env) != "0";
 
   // ---- the host state: the same padded state the CPU reference starts from ----
   // Each float64 array rounded to Real and freed at once, and each Real copy freed after its
@@ -718,6 +722,8 @@ void OpenClBackend::finish() {
 OpenClBackend::~OpenClBackend() {
   // the commands still queued may read host arrays this object owns (the halo rows written
   // without waiting, the point inflows) or hold profiling events: all complete before those go
+  if (staging_ptr_)
+    clEnqueueUnmapMemObject(queue_.get(), staging_.get(), staging_ptr_, 0, nullptr, nullptr);
   clFinish(queue_.get());
   for (auto& [name, ev] : profile_pending_)
     if (ev) clReleaseEvent(ev);
@@ -788,27 +794,30 @@ FieldStats OpenClBackend::collect(std::vector<double>* probes) {
   enqueue_tally_reduction();
   tally_raw_.resize(tally_slots() * acc_size_);
   change_raw_.resize(reduce_groups_ * acc_size_);
-  if (pending_ & kChangeBit) read(partial_b_, change_raw_.size(), change_raw_.data(), false);
-  if (pending_ & tally_bits()) read(tally_sums_, tally_raw_.size(), tally_raw_.data(), false);
+  std::vector<ReadRequest> reads;  // the step's one batch of reads, the last one blocking
+  if (pending_ & kChangeBit) reads.push_back({&partial_b_, change_raw_.size(), change_raw_.data()});
+  if (pending_ & tally_bits())
+    reads.push_back({&tally_sums_, tally_raw_.size(), tally_raw_.data()});
   std::vector<cl_long> cells(static_cast<std::size_t>(rows) * 3);
-  read(row_cells_, cells.size() * sizeof(cl_long), cells.data(), false);
+  reads.push_back({&row_cells_, cells.size() * sizeof(cl_long), cells.data()});
   const bool gather = probes && probe_count_ > 0 && !probe_fields_.empty();  // (owned ones)
   if (gather) {
     // the probes gathered on the device: a few floats in the step's one batch of reads
     enqueue_gather(probe_cells_, probe_count_, probe_fields_, probe_out_);
     probe_raw_.resize(part_count(probe_fields_) * probe_count_);
-    read(probe_out_, probe_raw_.size() * sizeof(float), probe_raw_.data(), false);
+    reads.push_back({&probe_out_, probe_raw_.size() * sizeof(float), probe_raw_.data()});
   }
   if (probes && face_water_done_) {  // a step's faces (end_step), in the same batch
     face_water_raw_.resize(face_count_);
-    read(face_water_out_, face_count_ * sizeof(Real), face_water_raw_.data(), false);
+    reads.push_back({&face_water_out_, face_count_ * sizeof(Real), face_water_raw_.data()});
   }
   if (probes && face_sediment_done_) {
     face_sediment_raw_.resize(face_count_);
-    read(face_sediment_out_, face_count_ * sizeof(Real), face_sediment_raw_.data(), false);
+    reads.push_back({&face_sediment_out_, face_count_ * sizeof(Real), face_sediment_raw_.data()});
   }
   stats_sums_raw_.resize(static_cast<std::size_t>(rows) * kStatsRowValues * acc_size_);
-  read(row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data(), true);
+  reads.push_back({&row_sums_, stats_sums_raw_.size(), stats_sums_raw_.data()});
+  read_batch(reads);
   resolve_profile(false);  // the blocking read: every command before it has completed
   deliver_tallies();
   if (probes && !probe_fields_.empty() && !probe_owner_.empty()) {

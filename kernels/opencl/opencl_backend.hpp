@@ -250,6 +250,17 @@ class OpenClBackend final : public Backend {
   void launch_reduction(cl_kernel k, std::size_t groups);
   /// Enqueues a read of `bytes` of `b` into `dst`; blocking or not.
   void read(const Buffer& b, std::size_t bytes, void* dst, bool blocking);
+  /// One read of a step's batch: `bytes` of `*buffer` into `dst`.
+  struct ReadRequest {
+    const Buffer* buffer;
+    std::size_t bytes;
+    void* dst;
+  };
+  /// Enqueues `reads` in order, the last one blocking: when it returns, every `dst` holds its
+  /// bytes. With pinned_reads_ they land in page-locked host memory (staging_), which a GPU
+  /// writes directly, and are copied into their `dst` after the wait; a GPU's read into
+  /// pageable memory goes through the driver's staging (performance.md, "Page-locked reads").
+  void read_batch(const std::vector<ReadRequest>& reads);
   /// Where profiling (ERODEM_OPENCL_PROFILE=1): an event slot for the command about to be
   /// enqueued, booked under `name` once resolved; else nullptr (no event). The slot stays
   /// where it is until resolve_profile (a deque: later slots do not move it).
@@ -361,6 +372,13 @@ class OpenClBackend final : public Backend {
   // ERODEM_OPENCL_PROFILE=1: the queue profiles, every launch and read takes an event, and
   // finish() and end_step() book their device time per kernel name (kernel_times()).
   bool profiling_ = false;
+  // read_batch's page-locked host memory: a buffer of CL_MEM_ALLOC_HOST_PTR mapped for its
+  // whole life (unmapped by the destructor), grown when a batch needs more. Used where
+  // ERODEM_OPENCL_PINNED=1 (off by default until measured on a GPU).
+  bool pinned_reads_ = false;
+  Buffer staging_;
+  unsigned char* staging_ptr_ = nullptr;
+  std::size_t staging_bytes_ = 0;
   std::deque<std::pair<std::string, cl_event>> profile_pending_;
   std::map<std::string, KernelTime> profile_;
   std::map<cl_kernel, std::string> kernel_names_;
