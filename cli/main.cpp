@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
   // in static destruction after the OpenCL implementation may have torn itself down.
   const OpenClRuntimes opencl_runtimes;
   // MPI, where mpirun started this process (docs/mpi.md): initialised here, finalised when
-  // main returns; an error on one rank ends them all (parallel::abort_all) with its exit code.
+  // main returns; in `erodem run`, which decomposes the grid (parallel::decompose), an error on
+  // one rank ends them all (parallel::abort_all) with its exit code.
   struct MpiSession {
     MpiSession(int* c, char*** v) { parallel::init(c, v); }
     ~MpiSession() { parallel::finalize(); }

@@ -61,9 +61,9 @@ BackendChoice auto_backend_choice(const std::vector<ClDeviceInfo>& devices,
   if (gpu != devices.end()) {
     c.backend = "opencl";
     c.device = static_cast<int>(gpu - devices.begin());
-    c.reason = parallel::size() > 1 ? "an OpenCL GPU (under MPI, the ranks of a machine take its "
-                                      "GPUs in turn)"
-                                    : "the first OpenCL GPU";
+    c.reason = parallel::local_size() > 1 ? "an OpenCL GPU (the processes mpirun started on a "
+                                            "machine take its GPUs in turn)"
+                                          : "the first OpenCL GPU";
     return c;
   }
   c.backend = "cpu";

@@ -255,15 +255,32 @@ TEST(FusedOpenCl, WaterUpdateAndErosionInOneKernelGiveTheSameBits) {
 TEST(OpenClReads, PinnedStagingGivesTheSameBits) {
   if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
   const Target target{"opencl", Precision::float32};
-  struct Restore {
-    ~Restore() { unsetenv("ERODEM_OPENCL_PINNED"); }
+  struct Restore {  // the variable as the test found it
+    const char* v = std::getenv("ERODEM_OPENCL_PINNED");
+    std::string old = v ? v : "";
+    bool had = v != nullptr;
+    ~Restore() {
+      if (had)
+        setenv("ERODEM_OPENCL_PINNED", old.c_str(), 1);
+      else
+        unsetenv("ERODEM_OPENCL_PINNED");
+    }
   } restore;
+  // probes on three cells (one on the section's row), read in the step's batch too
+  const std::vector<std::int64_t> cells = {5 * kNx + 11, 14 * kNx + 7, (kNy - 2) * kNx + 3};
+  const std::vector<FieldId> fields = {FieldId::water_depth, FieldId::velocity_x, FieldId::bed};
   for (const FlowScheme flow : {FlowScheme::local_inertial, FlowScheme::pipes}) {
     const Params p = valley_params(flow, Precision::float32, 2, true, true);
     setenv("ERODEM_OPENCL_PINNED", "1", 1);
     auto pinned = make_simulation(valley(), p, target);
     setenv("ERODEM_OPENCL_PINNED", "0", 1);
     auto pageable = make_simulation(valley(), p, target);
+    // the staging is taken in the one and not in the other
+    ASSERT_NE(pinned.backend().device().find("(page-locked reads)"), std::string::npos)
+        << pinned.backend().device();
+    ASSERT_EQ(pageable.backend().device().find("page-locked"), std::string::npos);
+    pinned.set_probes(cells, fields);
+    pageable.set_probes(cells, fields);
     pinned.run();
     pageable.run();
     ASSERT_EQ(pinned.steps_done(), 40);
@@ -278,12 +295,32 @@ TEST(OpenClReads, PinnedStagingGivesTheSameBits) {
     const double qa = pinned.sections()[0].volume, qb = pageable.sections()[0].volume;
     EXPECT_NE(qa, 0.0) << "no water through the section: its faces would be idle";
     EXPECT_EQ(std::memcmp(&qa, &qb, sizeof(double)), 0) << qa << " " << qb;
+    // the probes: as the other path read them, and as the fields hold them
+    ASSERT_NE(pinned.probes(), nullptr);
+    ASSERT_NE(pageable.probes(), nullptr);
+    const std::vector<double>& pa = *pinned.probes();
+    const std::vector<double>& pb = *pageable.probes();
+    ASSERT_EQ(pa.size(), cells.size() * fields.size());
+    ASSERT_EQ(pb.size(), pa.size());
+    std::size_t probes_differ = 0, probes_wet = 0;
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      const auto field = pinned.field(fields[f]);
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const std::size_t k = f * cells.size() + c;
+        probes_differ += std::memcmp(&pa[k], &pb[k], sizeof(double)) != 0;
+        EXPECT_EQ(pa[k], static_cast<double>(field[static_cast<std::size_t>(cells[c])]))
+            << "probe " << k;
+        probes_wet += fields[f] == FieldId::water_depth && pa[k] > 0.0;
+      }
+    }
+    EXPECT_EQ(probes_differ, 0u);
+    EXPECT_GT(probes_wet, 0u) << "every probe dry: the probes would not tell a misread";
     std::printf(
         "[opencl reads] %s: page-locked staging against reads into pageable memory: %zu field "
-        "values differ, %zu ledger entries differ (bound 0); water out %.6g m^3, through the "
-        "section %.6g m^3, max depth %.6g m\n",
-        flow == FlowScheme::pipes ? "pipes" : "local inertial", total, ledger,
-        pinned.ledger().boundary_out, qa, sa.max_depth);
+        "values differ, %zu ledger entries differ, %zu of %zu probe values differ (bound 0); "
+        "water out %.6g m^3, through the section %.6g m^3, max depth %.6g m\n",
+        flow == FlowScheme::pipes ? "pipes" : "local inertial", total, ledger, probes_differ,
+        pa.size(), pinned.ledger().boundary_out, qa, sa.max_depth);
   }
 }
 

@@ -155,13 +155,14 @@ void OpenClBackend::read_batch(const std::vector<ReadRequest>& reads) {
     at[j] = total;
     total += (reads[j].bytes + 63) / 64 * 64;
   }
-  if (total > staging_bytes_) {  // grown (the last batch has completed: it blocked)
+  if (total > staging_bytes_) {  // grown (the queue is in order: the unmap waits for earlier reads)
     if (staging_ptr_)
       check(
           clEnqueueUnmapMemObject(queue_.get(), staging_.get(), staging_ptr_, 0, nullptr, nullptr),
           "clEnqueueUnmapMemObject(staging)");
     staging_ptr_ = nullptr;
     staging_ = Buffer();
+    staging_bytes_ = 0;  // (until the new one is mapped: a failure below leaves none)
     cl_int err = CL_SUCCESS;
     staging_ = Buffer(clCreateBuffer(rt_->context.get(), CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR,
                                      total, nullptr, &err));

@@ -217,7 +217,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 }
 
 std::string OpenClBackend::device() const {
-  const std::string label = rt_->info.label();
+  const std::string label = rt_->info.label() + (pinned_reads_ ? " (page-locked reads)" : "");
   if (!band_.banded) return label;
   return fmt::format("{} (a rank), {} MPI ranks in bands of rows, halo {} row{}", label,
                      parallel::size(), band_.halo, band_.halo == 1 ? "" : "s");

@@ -60,7 +60,8 @@ const DeviceEntry& choose_device(const std::vector<DeviceEntry>& devices,
                                              "'<platform>:<device>'; devices: {}",
                                              selector, describe(devices)));
   }
-  // the first GPU; under MPI each rank of a machine its own, in turn (local_rank)
+  // the first GPU; each process a launcher started on a machine (the ranks of an MPI run, an
+  // ensemble's members) its own, in turn (local_rank)
   std::vector<const DeviceEntry*> gpus;
   for (const auto& d : devices)
     if (d.info.gpu()) gpus.push_back(&d);

@@ -2,7 +2,7 @@
 
 An ensemble script starts its members with ``mpirun -np N python3 script.py`` and lets mpi4py
 tell each process which member it is. Only ``erodem run`` decomposes a grid into bands of rows
-(``parallel::init``, called by the CLI's main alone); a Python process in which mpi4py
+(``parallel::decompose``, called by its ``run()`` alone); a Python process in which mpi4py
 initialised MPI is one member that runs its whole grid.
 
 Before 2026-11-29, such a process split its simulations into bands like a rank of

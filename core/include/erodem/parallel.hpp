@@ -31,9 +31,9 @@ void init(int* argc, char*** argv);
 void decompose();
 /// Finalises MPI where init started it.
 void finalize();
-/// Ends every rank with exit status `code` (MPI_Abort) where MPI runs with more than one
-/// rank: one rank's error must not leave the others waiting in a collective. Returns
-/// otherwise.
+/// Ends every rank with exit status `code` (MPI_Abort) in a decomposed run of more than one
+/// rank (decompose()): one rank's error must not leave the others waiting in a collective.
+/// Returns otherwise (each process of an ensemble ends on its own).
 void abort_all(int code);
 /// This process's rank and the number of ranks of the decomposed run (0 and 1 without MPI
 /// running, or where init() did not make this process a rank).
