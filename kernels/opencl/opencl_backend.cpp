@@ -42,6 +42,12 @@ std::size_t env_size(const char* name, std::size_t fallback) {
   return fallback;
 }
 
+/// Whether the switch `name` is on in the environment: set, not empty and not "0".
+bool env_flag(const char* name) {
+  const char* env = std::getenv(name);
+  return env && *env && std::string(env) != "0";
+}
+
 }  // namespace
 
 OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
@@ -74,16 +80,14 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
 
   rt_ = runtime_for(selector);
   cl_int err = CL_SUCCESS;
-  const char* profile_env = std::getenv("ERODEM_OPENCL_PROFILE");
-  profiling_ = profile_env && *profile_env && std::string(profile_env) != "0";
+  profiling_ = env_flag("ERODEM_OPENCL_PROFILE");
   queue_ = Queue(clCreateCommandQueue(rt_->context.get(), rt_->device,
                                       profiling_ ? CL_QUEUE_PROFILING_ENABLE : 0, &err));
   check(err, "clCreateCommandQueue");
   acc_size_ = rt_->fp64 ? sizeof(double) : sizeof(float);
   // the step's reads into page-locked memory (read_batch) where ERODEM_OPENCL_PINNED=1: meant
   // for GPUs, not yet measured on one (performance.md, "Page-locked reads"), so off by default
-  const char* pinned_env = std::getenv("ERODEM_OPENCL_PINNED");
-  pinned_reads_ = pinned_env && *pinned_env && std::string(pinned_env) != "0";
+  pinned_reads_ = env_flag("ERODEM_OPENCL_PINNED");
 
   // ---- the host state: the same padded state the CPU reference starts from ----
   // Each float64 array rounded to Real and freed at once, and each Real copy freed after its
