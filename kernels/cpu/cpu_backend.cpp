@@ -384,63 +384,158 @@ FieldStats CpuBackend<Real>::stats() {
 }
 
 namespace {
-// Eight lanes of doubles and their masks, GCC's vector extensions: the operations are IEEE's,
-// element by element, whatever registers a build has (two 64-byte vectors hold sixteen lanes
-// with AVX-512; AVX2 and SSE builds split them), so every build adds the same values in the
-// same order.
-typedef double Double8 __attribute__((vector_size(64)));
-typedef long long Mask8 __attribute__((vector_size(64)));
-typedef float Float8 __attribute__((vector_size(32)));
-typedef std::uint8_t Byte8 __attribute__((vector_size(8)));
+// Four lanes of doubles and their masks, GCC's vector extensions: the operations are IEEE's,
+// element by element, whatever registers a build has (an SSE build splits each vector in two),
+// so every build adds the same values in the same order. 32 bytes, not 64: without AVX-512,
+// GCC lowered the 64-byte vectors' selects to a test and a branch per element and kept the
+// sums on the stack (a third of the statistics' time, AVX2).
+typedef double Double4 __attribute__((vector_size(32)));
+typedef long long Mask4 __attribute__((vector_size(32)));
+typedef float Float4 __attribute__((vector_size(16)));
+typedef std::uint8_t Byte4 __attribute__((vector_size(4)));
 
-// (results through references: a 64-byte vector returned by value changes the ABI between
-// the v2, v3 and v4 builds, GCC's -Wpsabi)
-inline void load8(const float* p, Double8& v) {
-  Float8 f;
+// (results through references: a 32-byte vector returned by value changes the ABI between the
+// v2 build and the others, GCC's -Wpsabi)
+inline void load4(const float* p, Double4& v) {
+  Float4 f;
   std::memcpy(&f, p, sizeof f);
-  v = __builtin_convertvector(f, Double8);
+  v = __builtin_convertvector(f, Double4);
 }
-inline void load8(const double* p, Double8& v) {
+inline void load4(const double* p, Double4& v) {
   std::memcpy(&v, p, sizeof v);
 }
+/// Eight values as two vectors of doubles. (__builtin_convertvector converted two floats at a
+/// time and moved the upper two through the stack; GCC's loop vectoriser converts four.)
+inline void load8(const float* p, Double4& lo, Double4& hi) {
+  double t[8];
+  for (int j = 0; j < 8; ++j) t[j] = p[j];
+  std::memcpy(&lo, t, sizeof lo);
+  std::memcpy(&hi, t + 4, sizeof hi);
+}
+inline void load8(const double* p, Double4& lo, Double4& hi) {
+  std::memcpy(&lo, p, sizeof lo);
+  std::memcpy(&hi, p + 4, sizeof hi);
+}
 /// All ones where the kind is ERODEM_CELL_ACTIVE, else 0.
-inline void active8(const std::uint8_t* kind, Mask8& mask) {
-  Byte8 k;
+inline void active4(const std::uint8_t* kind, Mask4& mask) {
+  Byte4 k;
   std::memcpy(&k, kind, sizeof k);
-  mask = __builtin_convertvector(k == Byte8{} + ERODEM_CELL_ACTIVE, Mask8);
+  mask = __builtin_convertvector(k == Byte4{} + ERODEM_CELL_ACTIVE, Mask4);
+}
+/// sum += v where mask is all ones, += +0 where it is 0 (the bits of v and-ed with the mask).
+inline void add_where(Double4& sum, const Mask4& mask, const Double4& v) {
+  Mask4 bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  bits &= mask;
+  Double4 masked;
+  std::memcpy(&masked, &bits, sizeof masked);
+  sum += masked;
 }
 
-/// stats_row's volumes over the cells [0, count) of arrays that start at a row's first DEM cell
-/// (count a multiple of 16): cell x into lane x % 16 of pw (depth) and, with kMaterial, of pm
-/// (bed + residual + sediment) and ps (sediment), each in x order; an inactive cell adds +0.
-/// The sums stay in registers (a loop over arrays of lanes kept them in memory and ran slower
-/// than the single running sums it replaced when the row came from memory).
+/// The largest of four lanes (none NaN).
+inline double lane_max(const Double4& v) {
+  const double a = v[0] > v[1] ? v[0] : v[1], b = v[2] > v[3] ? v[2] : v[3];
+  return a > b ? a : b;
+}
+/// The smallest of four lanes (none NaN).
+inline double lane_min(const Double4& v) {
+  const double a = v[0] < v[1] ? v[0] : v[1], b = v[2] < v[3] ? v[2] : v[3];
+  return a < b ? a : b;
+}
+
+/// What stats_row's one pass over a row finds besides the volumes: the largest depth and the
+/// largest squared speed of the row's active cells (-1 where none beats -1; NaN never ranks) and
+/// the first chunk of `chunk` cells holding each, and the smallest depth (+inf where none).
+struct RowExtremes {
+  double max_depth = -1, max_speed2 = -1, min_depth = std::numeric_limits<double>::infinity();
+  int depth_chunk = 0, speed_chunk = 0;
+};
+
+/// One pass over the n cells of arrays that start at a row's first DEM cell, for stats_row:
+///  - the volumes: cell x into lane x % 16 of pw (depth) and, with kMaterial, of pm (bed +
+///    residual + sediment) and ps (sediment), each in x order (an inactive cell adds +0): the
+///    cells [0, n - n % 16) four vectors of four lanes at a time, the rest one by one into
+///    lanes 0, 1, ...;
+///  - per chunk of `chunk` cells (a multiple of 16), the largest and smallest depth and the
+///    largest squared speed u*u + v*v in double (exact for floats), each chunk's maximum ranked
+///    against the earlier chunks' strictly, so that each kept chunk is the first holding the
+///    row's largest value. Maxima and minima do not depend on the order of the lanes, which
+///    compare the depths in double: exact for a float depth, as the float comparison.
+/// The lanes stay in registers: without AVX-512, GCC lowered a select on 64-byte vectors to a
+/// test and a branch per element, and kept a simd reduction's mixed float and double maxima
+/// on the stack with byte masks repacked per vector (performance.md "The statistics in one
+/// pass").
 template <bool kMaterial, class Real>
-void volume_lanes(const std::uint8_t* kind, const Real* d, const Real* bed, const Real* bed_lo,
-                  const Real* sediment, int count, double* pw, double* pm, double* ps) {
-  const Double8 zero = {};
-  Double8 w[2] = {}, m[2] = {}, s[2] = {};
-  for (int x0 = 0; x0 < count; x0 += 16)
-    for (int h = 0; h < 2; ++h) {
-      const int x = x0 + 8 * h;
-      Mask8 active;
-      Double8 dv;
-      active8(kind + x, active);
-      load8(d + x, dv);
-      w[h] += active ? dv : zero;
+void row_pass(const std::uint8_t* kind, const Real* d, const Real* bed, const Real* bed_lo,
+              const Real* sediment, const Real* vx, const Real* vy, int n, int chunk, double* pw,
+              double* pm, double* ps, RowExtremes& e) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const Double4 minus_one = Double4{} - 1.0, infinity = Double4{} + inf;
+  const int whole = n - n % 16;
+  Double4 w[4] = {}, m[4] = {}, s[4] = {};
+  for (int c0 = 0; c0 < n; c0 += chunk) {
+    const int c1 = std::min(c0 + chunk, n), v1 = std::min(c1, whole);
+    Double4 hi = minus_one, fast = minus_one, lo = infinity;
+    for (int x0 = c0; x0 < v1; x0 += 16)
+      for (int half = 0; half < 2; ++half) {
+        const int x8 = x0 + 8 * half;
+        Double4 h8[2], u8[2], v8[2], b8[2], l8[2], s8[2];
+        load8(d + x8, h8[0], h8[1]);
+        load8(vx + x8, u8[0], u8[1]);
+        load8(vy + x8, v8[0], v8[1]);
+        if constexpr (kMaterial) {
+          load8(bed + x8, b8[0], b8[1]);
+          load8(bed_lo + x8, l8[0], l8[1]);
+          load8(sediment + x8, s8[0], s8[1]);
+        }
+        for (int k = 0; k < 2; ++k) {
+          const int q = 2 * half + k;
+          const Double4 h = h8[k], u = u8[k], v = v8[k];
+          Mask4 active;
+          active4(kind + x8 + 4 * k, active);
+          add_where(w[q], active, h);
+          if constexpr (kMaterial) {
+            add_where(m[q], active, b8[k] + l8[k] + s8[k]);
+            add_where(s[q], active, s8[k]);
+          }
+          const Double4 h_rank = active & (h > minus_one) ? h : minus_one;  // NaN: -1
+          hi = h_rank > hi ? h_rank : hi;
+          const Double4 h_low = active ? h : infinity;
+          lo = h_low < lo ? h_low : lo;
+          const Double4 v2 = u * u + v * v;
+          const Double4 v2_rank = active & (v2 > minus_one) ? v2 : minus_one;
+          fast = v2_rank > fast ? v2_rank : fast;
+        }
+      }
+    double c_hi = lane_max(hi), c_fast = lane_max(fast), c_lo = lane_min(lo);
+    if (c1 == n) {  // the last chunk: every vector add is done, the tail adds after them
+      std::memcpy(pw, w, sizeof w);
       if constexpr (kMaterial) {
-        Double8 bv, lv, sv;
-        load8(bed + x, bv);
-        load8(bed_lo + x, lv);
-        load8(sediment + x, sv);
-        m[h] += active ? bv + lv + sv : zero;
-        s[h] += active ? sv : zero;
+        std::memcpy(pm, m, sizeof m);
+        std::memcpy(ps, s, sizeof s);
       }
     }
-  std::memcpy(pw, w, sizeof w);
-  if constexpr (kMaterial) {
-    std::memcpy(pm, m, sizeof m);
-    std::memcpy(ps, s, sizeof s);
+    for (int x = std::max(c0, whole); x < c1; ++x) {  // the tail, into lanes 0 .. n - whole - 1
+      const std::size_t j = static_cast<std::size_t>(x - whole);
+      const bool active = kind[x] == ERODEM_CELL_ACTIVE;
+      const double h = d[x];
+      pw[j] += active ? h : 0.0;
+      if constexpr (kMaterial) {
+        const double sv = sediment[x];
+        pm[j] += active ? static_cast<double>(bed[x]) + static_cast<double>(bed_lo[x]) + sv : 0.0;
+        ps[j] += active ? sv : 0.0;
+      }
+      const double h_rank = active && h > -1 ? h : -1.0;
+      c_hi = h_rank > c_hi ? h_rank : c_hi;
+      const double h_low = active ? h : inf;
+      c_lo = h_low < c_lo ? h_low : c_lo;
+      const double u = vx[x], v = vy[x], v2 = u * u + v * v;
+      const double v2_rank = active && v2 > -1 ? v2 : -1.0;
+      c_fast = v2_rank > c_fast ? v2_rank : c_fast;
+    }
+    if (c_hi > e.max_depth) e.max_depth = c_hi, e.depth_chunk = c0;
+    if (c_fast > e.max_speed2) e.max_speed2 = c_fast, e.speed_chunk = c0;
+    e.min_depth = c_lo < e.min_depth ? c_lo : e.min_depth;
   }
 }
 }  // namespace
@@ -449,14 +544,16 @@ template <class Real>
 RowStats CpuBackend<Real>::stats_row(int y, const Real* depth, bool material_known) {
   // The row's volumes (in the fixed order of sum_row's lanes) and the results of one scan of
   // its active cells in x order (the first cell of the largest depth and of the largest
-  // squared speed, "larger" strictly, so NaN never wins; the first cell not physical), in
-  // passes (performance.md "The statistics' row passes", "Sums in sixteen lanes"):
-  //  1. the volumes: three sums in the lanes of sum_row, times the area (an inactive cell
-  //     adds +0, which leaves a sum as it is: a sum that starts at +0 never becomes -0);
-  //  2. per chunk of kStatsChunk cells, the largest depth and squared speed and the smallest
-  //     depth (SIMD reductions: a maximum's value does not depend on the order), the chunks
-  //     ranked as the scan ranks cells (strictly larger), so the first chunk holding each
-  //     largest value is the scan's; then the first cell in it holding that value;
+  // squared speed, "larger" strictly, so NaN never wins; the first cell not physical)
+  // (performance.md "The statistics' row passes", "Sums in sixteen lanes", "The statistics in
+  // one pass"):
+  //  1. one pass over the row (row_pass): the three volumes in the lanes of sum_row (an
+  //     inactive cell adds +0, which leaves a sum as it is: a sum that starts at +0 never
+  //     becomes -0), times the area; and per chunk of kStatsChunk cells, the largest depth and
+  //     squared speed and the smallest depth (in vector lanes: a maximum's value does not
+  //     depend on the order), the chunks ranked as the scan ranks cells (strictly larger), so
+  //     the first chunk holding each largest value is the scan's;
+  //  2. the first cell in that chunk holding that value;
   //  3. only where a volume is not finite or a depth negative, the scan for the first cell
   //     that is not physical (a NaN or infinite depth, bed or sediment makes a volume so).
   RowStats row;
@@ -482,23 +579,17 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth, bool material_kno
   // the volumes: each a sum over the row's cells in the lanes of sum_row (cell x's value into
   // lane (x - 1) % kSumLanes, +0 for an inactive cell), combined by sum_lanes, times the
   // cells' area; the material's and the sediment's only when they may have changed
-  // (material_rows_)
-  static_assert(kSumLanes == 16, "volume_lanes holds sixteen lanes");
+  // (material_rows_); and the extremes, in the same pass (row_pass)
+  static_assert(kSumLanes == 16, "row_pass holds sixteen lanes");
+  static_assert(kStatsChunk % 16 == 0, "row_pass's chunks hold whole vectors of lanes");
   double pw[kSumLanes] = {}, pm[kSumLanes] = {}, ps[kSumLanes] = {};
-  const int n = W - 2, whole = n - n % static_cast<int>(kSumLanes);
+  RowExtremes e;
   if (material_known)
-    volume_lanes<false>(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, whole, pw, pm, ps);
+    row_pass<false>(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, vx + 1, vy + 1, W - 2,
+                    kStatsChunk, pw, pm, ps, e);
   else
-    volume_lanes<true>(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, whole, pw, pm, ps);
-  for (int x = 1 + whole; x < W - 1; ++x) {  // the tail, into lanes 0 .. n - whole - 1
-    const std::size_t j = static_cast<std::size_t>(x - 1 - whole);
-    const bool active = kind[x] == ERODEM_CELL_ACTIVE;
-    pw[j] += active ? static_cast<double>(d[x]) : 0.0;
-    if (material_known) continue;
-    const double s = sediment[x];
-    pm[j] += active ? static_cast<double>(bed[x]) + static_cast<double>(bed_lo[x]) + s : 0.0;
-    ps[j] += active ? s : 0.0;
-  }
+    row_pass<true>(kind + 1, d + 1, bed + 1, bed_lo + 1, sediment + 1, vx + 1, vy + 1, W - 2,
+                   kStatsChunk, pw, pm, ps, e);
   MaterialRow& kept = material_rows_[static_cast<std::size_t>(y - 1)];
   if (!material_known) kept = {sum_lanes(pm) * a, sum_lanes(ps) * a};
   const double water = sum_lanes(pw) * a, material = kept.material, sed = kept.sediment;
@@ -506,30 +597,10 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth, bool material_kno
   row.material = material;
   row.sediment = sed;
 
-  constexpr Real inf = std::numeric_limits<Real>::infinity();
-  Real best_d = Real(-1), min_d = inf;
-  double best_v2 = -1;
-  int chunk_d = 0, chunk_v = 0;
-  for (int c0 = 1; c0 < W - 1; c0 += kStatsChunk) {
-    const int c1 = std::min(c0 + kStatsChunk, W - 1);
-    Real m = Real(-1), lo = inf;
-    double mv = -1;
-#pragma omp simd reduction(max : m, mv) reduction(min : lo)
-    for (int x = c0; x < c1; ++x) {
-      const bool active = kind[x] == ERODEM_CELL_ACTIVE;
-      const Real h = d[x];
-      const Real h_rank = active && h > Real(-1) ? h : Real(-1);  // NaN: -1, never ranked
-      m = h_rank > m ? h_rank : m;
-      const Real h_low = active ? h : inf;
-      lo = h_low < lo ? h_low : lo;
-      const double v2 = speed2(x);
-      const double v2_rank = active && v2 > -1 ? v2 : -1.0;
-      mv = v2_rank > mv ? v2_rank : mv;
-    }
-    if (m > best_d) best_d = m, chunk_d = c0;
-    if (mv > best_v2) best_v2 = mv, chunk_v = c0;
-    min_d = lo < min_d ? lo : min_d;
-  }
+  // the largest depth is a Real's value (exact in double)
+  const Real best_d = static_cast<Real>(e.max_depth);
+  const double best_v2 = e.max_speed2;
+  const int chunk_d = 1 + e.depth_chunk, chunk_v = 1 + e.speed_chunk;
   if (best_d > Real(-1)) {  // a cell beat the -1 a scan starts from
     int x = chunk_d;
     while (!(kind[x] == ERODEM_CELL_ACTIVE && d[x] == best_d)) ++x;
@@ -543,7 +614,7 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth, bool material_kno
     row.max_speed_cell = row_cell + x;
     row.speed = std::hypot(static_cast<double>(vx[x]), static_cast<double>(vy[x]));
   }
-  if (!(std::isfinite(water) && std::isfinite(material) && std::isfinite(sed) && min_d >= 0))
+  if (!(std::isfinite(water) && std::isfinite(material) && std::isfinite(sed) && e.min_depth >= 0))
     for (int x = 1; x < W - 1; ++x)
       if (kind[x] == ERODEM_CELL_ACTIVE && !cell::cell_state_ok(bed[x], d[x], sediment[x])) {
         row.bad_cell = row_cell + x;
