@@ -22,8 +22,8 @@ void CpuBackend<Real>::run_erosion(Real dt, StepTally& tally) {
     // Locals, not closure members: stores to Real arrays could alias those.
     const Real step = dt;
     const cell_params::ErosionParams<Real> p = params;
-    const auto eroded_row = row_scratch(W), deposited_row = row_scratch(W);
-    Real *eroded = eroded_row.get(), *deposited = deposited_row.get();
+    Real* eroded = tally_rows(2);
+    Real* deposited = eroded + W;
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
       cell::erosion_sweep_cell(x, y, W, kind, bed, bed_lo, sediment, depth, u, v, hardness, dx, dy,
@@ -59,8 +59,8 @@ void CpuBackend<Real>::run_erosion_physical(Real dt, StepTally& tally) {
     Real *lo_ = bed_lo, *s_ = sediment, *l_ = soil;
     const Real step = dt;
     const cell_params::SedimentParams<Real> p = params;
-    const auto r0 = row_scratch(W), r1 = row_scratch(W), r2 = row_scratch(W), r3 = row_scratch(W);
-    Real *eroded = r0.get(), *deposited = r1.get(), *rock = r2.get(), *bulking = r3.get();
+    Real* eroded = tally_rows(4);
+    Real *deposited = eroded + W, *rock = deposited + W, *bulking = rock + W;
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
       cell::sediment_sweep_cell(x, y, W, k_, b_, lo_, s_, l_, h_, u_, v_, n_, r_, dx_l, dy_l, a_,

@@ -129,12 +129,9 @@ typename CpuBackend<Real>::GenericRows CpuBackend<Real>::cell_rows(const SweepIn
   GenericRows rows;
   rows.row = [this, fields, params, dt](int y) {
     const int W = W_;
-    std::array<std::unique_ptr<Real[]>, nt> scratch;
+    Real* scratch = tally_rows(static_cast<int>(nt));
     std::array<Real*, nt> t{};
-    for (std::size_t k = 0; k < nt; ++k) {
-      scratch[k] = row_scratch(W);
-      t[k] = scratch[k].get();
-    }
+    for (std::size_t k = 0; k < nt; ++k) t[k] = scratch + k * static_cast<std::size_t>(W);
     cell_row<Cell, Args>(y, W, fields, area_.data(), dt, params, t, std::make_index_sequence<nf>{},
                          std::make_index_sequence<nt>{});
     for (std::size_t k = 0; k < nt; ++k)

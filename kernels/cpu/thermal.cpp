@@ -33,12 +33,18 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
   // the new bed in place (rows_in_place): each cell reads its neighbours' old bed
   rows_in_place(bed_.data(), [=](int y, Real* bed_new) {
     const cell_params::ThermalParams<Real> p = params;
-    const auto given_row = row_scratch(W);
-    Real* given = given_row.get();
+    Real* given = tally_rows(1);
+    // the row as row 0 of arrays that start at row y (its neighbours at -W and +W), its kinds
+    // as int (int_kinds_around): the same values, the same operations
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
+    const int* k_row = int_kinds_around(y);
+    const Real *bed_r = bed + row, *wet_r = wet + row, *talus_r = talus + row,
+               *share_r = share + row, *dx_r = dx + y, *dy_r = dy + y, *area_r = area + y;
+    Real* bed_lo_r = bed_lo + row;
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
-      cell::thermal_apply_sweep_cell(x, y, W, kind, bed, bed_lo, wet, talus, share, dx, dy, area, p,
-                                     bed_new + x, given + x);
+      cell::thermal_apply_sweep_cell(x, 0, W, k_row, bed_r, bed_lo_r, wet_r, talus_r, share_r, dx_r,
+                                     dy_r, area_r, p, bed_new + x, given + x);
     row_sums_a_[y] = sum_row(given, static_cast<std::size_t>(W));
   });
   tally.thermal_moved += sum_rows(row_sums_a_);

@@ -22,8 +22,8 @@ void CpuBackend<Real>::run_transport(Real dt, StepTally& tally) {
                *ft = flux_[2].data(), *fb = flux_[3].data();
     rows_in_place(sediment_.data(), [=](int y, Real* sediment_new) {
       const Real step = dt;
-      const auto out_row = row_scratch(W), given_row = row_scratch(W);
-      Real *out = out_row.get(), *given = given_row.get();
+      Real* out = tally_rows(2);
+      Real* given = out + W;
       ERODEM_IVDEP
       for (int x = 1; x < W - 1; ++x)
         cell::transport_conservative_sweep_cell(x, y, W, kind, sediment, depth_flow, fl, fr, ft, fb,

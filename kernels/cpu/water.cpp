@@ -19,19 +19,13 @@ void CpuBackend<Real>::water_row(int y, Real dt, const std::array<const Real*, 4
   const Real step = dt;
   const cell_params::WaterParams<Real> p = cell_.water;
   const int W = W_;
-  const auto clipped = row_scratch(W), given = row_scratch(W);
-  Real* cl = clipped.get();
-  Real* gv = given.get();
-  // The kinds of rows y - 1 .. y + 1 as int: with the kinds' bytes in the loop GCC works on 64
-  // cells at once (AVX-512), four registers for every float value, and spills throughout; with
-  // ints on 16 (performance.md, "The CPU water update"). The row's cells are passed
-  // as row 0 of arrays that start at row y (its neighbours at -W and +W, inside the fields and
-  // the three rows of kinds): the same values, the same operations.
+  Real* cl = tally_rows(2);  // the clipped and the given volumes of the row's cells
+  Real* gv = cl + W;
+  // The row's cells are passed as row 0 of arrays that start at row y (its neighbours at -W
+  // and +W, inside the fields), its kinds as int (int_kinds_around): the same values, the same
+  // operations.
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
-  const auto kinds3 = std::unique_ptr<int[]>(new int[3 * static_cast<std::size_t>(W)]);
-  for (std::ptrdiff_t k = 0; k < 3 * static_cast<std::ptrdiff_t>(W); ++k)
-    kinds3[static_cast<std::size_t>(k)] = kind[row - W + k];
-  const int* k_row = kinds3.get() + W;
+  const int* k_row = int_kinds_around(y);
   const Real *bed_r = bed + row, *depth_r = depth + row, *fl_r = fl + row, *fr_r = fr + row,
              *ft_r = ft + row, *fb_r = fb + row, *dx_r = dx + y, *dy_r = dy + y, *area_r = area + y;
   Real *depth_out_r = depth_out + row, *u_r = u + row, *v_r = v + row;
