@@ -267,7 +267,7 @@ class CpuBackend final : public Backend {
   /// to call; valid until its next call): a pointer to row y's first. Cell loops that compare
   /// their neighbours' kinds take these: with the kinds' bytes, GCC works on 32 or 64 cells at
   /// once, widens every compare and spills throughout (performance.md "The CPU water update",
-  /// "The kinds as int in thermal collapse").
+  /// "The statistics in one pass").
   const int* int_kinds_around(int y) const {
     thread_local std::vector<int> kinds;
     const std::size_t w = static_cast<std::size_t>(W_);
