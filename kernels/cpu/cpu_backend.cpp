@@ -391,19 +391,10 @@ namespace {
 // sums on the stack (a third of the statistics' time, AVX2).
 typedef double Double4 __attribute__((vector_size(32)));
 typedef long long Mask4 __attribute__((vector_size(32)));
-typedef float Float4 __attribute__((vector_size(16)));
 typedef std::uint8_t Byte4 __attribute__((vector_size(4)));
 
 // (results through references: a 32-byte vector returned by value changes the ABI between the
 // v2 build and the others, GCC's -Wpsabi)
-inline void load4(const float* p, Double4& v) {
-  Float4 f;
-  std::memcpy(&f, p, sizeof f);
-  v = __builtin_convertvector(f, Double4);
-}
-inline void load4(const double* p, Double4& v) {
-  std::memcpy(&v, p, sizeof v);
-}
 /// Eight values as two vectors of doubles. (__builtin_convertvector converted two floats at a
 /// time and moved the upper two through the stack; GCC's loop vectoriser converts four.)
 inline void load8(const float* p, Double4& lo, Double4& hi) {

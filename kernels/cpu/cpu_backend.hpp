@@ -146,8 +146,8 @@ class CpuBackend final : public Backend {
   /// The statistics (stats()) of padded row y (1 .. H - 2) with the depths `depth`; the row's
   /// material and sediment volumes summed and kept in material_rows_, or, where
   /// `material_known`, taken from there.
-  /// Cells per chunk of stats_row's maxima: a SIMD reduction each, and at most this many
-  /// cells searched for the one holding a row's largest value.
+  /// Cells per chunk of stats_row's maxima (a multiple of 16: whole vectors of row_pass's
+  /// lanes), and at most this many cells searched for the one holding a row's largest value.
   static constexpr int kStatsChunk = 128;
   RowStats stats_row(int y, const Real* depth, bool material_known);
   /// Whether material_rows_ hold the volumes of the bed and sediment as they are now.
@@ -261,8 +261,6 @@ class CpuBackend final : public Backend {
       p[static_cast<std::size_t>(xs[k]) % kSumLanes] += static_cast<double>(value(xs[k]));
     return sum_lanes(p);
   }
-  /// Per-row scratch of `n` zeros for per-cell tallies. From new[], so GCC knows the pointer
-  /// is not null and if-converts the stores of the cell loops (a vector's data() may be).
   /// The kinds of padded rows y - 1 .. y + 1 as int, in this thread's scratch (kept from call
   /// to call; valid until its next call): a pointer to row y's first. Cell loops that compare
   /// their neighbours' kinds take these: with the kinds' bytes, GCC works on 32 or 64 cells at
@@ -288,6 +286,8 @@ class CpuBackend final : public Backend {
     for (std::size_t r = 0; r < n; r += w) rows[r] = rows[r + w - 1] = Real(0);
     return rows.data();
   }
+  /// `n` zeros: rows_in_place's row buffers, one per thread and pass. (Per-row tallies take
+  /// tally_rows.)
   static std::unique_ptr<Real[]> row_scratch(int n) {
     return std::unique_ptr<Real[]>(new Real[static_cast<std::size_t>(n)]());
   }
