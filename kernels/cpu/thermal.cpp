@@ -12,7 +12,6 @@ namespace ERODEM_CPU_NAMESPACE {
 
 template <class Real>
 void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
-  const Kind* kind = kind_.data();
   const Real *bed = bed_.data(), *dx = dx_.data(), *dy = dy_.data(), *area = area_.data();
   const Real* wet = wetness_.data();
   // The talus slopes are read only where the classes set them (by_class); otherwise any
@@ -25,9 +24,16 @@ void CpuBackend<Real>::run_thermal(Real dt, StepTally& tally) {
     // Locals, not closure members: stores to Real arrays could alias those.
     const Real step = dt;
     const cell_params::ThermalParams<Real> p = params;
+    // the row as row 0 of arrays that start at row y, its kinds as int (as the apply pass below)
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * W;
+    const int* k_row = int_kinds_around(y);
+    const Real *bed_r = bed + row, *wet_r = wet + row, *talus_r = talus + row, *dx_r = dx + y,
+               *dy_r = dy + y, *area_r = area + y;
+    Real* share_r = share + row;
     ERODEM_IVDEP
     for (int x = 1; x < W - 1; ++x)
-      cell::thermal_share_sweep_cell(x, y, W, kind, bed, wet, talus, dx, dy, area, share, step, p);
+      cell::thermal_share_sweep_cell(x, 0, W, k_row, bed_r, wet_r, talus_r, dx_r, dy_r, area_r,
+                                     share_r, step, p);
   });
   exchange_halo({"thermal_share"});  // the apply pass reads the neighbours' shares
   // the new bed in place (rows_in_place): each cell reads its neighbours' old bed
