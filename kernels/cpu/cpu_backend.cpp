@@ -560,8 +560,9 @@ RowStats CpuBackend<Real>::stats_row(int y, const Real* depth, bool material_kno
   const int W = W_;
   const std::int64_t row_cell = static_cast<std::int64_t>(y - 1 + band_.row0) * nx_ - 1;
   // The squared speed ranks the cells (products of floats are exact in double), as in
-  // stats.cl; the winner's speed is hypot below. One expression for the reduction and the
-  // search, which finds the cell by equality with the reduction's value.
+  // stats.cl; the winner's speed is hypot below. The search computes it as row_pass's lanes
+  // and tail do (u * u + v * v in double, never contracted: -ffp-contract=off), so it finds the
+  // cell by equality with row_pass's value.
   auto speed2 = [vx, vy](int x) {
     const double u = vx[x], v = vy[x];
     return u * u + v * v;
