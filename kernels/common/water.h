@@ -92,7 +92,12 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
   /* The outflow limit keeps d_raw >= 0 up to rounding: lift such a rounding-level negative
    * to 0 and book the volume; anything deeper is left for the stability check to stop. */
   const real rounding = (real)64 * ERODEM_EPSILON(real) * (d_old + dt * inflow / area[y]);
-  const int lift = (d_raw < 0) & (d_raw >= -rounding);
+  /* -d_raw <= rounding, not d_raw >= -rounding (the same truth for every value): through the
+   * latter LLVM's SLP pass paired d_raw with the rounding bound, both d_old + dt x / area, in
+   * one vector of two, and PoCL then left water_update and water_erosion scalar across
+   * work-items on AVX2 (5x slower; tests/pocl_vectorisation.sh, performance.md "PoCL's water
+   * update vectorised on AVX2"). */
+  const int lift = (d_raw < 0) & (-d_raw <= rounding);
   const real d_new = lift ? (real)0 : d_raw;
   const real clip = active & lift ? -d_raw * area[y] : (real)0;
   *clipped = clip;
