@@ -75,8 +75,13 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const real e_b = kind[i + W] == ERODEM_CELL_ACTIVE ? x_b : (real)0;
   const real total = e_l + e_r + e_t + e_b;
   const int moves = total > 0;
-  const real m_lr = e_l > e_r ? e_l : e_r, m_tb = e_t > e_b ? e_t : e_b;
-  const real e_max = m_lr > m_tb ? m_lr : m_tb;
+  /* The largest excess as a chain, not as max(max(l, r), max(t, b)): from that pair of pairs
+   * LLVM's SLP pass packed the four excesses two by two into vectors of two, and PoCL then
+   * left thermal_share scalar across work-items on AVX2 (4x slower; tests/pocl_vectorisation.sh).
+   * The same value in any order: every e_* is +0 or positive, never NaN or -0. */
+  const real m_lr = e_l > e_r ? e_l : e_r;
+  const real m_lrt = m_lr > e_t ? m_lr : e_t;
+  const real e_max = m_lrt > e_b ? m_lrt : e_b;
   const real k = rate * dt;
   const real volume = (k < (real)1 ? k : (real)1) * area[y] * e_max * (real)0.5;
   const real per_excess = volume / (moves ? total : (real)1);
