@@ -15,13 +15,15 @@
 # where that code is inlined, the loop stays and tests every local id. Exit 77 (skipped) without a PoCL CPU device, or where PoCL vectorises
 # nothing 8 wide (no AVX). The counts belong to one PoCL and LLVM (Debian's PoCL 3.1, LLVM 15)
 # and to the CPU's vector width: one table for CPUs with AVX-512 (measured 2026-11-23 on a
-# 2-vCPU AMD EPYC with AVX-512), one for AVX2 without it (measured 2026-11-25 on a 2-vCPU AMD
-# EPYC without AVX-512, where PoCL leaves flow_pipes, water_update and thermal_share scalar
-# with the code before the bed pair too, so its 8-wide counts are lower). The peeled counts
+# 2-vCPU AMD EPYC with AVX-512), one for AVX2 without it (first measured 2026-11-25 on a 2-vCPU
+# AMD EPYC without AVX-512, where PoCL then left flow_pipes, water_update and thermal_share
+# scalar, so its 8-wide counts were lower; measured again 2026-11-30, below, where only
+# flow_pipes stays scalar). The peeled counts
 # grew by the group sums of erosion, transport and thermal (the ledger's moved volumes). The
 # AVX-512 table was checked again on 2026-11-26: the cell velocity from the faces' flow depths
 # (water.h) had left water_update scalar there (36 < 39: SLP packed its four face depths),
-# which the AVX2 table could not show, since PoCL leaves water_update scalar on AVX2 anyway.
+# which the AVX2 table could not show, since PoCL left water_update scalar on AVX2 until
+# 2026-11-30.
 # The AVX2 table was checked again on 2026-11-27 (a 2-vCPU AMD EPYC without AVX-512, the CI
 # machine that day): both conservative cases counted 3 loops fewer than on 2026-11-25 (30 < 33,
 # 21 < 24; the semi-Lagrangian ones as before), with the kernel sources of that morning too,

@@ -77,7 +77,9 @@ ERODEM_FN real thermal_share_cell(int x, int y, int W, GLOBAL const erodem_kind_
   const int moves = total > 0;
   /* The largest excess as a chain, not as max(max(l, r), max(t, b)): from that pair of pairs
    * LLVM's SLP pass packed the four excesses two by two into vectors of two, and PoCL then
-   * left thermal_share scalar across work-items on AVX2 (4x slower; tests/pocl_vectorisation.sh).
+   * left thermal_share scalar across work-items on AVX2 (4.6 against 1.13 ms per call at
+   * 1024^2; tests/pocl_vectorisation.sh, performance.md "PoCL's water update and thermal share
+   * vectorised on AVX2").
    * The same value in any order: every e_* is +0 or positive, never NaN or -0. */
   const real m_lr = e_l > e_r ? e_l : e_r;
   const real m_lrt = m_lr > e_t ? m_lr : e_t;

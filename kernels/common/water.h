@@ -93,10 +93,10 @@ ERODEM_FN void water_update_cell(int x, int y, int W, GLOBAL const erodem_kind_t
    * to 0 and book the volume; anything deeper is left for the stability check to stop. */
   const real rounding = (real)64 * ERODEM_EPSILON(real) * (d_old + dt * inflow / area[y]);
   /* -d_raw <= rounding, not d_raw >= -rounding (the same truth for every value): through the
-   * latter LLVM's SLP pass paired d_raw with the rounding bound, both d_old + dt x / area, in
-   * one vector of two, and PoCL then left water_update and water_erosion scalar across
-   * work-items on AVX2 (5x slower; tests/pocl_vectorisation.sh, performance.md "PoCL's water
-   * update vectorised on AVX2"). */
+   * latter LLVM's SLP pass paired d_raw with the sum inside the rounding bound, both
+   * d_old + dt x / area, in one vector of two, and PoCL then left water_update and water_erosion
+   * scalar across work-items on AVX2 (about 4.5x slower; tests/pocl_vectorisation.sh,
+   * performance.md "PoCL's water update and thermal share vectorised on AVX2"). */
   const int lift = (d_raw < 0) & (-d_raw <= rounding);
   const real d_new = lift ? (real)0 : d_raw;
   const real clip = active & lift ? -d_raw * area[y] : (real)0;
