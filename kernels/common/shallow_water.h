@@ -560,7 +560,7 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
  * update: sw_velocity (eastwards and northwards, m/s) with h_eps the water update's
  * velocity_min_depth (m): the velocity the other processes, the statistics and the adaptive
  * step read. 0 on other cells. The generic sweep "shallow_water_velocity" of the water
- * process (kernels/cpu/sweeps.cpp, kernels/opencl/shallow_water.cl). */
+ * process (kernels/cpu/sweeps.cpp, kernels/opencl/water.cl). */
 ERODEM_FN void shallow_water_velocity_sweep_cell(int x, int y, int W,
                                                  GLOBAL const erodem_kind_t* kind,
                                                  GLOBAL const real* depth, GLOBAL const real* q_x,
@@ -571,9 +571,15 @@ ERODEM_FN void shallow_water_velocity_sweep_cell(int x, int y, int W,
   (void)dt;
   const int i = x + y * W;
   const int active = (x >= 1) & (x <= W - 2) & (kind[i] == ERODEM_CELL_ACTIVE);
-  const real h = depth[i];
-  velocity_x[i] = active ? sw_velocity(q_x[i], h, p.velocity_min_depth) : (real)0;
-  velocity_y[i] = active ? sw_velocity(q_y[i], h, p.velocity_min_depth) : (real)0;
+  /* every load unconditional and the results selected: with the unit discharges loaded under
+   * `active`, clang kept a branch around both velocities, LLVM's SLP pass paired them in a vector
+   * of two at its end, and PoCL left the kernel scalar across work-items on AVX2 ("instruction
+   * return type cannot be vectorized"; tests/pocl_vectorisation.sh) */
+  const real h = depth[i], qx = q_x[i], qy = q_y[i];
+  const real u = sw_velocity(qx, h, p.velocity_min_depth);
+  const real v = sw_velocity(qy, h, p.velocity_min_depth);
+  velocity_x[i] = active ? u : (real)0;
+  velocity_y[i] = active ? v : (real)0;
 }
 
 ERODEM_END_NAMESPACE
