@@ -17,8 +17,8 @@
 # and to the CPU's vector width: one table for CPUs with AVX-512 (measured 2026-11-23 on a
 # 2-vCPU AMD EPYC with AVX-512), one for AVX2 without it (first measured 2026-11-25 on a 2-vCPU
 # AMD EPYC without AVX-512, where PoCL then left flow_pipes, water_update and thermal_share
-# scalar, so its 8-wide counts were lower; measured again 2026-11-30, below, where of the cell
-# kernels of the interior only flow_pipes_interior stays scalar). The peeled counts
+# scalar, so its 8-wide counts were lower; measured again 2026-11-30, below, where every cell
+# kernel of the interior is now 8 wide). The peeled counts
 # grew by the group sums of erosion, transport and thermal (the ledger's moved volumes). The
 # AVX-512 table was checked again on 2026-11-26: the cell velocity from the faces' flow depths
 # (water.h) had left water_update scalar there (36 < 39: SLP packed its four face depths),
@@ -46,8 +46,9 @@
 # both `d_old + dt * x / area`) into one vector of two, reached through the comparison
 # `d_raw >= -rounding`; written `-d_raw <= rounding` (the same truth for every value) it no
 # longer does. Then 48, 54, 39 and 45 once thermal_share vectorised too (its largest excess as a
-# chain: thermal.h). Its bounds are those counts. flow_pipes_interior stays scalar there (an SLP
-# pack of two pipes, docs/testing.md "Known gaps").
+# chain: thermal.h). Then 48, 54, 48 and 54 once the pipes' kernels vectorised (flow_pipes_interior
+# 3 loops, flow_pipes 6: each pipe a block of its own, which LLVM's SLP pass cannot pack with
+# another, flow.h). Its bounds are those counts.
 # On AVX2 it also counts the masked stores (vmaskmovps and its kin, `vmaskmovps %ymmA,%ymmB,MEM`
 # in objdump's syntax; AMD's Zen cores run them as microcode) in the kernels PoCL compiled and
 # cached: a load under a per-cell condition becomes a masked load, and the store of
@@ -88,17 +89,18 @@ pipes semi_lagrangian 48 9 27'
 else
   table='local_inertial conservative 48 0 27
 local_inertial semi_lagrangian 54 0 27
-pipes conservative 39 0 27
-pipes semi_lagrangian 45 0 27'
+pipes conservative 48 0 27
+pipes semi_lagrangian 54 0 27'
   isa="AVX2 (no AVX-512)"
   count_masked_stores=1
   # The kernels PoCL leaves without a vectorised loop here (2026-11-30, per kernel): those of
   # the edges and the per-row merge (ghost columns, the clamped first and last rows of the
-  # flow, the list of cells beside a ghost, whose gathers the cost model declines; stats_rows'
-  # loop over a row's partials), and flow_pipes_interior (an SLP pack of two pipes,
-  # docs/testing.md "Known gaps"). Any other kernel without one fails. Not applied on AVX-512,
-  # where the per-kernel view was not measured (it is printed there).
-  expected_scalar="boundary_fill stats_rows flow_local_inertial_faces flow_local_inertial_split flow_pipes flow_pipes_interior edge_tallies"
+  # local-inertial flow, the list of cells beside a ghost, whose gathers the cost model
+  # declines; stats_rows' loop over a row's partials). Any other kernel without one fails (the
+  # pipes' flow_pipes and flow_pipes_interior were scalar until 2026-11-30, 16:00 UTC: an SLP
+  # pack of two pipes, flow.h). Not applied on AVX-512, where the per-kernel view was not
+  # measured (it is printed there).
+  expected_scalar="boundary_fill stats_rows flow_local_inertial_faces flow_local_inertial_split edge_tallies"
   # and of the processes the four benchmarks above do not run (the rows below): the
   # shallow-water flow of both orders (flow_shallow_water, flow_shallow_water_muscl: LLVM's SLP
   # pass packs the desingularised velocity's denominators of a cell and its east neighbour,

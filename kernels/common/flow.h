@@ -57,13 +57,29 @@ ERODEM_FN real outflow_limit(real depth, real cell_area, real total_out, real dt
 
 /* ---- pipes (Mei, Decaudin & Hu 2007) ------------------------------------------------ */
 
+/* One pipe of the pipes scheme: its previous outflow f (m^3/s) plus c dh / length, with
+ * c = dt A g (m^3/s), dh the surface drop towards the neighbour (m) and length the pipe's (m);
+ * floored at 0 (a comparison: NaN gives 0, as fmax does, and GCC vectorises it); 0 where the
+ * cell gives no water that way (`gives` 0). Computed in a block of its own, under `gives`: LLVM's
+ * SLP pass packs alike instructions of one block into short vectors, and with the four pipes in
+ * one block it packed two of them, after which PoCL did not vectorise the kernel across
+ * work-items (the flow 6 times slower on AVX2: performance.md, "The pipes on PoCL, across
+ * work-items"). The loop vectorisers (PoCL's, GCC's) turn the blocks into selects again. */
+ERODEM_FN_INLINED real pipe_outflow(int gives, real f, real c, real dh, real length) {
+  real out = (real)0;
+  if (gives) {
+    const real p = f + c * dh / length;
+    out = p > 0 ? p : (real)0;
+  }
+  return out;
+}
+
 /* The pipes scheme (Mei, Decaudin & Hu 2007) for a cell of kind k with neighbours of kinds
  * k_left .. k_bottom: surface eta = bed + depth of the cell and eta_* of the neighbours (m),
  * its previous outflows f_* (m^3/s), pipe lengths across x and towards the cells north and
  * south (m), its depth (m) and area (m^2); dt (s), gravity g (m/s^2), pipe_area A (m^2). Active and
- * fixed-level cells give water to neighbours that take it (gives_water); an active cell's outflows
- * are then limited to what it holds. Branch-free: every pipe is computed and the ones that carry
- * nothing are replaced by 0. */
+ * fixed-level cells give water to neighbours that take it (gives_water); a pipe that carries
+ * nothing is 0; an active cell's outflows are then limited to what it holds. */
 ERODEM_FN void flow_pipes_outflows(int k, int k_left, int k_right, int k_top, int k_bottom,
                                    real eta, real eta_left, real eta_right, real eta_top,
                                    real eta_bottom, real f_left, real f_right, real f_top,
@@ -71,25 +87,17 @@ ERODEM_FN void flow_pipes_outflows(int k, int k_left, int k_right, int k_top, in
                                    real length_bottom, real depth, real cell_area, real dt,
                                    real gravity, real pipe_area, real* out_left, real* out_right,
                                    real* out_top, real* out_bottom) {
-  /* Each pipe: f <- max(0, f + dt A g dh / l), dh the surface drop towards the neighbour.
-   * The four are written in four forms that give the same numbers (c dh = dh c, and
-   * f + c (a - b) / l = f - c (b - a) / l exactly; a zero's sign aside, which the max
-   * removes): written alike, PoCL's SLP vectoriser packs them into a 4-vector and then does
-   * not vectorise the kernel across work-items (8 times slower). The max as a comparison
-   * (NaN gives 0, as fmax does), which GCC vectorises. */
+  /* Each pipe: f <- max(0, f + dt A g dh / l) (pipe_outflow). The limit is computed for every
+   * cell and then selected: computed under the kind's test, the row's area was loaded in a
+   * branch, which PoCL's vectoriser made a scalar load per work-item. */
   const real c = dt * pipe_area * gravity;
-  const real fl = f_left + c * (eta - eta_left) / length_x;
-  const real fr = f_right - c * (eta_right - eta) / length_x;
-  const real ft = f_top + (eta - eta_top) * c / length_top;
-  const real fb = f_bottom - (eta_bottom - eta) * c / length_bottom;
-  const real pl = fl > 0 ? fl : (real)0, pr = fr > 0 ? fr : (real)0;
-  const real pt = ft > 0 ? ft : (real)0, pb = fb > 0 ? fb : (real)0;
-  const real gl = gives_water(k, k_left) ? pl : (real)0;
-  const real gr = gives_water(k, k_right) ? pr : (real)0;
-  const real gt = gives_water(k, k_top) ? pt : (real)0;
-  const real gb = gives_water(k, k_bottom) ? pb : (real)0;
-  const real K =
-      k == ERODEM_CELL_ACTIVE ? outflow_limit(depth, cell_area, gl + gr + gt + gb, dt) : (real)1;
+  const real gl = pipe_outflow(gives_water(k, k_left), f_left, c, eta - eta_left, length_x);
+  const real gr = pipe_outflow(gives_water(k, k_right), f_right, c, eta - eta_right, length_x);
+  const real gt = pipe_outflow(gives_water(k, k_top), f_top, c, eta - eta_top, length_top);
+  const real gb =
+      pipe_outflow(gives_water(k, k_bottom), f_bottom, c, eta - eta_bottom, length_bottom);
+  const real limit = outflow_limit(depth, cell_area, gl + gr + gt + gb, dt);
+  const real K = k == ERODEM_CELL_ACTIVE ? limit : (real)1;
   *out_left = gl * K;
   *out_right = gr * K;
   *out_top = gt * K;
