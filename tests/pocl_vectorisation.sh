@@ -106,7 +106,9 @@ pipes semi_lagrangian 54 0 27'
   # pass packs the desingularised velocity's denominators of a cell and its east neighbour,
   # sw_velocity in shallow_water.h, and the work-item loop is refused with "instruction return
   # type cannot be vectorized"; without that pack the cost model declines the loop for its
-  # clamped neighbour indices: performance.md "PoCL per kernel"),
+  # clamped neighbour indices: performance.md "PoCL per kernel"; on CPU devices the first
+  # order's flow_shallow_water runs only the first and last row since 2026-11-30, the interior
+  # rows by flow_shallow_water_interior, which is 8 wide and checked),
   # infiltration (Newton's iterations with an early exit, run only where they decide the take:
   # infiltration.h) and the terrain classes (a call PoCL does not vectorise; every
   # terrain_classes.interval steps).

@@ -224,10 +224,10 @@ TEST(ProcessTable, StateAndOutputFieldsAreTheListsOfBefore) {
 TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
   // the cell kernels whose work-group the OpenCL backend queried from its own list (before
   // 2026-11-26), the snow pack's (with snow.temperature_grids: snow_gridded), the shallow-water
-  // second order's, infiltration's, the stage hydrograph's and the terrain classes' (added
-  // through the table), as a set; the program in step order (the terrain classes first)
-  // (flow before sources since they run after it; before, the files were listed in the enum's
-  // order)
+  // second order's and first-order interior's (with its velocities), infiltration's, the stage
+  // hydrograph's and the terrain classes' (added through the table), as a set; the program in step
+  // order (the terrain classes first) (flow before sources since they run after it; before, the
+  // files were listed in the enum's order)
   const auto k = opencl_cell_kernels();
   EXPECT_EQ(std::set<std::string>(k.begin(), k.end()),
             (std::set<std::string>{"sources_rain",
@@ -254,12 +254,14 @@ TEST(ProcessTable, OpenClKernelsAndProgramOrder) {
                                    "boundary_level",
                                    "terrain_class",
                                    "flow_shallow_water",
+                                   "flow_shallow_water_velocities",
+                                   "flow_shallow_water_interior",
                                    "flow_shallow_water_muscl",
                                    "flow_shallow_water_stage_depth",
                                    "shallow_water_velocity",
                                    "field_stats",
                                    "edge_tallies"}));
-  EXPECT_EQ(k.size(), 29u) << "a kernel listed twice";
+  EXPECT_EQ(k.size(), 31u) << "a kernel listed twice";
   EXPECT_EQ(opencl_program_order(),
             (std::vector<std::string>{"reduce.cl", "terrain_class.cl", "boundary.cl", "flow.cl",
                                       "sources.cl", "water.cl", "erosion.cl", "transport.cl",

@@ -124,8 +124,10 @@ ERODEM_FN void pipe_lengths(int y, int y_top, int y_bottom, GLOBAL const real* d
  * writes out_*. Every index it reads lies inside the raster in these rows, so it reads
  * without clamping, and the per-row values come in as numbers: loops over x vectorise. In the
  * first and last column x - 1 and x + 1 reach across the row ends to halo cells of the rows
- * above and below; the halo is never active, so no pipe between two halo cells carries water
- * (gives_water) and those reads need no mask (a mask on x kept GCC from vectorising). */
+ * above and below; the halo is not active, so no pipe between two halo cells carries water
+ * (gives_water) and those reads need no mask (a mask on x kept GCC from vectorising). With
+ * boundary.periodic_x the ghost columns are active, and what they compute there is overwritten
+ * by the halo exchange after the flow (the copies of the columns they repeat). */
 ERODEM_FN void flow_pipes_cell_interior(
     int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
     GLOBAL const real* depth, real length_x, real length_top, real length_bottom, real cell_area,
@@ -411,8 +413,7 @@ ERODEM_FN void local_inertial_split(int k, int k_left, int k_right, int k_top, i
   const real fb = gives_water(k, k_bottom) & (q_bottom > 0) ? q_bottom : (real)0;
   /* the limit for every cell, then selected: under the condition, its division (and the
    * row's area with it) went into a branch that PoCL turned into a gather per iteration
-   * (15.1 -> 14.4 ms at 4096^2). (The same in flow_pipes_outflows lets SLP pack its four
-   * pipes, so there the condition stays.) */
+   * (15.1 -> 14.4 ms at 4096^2), as in flow_pipes_outflows. */
   const real limit = outflow_limit(depth, cell_area, fl + fr + ft + fb, dt);
   const real K = k == ERODEM_CELL_ACTIVE ? limit : (real)1;
   *out_left = fl * K;

@@ -313,41 +313,34 @@ ERODEM_INLINE int sw_south_face_row(int y, int H) {
 /* The shallow-water step of padded cell i of row y (shallow_water_cell_update), its neighbours'
  * kinds k_* and indices i_* (west, east, north, south) and the rows y_n, y_s of its north and
  * south faces (the faces between rows y_n and y_n + 1, y_s and y_s + 1), from the state at the
- * start of the step: depth, bed, unit discharges q_x (east), q_y (north) (m^2/s), Manning n
- * (s m^-1/3; the cell's at index i_manning: param_index), the rows' dx, dy (m) and cell areas
- * (m^2); dt (s); p.gravity (m/s^2) and
- * p.dry_depth (m: velocities are desingularised below it). Writes the cell's outflows (m^3/s)
- * and unit discharges into the second buffers. Each cell computes the four faces around it
- * (every face twice over the grid, by the same function with the same arguments, so both sides
- * see the same bits; the CPU loop computes each once, with those arguments). Written through
- * shallow_water_stage_store, as a first stage. */
-ERODEM_FN_INLINED void shallow_water_cell_at(
+ * start of the step: depth, bed, unit discharges q_x (east), q_y (north) (m^2/s), and the
+ * velocities (m/s, eastwards u and northwards v: sw_velocity with h_eps = p.dry_depth) of the
+ * cell (u, v) and of its four neighbours (u_w, v_w ... u_s, v_s); Manning n (s m^-1/3; the cell's
+ * at index i_manning: param_index), the rows' dx, dy (m) and cell areas (m^2); dt (s); p.gravity
+ * (m/s^2) and p.dry_depth (m). Writes the cell's outflows (m^3/s) and unit discharges into the
+ * second buffers. Each cell computes the four faces around it (every face twice over the grid, by
+ * the same function with the same arguments, so both sides see the same bits; the CPU loop
+ * computes each once, with those arguments). Written through shallow_water_stage_store, as a
+ * first stage. */
+ERODEM_FN_INLINED void shallow_water_cell_uv(
     int i, int y, int k_w, int k_e, int k_n, int k_s, int i_w, int i_e, int i_n, int i_s, int y_n,
     int y_s, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed, GLOBAL const real* depth,
-    GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* manning, int i_manning,
+    GLOBAL const real* q_x, GLOBAL const real* q_y, real u, real v, real u_w, real v_w, real u_e,
+    real v_e, real u_n, real v_n, real u_s, real v_s, GLOBAL const real* manning, int i_manning,
     GLOBAL const real* dx, GLOBAL const real* dy, GLOBAL const real* area, real dt,
     ERODEM_P(FlowParams) p, GLOBAL real* out_left, GLOBAL real* out_right, GLOBAL real* out_top,
     GLOBAL real* out_bottom, GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
   const int k = kind[i];
   const real g = p.gravity, eps = p.dry_depth;
   const real h = depth[i], z = bed[i];
-  const real u = sw_velocity(q_x[i], h, eps), v = sw_velocity(q_y[i], h, eps);
   /* east face: a = this cell, b = east; normal east, tangent north */
-  const ERODEM_S(SwFace) e =
-      sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], sw_velocity(q_x[i_e], depth[i_e], eps),
-              sw_velocity(q_y[i_e], depth[i_e], eps), g, eps);
+  const ERODEM_S(SwFace) e = sw_face(k, k_e, h, z, u, v, depth[i_e], bed[i_e], u_e, v_e, g, eps);
   /* west face: a = west, b = this cell */
-  const ERODEM_S(SwFace) w =
-      sw_face(k_w, k, depth[i_w], bed[i_w], sw_velocity(q_x[i_w], depth[i_w], eps),
-              sw_velocity(q_y[i_w], depth[i_w], eps), h, z, u, v, g, eps);
+  const ERODEM_S(SwFace) w = sw_face(k_w, k, depth[i_w], bed[i_w], u_w, v_w, h, z, u, v, g, eps);
   /* south face: a = this cell, b = south; normal south (velocity -v), tangent east (u) */
-  const ERODEM_S(SwFace) s =
-      sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -sw_velocity(q_y[i_s], depth[i_s], eps),
-              sw_velocity(q_x[i_s], depth[i_s], eps), g, eps);
+  const ERODEM_S(SwFace) s = sw_face(k, k_s, h, z, -v, u, depth[i_s], bed[i_s], -v_s, u_s, g, eps);
   /* north face: a = north, b = this cell */
-  const ERODEM_S(SwFace) nf =
-      sw_face(k_n, k, depth[i_n], bed[i_n], -sw_velocity(q_y[i_n], depth[i_n], eps),
-              sw_velocity(q_x[i_n], depth[i_n], eps), h, z, -v, u, g, eps);
+  const ERODEM_S(SwFace) nf = sw_face(k_n, k, depth[i_n], bed[i_n], -v_n, u_n, h, z, -v, u, g, eps);
   /* face lengths: x-faces the row's dy; y-faces the mean dx of their two rows */
   const ERODEM_S(SwCell) c = shallow_water_cell_update(
       k, h, q_x[i], q_y[i], manning[i_manning], dy[y], face_y_width(dx, y_n), face_y_width(dx, y_s),
@@ -536,8 +529,8 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell(
                             q_y_new);
 }
 
-/* shallow_water_cell_at for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices
- * clamped into the raster, their kinds outside it walls. */
+/* shallow_water_cell_uv for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices
+ * clamped into the raster, their kinds outside it walls, every velocity computed here. */
 ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,
                                   GLOBAL const real* bed, GLOBAL const real* depth,
                                   GLOBAL const real* q_x, GLOBAL const real* q_y,
@@ -548,12 +541,57 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
                                   GLOBAL real* out_bottom, GLOBAL real* q_x_new,
                                   GLOBAL real* q_y_new) {
   const int i = x + y * W;
-  shallow_water_cell_at(i, y, kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
-                        kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H),
-                        x >= 1 ? i - 1 : i, x + 1 < W ? i + 1 : i, y >= 1 ? i - W : i,
-                        y + 1 < H ? i + W : i, sw_north_face_row(y), sw_south_face_row(y, H), kind,
-                        bed, depth, q_x, q_y, manning, param_index(x, y, p.manning_pitch), dx, dy,
-                        area, dt, p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
+  const int i_w = x >= 1 ? i - 1 : i, i_e = x + 1 < W ? i + 1 : i;
+  const int i_n = y >= 1 ? i - W : i, i_s = y + 1 < H ? i + W : i;
+  const real eps = p.dry_depth;
+  shallow_water_cell_uv(
+      i, y, kind_at(kind, x - 1, y, W, H), kind_at(kind, x + 1, y, W, H),
+      kind_at(kind, x, y - 1, W, H), kind_at(kind, x, y + 1, W, H), i_w, i_e, i_n, i_s,
+      sw_north_face_row(y), sw_south_face_row(y, H), kind, bed, depth, q_x, q_y,
+      sw_velocity(q_x[i], depth[i], eps), sw_velocity(q_y[i], depth[i], eps),
+      sw_velocity(q_x[i_w], depth[i_w], eps), sw_velocity(q_y[i_w], depth[i_w], eps),
+      sw_velocity(q_x[i_e], depth[i_e], eps), sw_velocity(q_y[i_e], depth[i_e], eps),
+      sw_velocity(q_x[i_n], depth[i_n], eps), sw_velocity(q_y[i_n], depth[i_n], eps),
+      sw_velocity(q_x[i_s], depth[i_s], eps), sw_velocity(q_y[i_s], depth[i_s], eps), manning,
+      param_index(x, y, p.manning_pitch), dx, dy, area, dt, p, out_left, out_right, out_top,
+      out_bottom, q_x_new, q_y_new);
+}
+
+/* The velocities the shallow-water faces read, of padded cell (x, y): sw_velocity of its unit
+ * discharges q_x, q_y (m^2/s) over its depth (m) with h_eps = dry_depth (m), into u, v (m/s),
+ * every cell. For shallow_water_cell_interior, which then reads them instead of computing each
+ * cell's five times (once as itself, once as each neighbour's neighbour); the same values. */
+ERODEM_FN void shallow_water_flow_velocity_cell(int x, int y, int W, GLOBAL const real* depth,
+                                                GLOBAL const real* q_x, GLOBAL const real* q_y,
+                                                real dry_depth, GLOBAL real* u, GLOBAL real* v) {
+  const int i = x + y * W;
+  const real h = depth[i], qx = q_x[i], qy = q_y[i];
+  u[i] = sw_velocity(qx, h, dry_depth);
+  v[i] = sw_velocity(qy, h, dry_depth);
+}
+
+/* shallow_water_cell_uv for padded cell (x, y) of a row 1 <= y <= H - 2, any 0 <= x <= W - 1,
+ * with the velocities u, v of every cell (shallow_water_flow_velocity_cell): the neighbours at
+ * i -+ 1 and i -+ W without clamping, their kinds as they are, so the loads of a row are
+ * consecutive (PoCL vectorises the loop over x on CPU devices). In the first and last column
+ * x - 1 and x + 1 reach across the row ends to the ghost column of the row above or below, where
+ * shallow_water_cell clamps to the cell itself, a wall: a ghost cell's face with another ghost
+ * carries nothing either way (sw_face: no flux between two ghosts), and a ghost's other results
+ * do not read that face (its unit discharges are kept; it gives only through its faces with
+ * active cells), so the results are the same. */
+ERODEM_FN void shallow_water_cell_interior(
+    int x, int y, int W, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
+    GLOBAL const real* depth, GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* u,
+    GLOBAL const real* v, GLOBAL const real* manning, GLOBAL const real* dx, GLOBAL const real* dy,
+    GLOBAL const real* area, real dt, ERODEM_P(FlowParams) p, GLOBAL real* out_left,
+    GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+    GLOBAL real* q_y_new) {
+  const int i = x + y * W;
+  shallow_water_cell_uv(i, y, kind[i - 1], kind[i + 1], kind[i - W], kind[i + W], i - 1, i + 1,
+                        i - W, i + W, y - 1, y, kind, bed, depth, q_x, q_y, u[i], v[i], u[i - 1],
+                        v[i - 1], u[i + 1], v[i + 1], u[i - W], v[i - W], u[i + W], v[i + W],
+                        manning, param_index(x, y, p.manning_pitch), dx, dy, area, dt, p, out_left,
+                        out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* The velocity of padded cell (x, y) from its unit discharges and its depth after the water

@@ -163,6 +163,38 @@ __kernel void flow_shallow_water(
                      out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
+/* The velocities the shallow-water faces read (shallow_water_flow_velocity_cell), every padded
+ * cell, into u, v: scratch for flow_shallow_water_interior, on CPU devices. */
+__kernel void flow_shallow_water_velocities(int W, int H, __global const real* restrict depth,
+                                            __global const real* restrict q_x,
+                                            __global const real* restrict q_y, FlowParams p,
+                                            __global real* restrict u, __global real* restrict v) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W) || y >= H) return;
+  shallow_water_flow_velocity_cell(x, y, W, depth, q_x, q_y, p.dry_depth, u, v);
+}
+
+/* The shallow-water scheme on rows 1 .. H - 2 (shallow_water_cell_interior) from the velocities
+ * flow_shallow_water_velocities wrote: no clamping, and no velocity computed five times, so
+ * PoCL vectorises it across work-items on CPU devices (flow_shallow_water, whose velocities
+ * LLVM's SLP pass packs in pairs, does not). The host runs it on CPU devices, with
+ * flow_shallow_water on rows 0 and H - 1; on other devices flow_shallow_water on every row. */
+__kernel void flow_shallow_water_interior(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict q_x,
+    __global const real* restrict q_y, __global const real* restrict u,
+    __global const real* restrict v, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict area, real dt, FlowParams p, __global real* restrict out_left,
+    __global real* restrict out_right, __global real* restrict out_top,
+    __global real* restrict out_bottom, __global real* restrict q_x_new,
+    __global real* restrict q_y_new) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W)) return;
+  shallow_water_cell_interior(x, y, W, kind, bed, depth, q_x, q_y, u, v, manning, dx, dy, area, dt,
+                              p, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
+}
+
 /* The shallow-water scheme's second order (flow.order = 2, shallow_water.h): a stage of Heun's
  * method with MUSCL faces, one work-item per padded cell (rows 0 .. H - 1); `combine` 0 for the
  * first stage, 1 for the second (averaged into what out_* and q_*_new hold). */

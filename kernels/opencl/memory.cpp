@@ -87,9 +87,9 @@ Buffer& OpenClBackend::second_for(Buffer& second, const Buffer& field) {
 const Buffer& OpenClBackend::depth_flow() {
   if (depth_next_scratch_)
     throw Error(ExitCode::internal,
-                "OpenCL: the depth the water update started from is read after the face pass or "
-                "thermal collapse held their scratch in its buffer, with no water update between "
-                "(process order)");
+                "OpenCL: the depth the water update started from is read after the face pass, the "
+                "shallow-water velocities or thermal collapse held their scratch in its buffer, "
+                "with no water update between (process order)");
   return made(depth_next_, &depth_);  // before any water update: the depth as it is
 }
 

@@ -549,7 +549,25 @@ void OpenClBackend::run_flow(Real dt) {
     cl_kernel k = kernel("flow_shallow_water");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_, dt,
              cell_.flow, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
-    launch_rows(k, 0, H_);
+    if (whole_rows()) {
+      // CPU devices: the velocities first, into scratch buffers that hold nothing alive during
+      // the flow (as local inertial's faces), then the interior rows by a kernel that reads them
+      // without clamping (it vectorises), the first and last row by the general one; the same
+      // bits as the general kernel on every row (shallow_water_cell_interior)
+      const Buffer& u = depth_next_as_scratch();
+      const Buffer& v = made(spare_);
+      cl_kernel vel = kernel("flow_shallow_water_velocities");
+      set_args(vel, cl_int{W_}, cl_int{H_}, depth_, qx, qy, cell_.flow, u, v);
+      launch_rows(vel, 0, H_);
+      cl_kernel in = kernel("flow_shallow_water_interior");
+      set_args(in, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, u, v, manning_, dx_, dy_,
+               area_, dt, cell_.flow, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
+      launch_rows(in, 1, H_ - 1);
+      launch_rows(k, 0, 1);
+      launch_rows(k, H_ - 1, H_);
+    } else {
+      launch_rows(k, 0, H_);
+    }
     std::swap(qx, qx_next);
     std::swap(qy, qy_next);
     return;

@@ -300,8 +300,8 @@ class OpenClBackend final : public Backend {
   /// A buffer of `n_` Reals of zeros.
   Buffer zero_field() { return filled_field(Real(0)); }
   /// `b` made on first use, for the buffers a run may never need (the bed's and the sediment's
-  /// second buffers without erosion, thermal collapse or transport; the face fields without
-  /// local inertial): a buffer of n_
+  /// second buffers without erosion, thermal collapse or transport; the scratch of local
+  /// inertial's faces and of the first-order shallow water's velocities): a buffer of n_
   /// Reals, a copy of `like` where given (what the cells a kernel leaves untouched must hold),
   /// else zeros. Returns `b`.
   Buffer& made(Buffer& b, const Buffer* like = nullptr);
@@ -313,8 +313,9 @@ class OpenClBackend final : public Backend {
   /// sections' and the edges' sediment): made as a copy of the depth before any water update;
   /// Error(internal) where it holds scratch (depth_next_scratch_).
   const Buffer& depth_flow();
-  /// depth_next_ to hold scratch (the face pass's east faces, the thermal shares) until the
-  /// next water update: made on first use, and marked so that depth_flow refuses it.
+  /// depth_next_ to hold scratch (the face pass's east faces, the first-order shallow water's
+  /// eastward velocities on CPU devices, the thermal shares) until the next water update: made
+  /// on first use, and marked so that depth_flow refuses it.
   Buffer& depth_next_as_scratch();
   /// Copies rows 0 and H - 1 of `from` into `to`: a second buffer that held scratch gets the
   /// rows its update leaves as they are.
@@ -419,15 +420,17 @@ class OpenClBackend final : public Backend {
   Buffer bed_, bed0_, bed_residual_, depth_, sediment_;
   // The depth the water update started from, for conservative transport ("depth_flow"). From
   // the transport to the next water update nothing reads it, and it holds thermal collapse's
-  // shares between its two passes ("thermal_share") and the local-inertial face pass's east
-  // faces (discharge, m^3/s) until its cell pass: second_for restores its rows 0 and H - 1,
+  // shares between its two passes ("thermal_share"), the local-inertial face pass's east
+  // faces (discharge, m^3/s) until its cell pass and, on CPU devices, the first-order shallow
+  // water's eastward velocities (m/s) during its flow: second_for restores its rows 0 and H - 1,
   // which the water update does not write, before that update. Made on first use.
   Buffer depth_next_;
-  bool depth_next_scratch_ = false;  // it holds the faces or the shares, not a depth
+  bool depth_next_scratch_ = false;  // it holds faces, velocities or shares, not a depth
   // The spare: the second buffer of the bed and of the sediment (erosion, thermal collapse and
   // the transport write their field's new values into it, and the two swap: second_for), and
-  // the local-inertial face pass's south faces (discharge, m^3/s) until its cell pass. One
-  // buffer for the three, as none of them is alive when another begins. bed_next_ is its name
+  // the local-inertial face pass's south faces (discharge, m^3/s) until its cell pass, or on
+  // CPU devices the first-order shallow water's northward velocities (m/s) during its flow. One
+  // buffer for them all, as none of them is alive when another begins. bed_next_ is its name
   // for the field registry (the bed's twin); sediment_next_ is never made (field_registry.hpp
   // binds both names on both backends).
   Buffer spare_;
