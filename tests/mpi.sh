@@ -21,6 +21,9 @@
 #    makes the lattices of its rows);
 #  - shallow_water: second-order shallow water (two stages a step, 2-row halo) with
 #    boundary.periodic_x (the periodic columns and the bands' rows together);
+#  - shallow_water_edges, shallow_water_order1: the shallow water of the second and of the first
+#    order with an open east edge and a fixed-level south edge (on OpenCL's CPU devices the
+#    interior rows by the kernels that read the velocities from a pass of their own);
 #  - water_cycle: every other process that reads or writes across cells, each of whose halo
 #    fields must be exchanged or may not be (process.hpp neighbour_read_fields): local
 #    inertial, Mei's erosion law with hardness noise, a snow pack that melts and slides,
@@ -59,7 +62,7 @@
 # N = 2: `erodem compare` reports rel_L2 of 1e-3 .. 1 on water_depth and the others (see
 # docs/mpi.md for the figures).
 # BACKEND (the third argument, `cpu` by default): `opencl` runs the scenarios erosion, pipes,
-# shallow_water, water_cycle, row_tail and restart on the OpenCL backend (PoCL here, each rank its own
+# the three of the shallow water, water_cycle, row_tail and restart on the OpenCL backend (PoCL here, each rank its own
 # context) against the serial OpenCL run, bit for bit as on the CPU, twice: with the launches
 # of whole rows PoCL gets by default, and with ERODEM_OPENCL_WG=64 (work-groups that do not
 # divide a row, and the statistics' tree reduction: the launches GPUs get).
@@ -169,6 +172,18 @@ EOF
   shallow_water)
     sets=(--set flow.scheme=shallow_water --set flow.order=2 --set boundary.periodic_x=true)
     ;;
+  shallow_water_edges | shallow_water_order1)
+    # an open east edge and a fixed-level south edge instead of periodic columns: on CPU devices
+    # the interior rows then run by the interior kernels (periodic_x keeps the second order on
+    # the general one)
+    sets=(--set flow.scheme=shallow_water --set boundary.east=open --set boundary.south=fixed_level
+      --set boundary.sea_level=20)
+    if [ "$scenario" = shallow_water_edges ]; then
+      sets+=(--set flow.order=2)
+    else
+      sets+=(--set flow.order=1)
+    fi
+    ;;
   row_tail)
     # the valley's [dem] lines (synthetic .. cell_size) replaced by a window across a wider one
     "$erodem" generate --kind valley --size 2061 --seed 7 --relief 150 wide_valley.tif >/dev/null
@@ -251,7 +266,9 @@ EOF
     ;;
   refusals | interrupt) ;;
   *)
-    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, water_cycle, row_tail, dem_rows, dem_rows_coarse, restart, refusals, interrupt)"
+    echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, shallow_water_edges," \
+      "shallow_water_order1, water_cycle, row_tail, dem_rows, dem_rows_coarse, restart, refusals," \
+      "interrupt)"
     exit 2
     ;;
 esac

@@ -106,9 +106,11 @@ pipes semi_lagrangian 54 0 27'
   # pass packs the desingularised velocity's denominators of a cell and its east neighbour,
   # sw_velocity in shallow_water.h, and the work-item loop is refused with "instruction return
   # type cannot be vectorized"; without that pack the cost model declines the loop for its
-  # clamped neighbour indices: performance.md "PoCL per kernel"; on CPU devices the first
-  # order's flow_shallow_water runs only the first and last row since 2026-11-30, the interior
-  # rows by flow_shallow_water_interior, which is 8 wide and checked),
+  # clamped neighbour indices: performance.md "PoCL per kernel"; on CPU devices since
+  # 2026-11-30 flow_shallow_water runs only the first and last row and flow_shallow_water_muscl
+  # the two first and two last, the interior rows by flow_shallow_water_interior and
+  # flow_shallow_water_muscl_interior, which are 8 wide and checked; the second order's was
+  # scalar with the minmod's two absolute values packed by SLP, shallow_water.h sw_minmod),
   # infiltration (Newton's iterations with an early exit, run only where they decide the take:
   # infiltration.h) and the terrain classes (a call PoCL does not vectorise; every
   # terrain_classes.interval steps).

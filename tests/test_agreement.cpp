@@ -479,79 +479,89 @@ INSTANTIATE_TEST_SUITE_P(
                       true}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) { return i.param.name; });
 
-// On CPU devices (whole-row launches) the first-order shallow water runs its interior rows by
-// flow_shallow_water_interior from velocities computed once per cell, the first and last row by
-// the general flow_shallow_water; with rounded launches (ERODEM_OPENCL_WG, as on GPUs) the
-// general kernel runs every row. The two must give the same bits (shallow_water_cell_interior:
-// in the first and last column it reads the ghost column across the row end where the general
-// kernel sees a wall, and a face between two ghosts carries nothing). A bumpy bed with a lake,
-// an island and rain, 80 steps of 0.2 s, with walls, with fixed levels east and west (ghost
-// columns that give water, and whose faces across the row ends the interior kernel computes)
-// and with periodic east-west edges (whose ghost columns are active cells): the depth, both unit
-// discharges and the four outflows of every DEM cell, bound 0 differing values. Not vacuous: the
-// water must have moved (a nonzero eastward unit discharge in most cells; an idle solver on
-// both sides would agree too), and swapping the east and west neighbours' eastward velocities
-// in the interior kernel made 7743, 6956 and 7931 of the 9583 values differ (walls, fixed
-// levels, periodic).
-TEST(AgreementLaunch, FirstOrderShallowWaterInteriorKernelSameBitsAsGeneral) {
+// On CPU devices (whole-row launches) the shallow water runs its interior rows by kernels that
+// read velocities computed once per cell and need no clamping: the first order rows 1 .. H - 2
+// by flow_shallow_water_interior, the second order rows 2 .. H - 3 by
+// flow_shallow_water_muscl_interior (each of Heun's stages; not with periodic east-west edges),
+// the other rows by the general flow_shallow_water and flow_shallow_water_muscl. With rounded
+// launches (ERODEM_OPENCL_WG, as on GPUs) the general kernels run every row. The two must give
+// the same bits (shallow_water_cell_interior, shallow_water_muscl_cell_interior: near the first
+// and last column they read across the row end where the general kernels see a wall; a face
+// between two ghosts carries nothing, and a ghost's slopes are 0). A bumpy bed with a lake, an
+// island and rain, 80 steps of 0.2 s, with walls, with fixed levels east and west (ghost columns
+// that give water, and whose faces across the row ends the interior kernels compute) and with
+// periodic east-west edges (whose ghost columns are active cells; at the second order the
+// general kernel runs every row there on both sides): the depth, both unit discharges and the
+// four outflows of every DEM cell, bound 0 differing values. Not vacuous: the water must have
+// moved (a nonzero eastward unit discharge in most cells; an idle solver on both sides would
+// agree too), and swapping the east and west neighbours' eastward velocities in the interior
+// kernel made 7743, 6956 and 7931 of the 9583 values differ at the first order (walls, fixed
+// levels, periodic), 7776 and 7168 at the second (walls, fixed levels); and running the second
+// order's interior kernel with periodic edges too made 5949 differ.
+TEST(AgreementLaunch, ShallowWaterInteriorKernelsSameBitsAsGeneral) {
 #ifndef ERODEM_HAVE_OPENCL
   GTEST_SKIP() << "built without OpenCL";
 #else
   if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
   const char* wg = std::getenv("ERODEM_OPENCL_WG");
   const std::string wg_before = wg ? wg : "";
-  for (const int edges : {0, 1, 2}) {  // walls, fixed levels east and west, periodic
-    Terrain t = bumpy_terrain(37, 10.0);
-    t.water_depth.assign(t.grid.cells(), 0.0);
-    for (std::size_t i = 0; i < t.bed.size(); ++i)
-      t.water_depth[i] = t.bed[i] < 10.0 ? 10.0 - t.bed[i] : 0.0;
-    Params p = quiet_params(FlowScheme::shallow_water, 0.2);
-    p.flow.manning_n.value = 0.03;
-    p.rain.rate = 200e-3 / 3600;
-    if (edges == 1) {
-      // the ghost columns give water (a level of 9.5 m below the lake's 10 m: it drains out)
-      p.boundary.east = p.boundary.west = BoundaryKind::fixed_level;
-      p.boundary.sea_level = 9.5;
-    }
-    p.boundary.periodic_x = edges == 2;
-    const std::string label =
-        edges == 0 ? "walls" : (edges == 1 ? "fixed levels east and west" : "periodic east-west");
-    unsetenv("ERODEM_OPENCL_WG");
-    Simulation rows(t, p, make_backend("opencl", t, p));
-    setenv("ERODEM_OPENCL_WG", "64", 1);
-    Simulation rounded(t, p, make_backend("opencl", t, p));
-    if (wg_before.empty())
-      unsetenv("ERODEM_OPENCL_WG");
-    else
-      setenv("ERODEM_OPENCL_WG", wg_before.c_str(), 1);
-    const auto* a = dynamic_cast<const opencl::OpenClBackend*>(&rows.backend());
-    const auto* b = dynamic_cast<const opencl::OpenClBackend*>(&rounded.backend());
-    ASSERT_NE(a, nullptr);
-    ASSERT_NE(b, nullptr);
-    if (!a->whole_rows()) GTEST_SKIP() << "not a CPU device: no whole-row launches";
-    ASSERT_FALSE(b->whole_rows());
-    rows.step(80);
-    rounded.step(80);
-    std::size_t values = 0, differ = 0, moving = 0;
-    for (const FieldId f :
-         {FieldId::water_depth, FieldId::momentum_x, FieldId::momentum_y, FieldId::flux_left,
-          FieldId::flux_right, FieldId::flux_top, FieldId::flux_bottom}) {
-      const auto x = rows.field(f), y = rounded.field(f);
-      ASSERT_EQ(x.size(), y.size());
-      for (std::size_t i = 0; i < x.size(); ++i) {
-        ++values;
-        differ += std::memcmp(&x[i], &y[i], sizeof(double)) != 0;
-        if (f == FieldId::momentum_x) moving += x[i] != 0.0;
+  for (const int order : {1, 2}) {
+    for (const int edges : {0, 1, 2}) {  // walls, fixed levels east and west, periodic
+      Terrain t = bumpy_terrain(37, 10.0);
+      t.water_depth.assign(t.grid.cells(), 0.0);
+      for (std::size_t i = 0; i < t.bed.size(); ++i)
+        t.water_depth[i] = t.bed[i] < 10.0 ? 10.0 - t.bed[i] : 0.0;
+      Params p = quiet_params(FlowScheme::shallow_water, 0.2);
+      p.flow.order = order;
+      p.flow.manning_n.value = 0.03;
+      p.rain.rate = 200e-3 / 3600;
+      if (edges == 1) {
+        // the ghost columns give water (a level of 9.5 m below the lake's 10 m: it drains out)
+        p.boundary.east = p.boundary.west = BoundaryKind::fixed_level;
+        p.boundary.sea_level = 9.5;
       }
+      p.boundary.periodic_x = edges == 2;
+      const std::string label =
+          std::string(order == 1 ? "first order, " : "second order, ") +
+          (edges == 0 ? "walls"
+                      : (edges == 1 ? "fixed levels east and west" : "periodic east-west"));
+      unsetenv("ERODEM_OPENCL_WG");
+      Simulation rows(t, p, make_backend("opencl", t, p));
+      setenv("ERODEM_OPENCL_WG", "64", 1);
+      Simulation rounded(t, p, make_backend("opencl", t, p));
+      if (wg_before.empty())
+        unsetenv("ERODEM_OPENCL_WG");
+      else
+        setenv("ERODEM_OPENCL_WG", wg_before.c_str(), 1);
+      const auto* a = dynamic_cast<const opencl::OpenClBackend*>(&rows.backend());
+      const auto* b = dynamic_cast<const opencl::OpenClBackend*>(&rounded.backend());
+      ASSERT_NE(a, nullptr);
+      ASSERT_NE(b, nullptr);
+      if (!a->whole_rows()) GTEST_SKIP() << "not a CPU device: no whole-row launches";
+      ASSERT_FALSE(b->whole_rows());
+      rows.step(80);
+      rounded.step(80);
+      std::size_t values = 0, differ = 0, moving = 0;
+      for (const FieldId f :
+           {FieldId::water_depth, FieldId::momentum_x, FieldId::momentum_y, FieldId::flux_left,
+            FieldId::flux_right, FieldId::flux_top, FieldId::flux_bottom}) {
+        const auto x = rows.field(f), y = rounded.field(f);
+        ASSERT_EQ(x.size(), y.size());
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          ++values;
+          differ += std::memcmp(&x[i], &y[i], sizeof(double)) != 0;
+          if (f == FieldId::momentum_x) moving += x[i] != 0.0;
+        }
+      }
+      const std::size_t cells = t.grid.cells();
+      std::printf(
+          "[launch] shallow water, %s, 37^2, 80 steps: %zu of %zu values differ between the "
+          "interior kernel (whole rows) and the general one (rounded launches) (bound 0); cells "
+          "with a nonzero eastward unit discharge %zu of %zu (bound: more than half)\n",
+          label.c_str(), differ, values, moving, cells);
+      EXPECT_EQ(differ, 0u) << label;
+      EXPECT_GT(moving, cells / 2) << label;
     }
-    const std::size_t cells = t.grid.cells();
-    std::printf(
-        "[launch] first-order shallow water, %s, 37^2, 80 steps: %zu of %zu values differ between "
-        "the interior kernel (whole rows) and the general one (rounded launches) (bound 0); "
-        "cells with a nonzero eastward unit discharge %zu of %zu (bound: more than half)\n",
-        label.c_str(), differ, values, moving, cells);
-    EXPECT_EQ(differ, 0u) << label;
-    EXPECT_GT(moving, cells / 2) << label;
   }
 #endif
 }

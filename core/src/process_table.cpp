@@ -107,7 +107,8 @@ std::vector<SweepInfo> flow_sweeps(const Params& p) {
               {"flux_top", Wr},
               {"flux_bottom", Wr}},
              {"flow_shallow_water", "flow_shallow_water_velocities", "flow_shallow_water_interior",
-              "flow_shallow_water_muscl", "flow_shallow_water_stage_depth"}}};
+              "flow_shallow_water_muscl", "flow_shallow_water_muscl_interior",
+              "flow_shallow_water_stage_depth"}}};
   }
   if (p.flow.scheme == FlowScheme::local_inertial) {
     // local_inertial_face + local_inertial_split (flow.h): the face discharges from the old

@@ -292,13 +292,17 @@ ERODEM_FN void shallow_water_stage_store(int i, int combine, ERODEM_S(SwCell) r,
                                          GLOBAL real* out_left, GLOBAL real* out_right,
                                          GLOBAL real* out_top, GLOBAL real* out_bottom,
                                          GLOBAL real* q_x_new, GLOBAL real* q_y_new) {
+  /* every value loaded, then selected: loaded under `combine`, PoCL's vectorised loop stored
+   * all six through masks (tests/pocl_vectorisation.sh) */
   const real h = (real)0.5;
-  out_left[i] = combine ? h * (out_left[i] + r.left) : r.left;
-  out_right[i] = combine ? h * (out_right[i] + r.right) : r.right;
-  out_top[i] = combine ? h * (out_top[i] + r.top) : r.top;
-  out_bottom[i] = combine ? h * (out_bottom[i] + r.bottom) : r.bottom;
-  q_x_new[i] = combine ? h * (q_x_new[i] + r.q_x) : r.q_x;
-  q_y_new[i] = combine ? h * (q_y_new[i] + r.q_y) : r.q_y;
+  const real l = out_left[i], rt = out_right[i], t = out_top[i], b = out_bottom[i];
+  const real qx = q_x_new[i], qy = q_y_new[i];
+  out_left[i] = combine ? h * (l + r.left) : r.left;
+  out_right[i] = combine ? h * (rt + r.right) : r.right;
+  out_top[i] = combine ? h * (t + r.top) : r.top;
+  out_bottom[i] = combine ? h * (b + r.bottom) : r.bottom;
+  q_x_new[i] = combine ? h * (qx + r.q_x) : r.q_x;
+  q_y_new[i] = combine ? h * (qy + r.q_y) : r.q_y;
 }
 
 /* The rows of the faces north and south of padded row y (the faces between rows y_n and
@@ -350,10 +354,27 @@ ERODEM_FN_INLINED void shallow_water_cell_uv(
 
 /* ---- second order (flow.order = 2): MUSCL reconstruction and Heun's method ---------------- */
 
-/* minmod(a, b): the one of a and b nearer 0 where they have the same sign, else 0. */
+/* minmod(a, b): the one of a and b nearer 0 where they have the same sign, else 0 (b where they
+ * are equally near). With the same sign, a is nearer 0 where a < b for positive a and a > b for
+ * negative a: one comparison of a with b, where |a| < |b| took two absolute values that LLVM's
+ * SLP pass packed into a vector of two (sw_limited_slope). */
 ERODEM_FN real sw_minmod(real a, real b) {
-  const real m = fabs(a) < fabs(b) ? a : b;
+  const real m = (a > (real)0) == (a < b) ? a : b;
   return a * b > (real)0 ? m : (real)0;
+}
+
+/* The limited slope of a quantity of values f_m, f, f_p in three cells along a direction where
+ * `on`: sw_minmod(f - f_m, f_p - f); else 0. Where f_m == f_p the two differences have opposite
+ * signs (or are 0) and the slope is 0, so that case skips the minmod: the same values. Each
+ * quantity's slope is computed in a block of its own, on a condition of its own: within one
+ * block LLVM's SLP pass packs the four quantities' minmods into vectors of four, after which
+ * PoCL cannot vectorise the loop over work-items ("instruction return type cannot be
+ * vectorized", tests/pocl_vectorisation.sh); the loop vectoriser turns the blocks back into
+ * selects. */
+ERODEM_FN_INLINED real sw_limited_slope(int on, real f_m, real f, real f_p) {
+  real s = (real)0;
+  if (on & (f_m != f_p)) s = sw_minmod(f - f_m, f_p - f);
+  return s;
 }
 
 /* A cell's limited slopes in one direction (the change per cell towards its next neighbour)
@@ -377,10 +398,10 @@ ERODEM_FN ERODEM_S(SwSlopes)
   s.on = (k_m == ERODEM_CELL_ACTIVE) & (k == ERODEM_CELL_ACTIVE) & (k_p == ERODEM_CELL_ACTIVE) &
          (h_m > eps) & (h > eps) & (h_p > eps);
   const real e_m = z_m + h_m, e = z + h, e_p = z_p + h_p;
-  s.eta = s.on ? sw_minmod(e - e_m, e_p - e) : (real)0;
-  s.h = s.on ? sw_minmod(h - h_m, h_p - h) : (real)0;
-  s.u = s.on ? sw_minmod(u - u_m, u_p - u) : (real)0;
-  s.t = s.on ? sw_minmod(t - t_m, t_p - t) : (real)0;
+  s.eta = sw_limited_slope(s.on, e_m, e, e_p);
+  s.h = sw_limited_slope(s.on, h_m, h, h_p);
+  s.u = sw_limited_slope(s.on, u_m, u, u_p);
+  s.t = sw_limited_slope(s.on, t_m, t, t_p);
   return s;
 }
 
@@ -486,13 +507,43 @@ ERODEM_FN_INLINED ERODEM_S(SwFace)
   return sw_face(a.k, b.k, l.h, l.z, -l.u, l.t, r.h, r.z, -r.u, r.t, g, eps);
 }
 
-/* A stage of the second-order step of padded cell (x, y) (any row): its four faces from the
- * MUSCL-reconstructed states of the cells around it (two cells each way), then
- * shallow_water_cell_update on the stage's depth and unit discharges (depth, q_x, q_y). The
+/* A stage of the second-order step of padded cell i of row y (0 <= y < H) from the states of the
+ * cells around it (SwCellState: c the cell, w1, w2 one and two cells west, e1, e2 east, n1, n2
+ * north, s1, s2 south): its four faces from their MUSCL-reconstructed sides, then
+ * shallow_water_cell_update on the stage's depth and unit discharges (c.h; q_x, q_y at i). The
  * first stage (combine 0) writes the outflows and unit discharges as the first-order step does;
  * the second (combine 1) writes the step's: the mean of the first stage's outflows (read from
  * out_*, where it left them) and its own, and the mean of the unit discharges at the start of
- * the step (q_x_new, q_y_new on entry) and its own. */
+ * the step (q_x_new, q_y_new on entry) and its own. Manning's n at index i_manning
+ * (param_index). */
+ERODEM_FN_INLINED void shallow_water_muscl_cell_states(
+    int i, int y, int H, ERODEM_S(SwCellState) c, ERODEM_S(SwCellState) w1,
+    ERODEM_S(SwCellState) w2, ERODEM_S(SwCellState) e1, ERODEM_S(SwCellState) e2,
+    ERODEM_S(SwCellState) n1, ERODEM_S(SwCellState) n2, ERODEM_S(SwCellState) s1,
+    ERODEM_S(SwCellState) s2, GLOBAL const real* q_x, GLOBAL const real* q_y,
+    GLOBAL const real* manning, int i_manning, GLOBAL const real* dx, GLOBAL const real* dy,
+    GLOBAL const real* area, real dt, ERODEM_P(FlowParams) p, int combine, GLOBAL real* out_left,
+    GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+    GLOBAL real* q_y_new) {
+  const real g = p.gravity, eps = p.dry_depth;
+  const ERODEM_S(SwSlopes) sx_c = sw_slopes_x(w1, c, e1, eps);
+  const ERODEM_S(SwSlopes) sy_c = sw_slopes_y(n1, c, s1, eps);
+  const ERODEM_S(SwFace) fe = sw_face_x2(c, sx_c, e1, sw_slopes_x(c, e1, e2, eps), g, eps);
+  const ERODEM_S(SwFace) fw = sw_face_x2(w1, sw_slopes_x(w2, w1, c, eps), c, sx_c, g, eps);
+  const ERODEM_S(SwFace) fs = sw_face_y2(c, sy_c, s1, sw_slopes_y(c, s1, s2, eps), g, eps);
+  const ERODEM_S(SwFace) fn = sw_face_y2(n1, sw_slopes_y(n2, n1, c, eps), c, sy_c, g, eps);
+  const int y_n = sw_north_face_row(y), y_s = sw_south_face_row(y, H);
+  const ERODEM_S(SwCell) r = shallow_water_cell_update(
+      c.k, c.h, q_x[i], q_y[i], manning[i_manning], dy[y], face_y_width(dx, y_n),
+      face_y_width(dx, y_s), area[y], dt, p, fe, fw, fs, fn);
+  shallow_water_stage_store(i, combine, r, out_left, out_right, out_top, out_bottom, q_x_new,
+                            q_y_new);
+}
+
+/* shallow_water_muscl_cell_states for padded cell (x, y) of any row 0 <= y < H: the cells'
+ * states by sw_state_at (indices clamped into the raster, kinds outside it walls, velocities
+ * computed here), and with boundary.periodic_x the cells two columns off wrapped around the
+ * seam. */
 ERODEM_FN_INLINED void shallow_water_muscl_cell(
     int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
     GLOBAL const real* depth, GLOBAL const real* q_x, GLOBAL const real* q_y,
@@ -500,8 +551,7 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell(
     GLOBAL const real* area, real dt, ERODEM_P(FlowParams) p, int combine, GLOBAL real* out_left,
     GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
     GLOBAL real* q_y_new) {
-  const int i = x + y * W;
-  const real g = p.gravity, eps = p.dry_depth;
+  const real eps = p.dry_depth;
   const ERODEM_S(SwCellState) c = sw_state_at(x, y, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) w1 = sw_state_at(x - 1, y, W, H, kind, bed, depth, q_x, q_y, eps);
   /* with periodic_x the cells two columns off wrap around the seam (the ghost columns repeat
@@ -515,18 +565,57 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell(
   const ERODEM_S(SwCellState) n2 = sw_state_at(x, y - 2, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) s1 = sw_state_at(x, y + 1, W, H, kind, bed, depth, q_x, q_y, eps);
   const ERODEM_S(SwCellState) s2 = sw_state_at(x, y + 2, W, H, kind, bed, depth, q_x, q_y, eps);
-  const ERODEM_S(SwSlopes) sx_c = sw_slopes_x(w1, c, e1, eps);
-  const ERODEM_S(SwSlopes) sy_c = sw_slopes_y(n1, c, s1, eps);
-  const ERODEM_S(SwFace) fe = sw_face_x2(c, sx_c, e1, sw_slopes_x(c, e1, e2, eps), g, eps);
-  const ERODEM_S(SwFace) fw = sw_face_x2(w1, sw_slopes_x(w2, w1, c, eps), c, sx_c, g, eps);
-  const ERODEM_S(SwFace) fs = sw_face_y2(c, sy_c, s1, sw_slopes_y(c, s1, s2, eps), g, eps);
-  const ERODEM_S(SwFace) fn = sw_face_y2(n1, sw_slopes_y(n2, n1, c, eps), c, sy_c, g, eps);
-  const int y_n = sw_north_face_row(y), y_s = sw_south_face_row(y, H);
-  const ERODEM_S(SwCell) r = shallow_water_cell_update(
-      c.k, c.h, q_x[i], q_y[i], manning[param_index(x, y, p.manning_pitch)], dy[y],
-      face_y_width(dx, y_n), face_y_width(dx, y_s), area[y], dt, p, fe, fw, fs, fn);
-  shallow_water_stage_store(i, combine, r, out_left, out_right, out_top, out_bottom, q_x_new,
-                            q_y_new);
+  shallow_water_muscl_cell_states(x + y * W, y, H, c, w1, w2, e1, e2, n1, n2, s1, s2, q_x, q_y,
+                                  manning, param_index(x, y, p.manning_pitch), dx, dy, area, dt, p,
+                                  combine, out_left, out_right, out_top, out_bottom, q_x_new,
+                                  q_y_new);
+}
+
+/* The state of padded cell i for the second-order faces from the velocities u, v (m/s) of every
+ * cell (shallow_water_flow_velocity_cell: the same values sw_state_at computes). */
+ERODEM_FN_INLINED ERODEM_S(SwCellState)
+    sw_state_of(int i, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
+                GLOBAL const real* depth, GLOBAL const real* u, GLOBAL const real* v) {
+  ERODEM_S(SwCellState) c;
+  c.k = kind[i];
+  c.h = depth[i];
+  c.z = bed[i];
+  c.u = u[i];
+  c.v = v[i];
+  return c;
+}
+
+/* shallow_water_muscl_cell_states for padded cell (x, y) of a row 2 <= y <= H - 3, any
+ * 0 <= x <= W - 1, without boundary.periodic_x, with the velocities u, v of every cell
+ * (shallow_water_flow_velocity_cell): the cells at i -+ 1, i -+ 2, i -+ W, i -+ 2 W without
+ * clamping, their kinds as they are, so the loads of a row are consecutive (PoCL vectorises the
+ * loop over x on CPU devices). The same results as shallow_water_muscl_cell: near the first and
+ * last column, x -+ 1 and x -+ 2 reach across the row ends into the row above or below, where
+ * shallow_water_muscl_cell clamps to the nearest cell as a wall. Without periodic_x the ghost
+ * columns 0 and W - 1 are not active, so
+ * - a cell two columns off enters only the slopes of a ghost (w2 those of w1 at x = 1, e2 those of
+ *   e1 at x = W - 2; at x = 0 and W - 1 those of w1 or e1 beyond the ghost cell itself), and a
+ *   ghost's slopes are 0 (sw_slopes: first order unless the three cells are active);
+ * - a cell one column off across the row end meets a ghost (x = 0 or W - 1): a face between two
+ *   ghosts carries nothing (sw_face), and a ghost's other results do not read it (its unit
+ *   discharges are kept; it gives only through its faces with active cells).
+ * With periodic_x the ghost columns are active: shallow_water_muscl_cell. */
+ERODEM_FN_INLINED void shallow_water_muscl_cell_interior(
+    int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
+    GLOBAL const real* depth, GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* u,
+    GLOBAL const real* v, GLOBAL const real* manning, GLOBAL const real* dx, GLOBAL const real* dy,
+    GLOBAL const real* area, real dt, ERODEM_P(FlowParams) p, int combine, GLOBAL real* out_left,
+    GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
+    GLOBAL real* q_y_new) {
+  const int i = x + y * W;
+  shallow_water_muscl_cell_states(
+      i, y, H, sw_state_of(i, kind, bed, depth, u, v), sw_state_of(i - 1, kind, bed, depth, u, v),
+      sw_state_of(i - 2, kind, bed, depth, u, v), sw_state_of(i + 1, kind, bed, depth, u, v),
+      sw_state_of(i + 2, kind, bed, depth, u, v), sw_state_of(i - W, kind, bed, depth, u, v),
+      sw_state_of(i - 2 * W, kind, bed, depth, u, v), sw_state_of(i + W, kind, bed, depth, u, v),
+      sw_state_of(i + 2 * W, kind, bed, depth, u, v), q_x, q_y, manning,
+      param_index(x, y, p.manning_pitch), dx, dy, area, dt, p, combine, out_left, out_right,
+      out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* shallow_water_cell_uv for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices

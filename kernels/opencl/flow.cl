@@ -164,7 +164,8 @@ __kernel void flow_shallow_water(
 }
 
 /* The velocities the shallow-water faces read (shallow_water_flow_velocity_cell), every padded
- * cell, into u, v: scratch for flow_shallow_water_interior, on CPU devices. */
+ * cell, into u, v: scratch for flow_shallow_water_interior and flow_shallow_water_muscl_interior,
+ * on CPU devices. */
 __kernel void flow_shallow_water_velocities(int W, int H, __global const real* restrict depth,
                                             __global const real* restrict q_x,
                                             __global const real* restrict q_y, FlowParams p,
@@ -211,6 +212,29 @@ __kernel void flow_shallow_water_muscl(
   if (ERODEM_PAST_ROW(x, W) || y >= H) return;
   shallow_water_muscl_cell(x, y, W, H, kind, bed, depth, q_x, q_y, manning, dx, dy, area, dt, p,
                            combine, out_left, out_right, out_top, out_bottom, q_x_new, q_y_new);
+}
+
+/* A stage of the second order on rows 2 .. H - 3 (shallow_water_muscl_cell_interior) from the
+ * velocities flow_shallow_water_velocities wrote for the stage's state: no clamping and no
+ * velocity computed nine times, so PoCL vectorises it across work-items on CPU devices
+ * (flow_shallow_water_muscl does not). The host runs it on CPU devices without
+ * boundary.periodic_x, with flow_shallow_water_muscl on rows 0, 1, H - 2 and H - 1; elsewhere
+ * flow_shallow_water_muscl on every row. */
+__kernel void flow_shallow_water_muscl_interior(
+    int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
+    __global const real* restrict depth, __global const real* restrict q_x,
+    __global const real* restrict q_y, __global const real* restrict u,
+    __global const real* restrict v, __global const real* restrict manning,
+    __global const real* restrict dx, __global const real* restrict dy,
+    __global const real* restrict area, real dt, FlowParams p, int combine,
+    __global real* restrict out_left, __global real* restrict out_right,
+    __global real* restrict out_top, __global real* restrict out_bottom,
+    __global real* restrict q_x_new, __global real* restrict q_y_new) {
+  const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  if (ERODEM_PAST_ROW(x, W)) return;
+  shallow_water_muscl_cell_interior(x, y, W, H, kind, bed, depth, q_x, q_y, u, v, manning, dx, dy,
+                                    area, dt, p, combine, out_left, out_right, out_top, out_bottom,
+                                    q_x_new, q_y_new);
 }
 
 /* The depth after Heun's first stage (shallow_water_stage_depth_cell), every padded cell. */

@@ -517,6 +517,43 @@ void OpenClBackend::run_sources(const StepInputs& in) {
         "clEnqueueNDRangeKernel(sources_points)");
 }
 
+std::pair<const Buffer*, const Buffer*> OpenClBackend::flow_velocities(const Buffer& depth,
+                                                                       const Buffer& qx,
+                                                                       const Buffer& qy) {
+  const Buffer& u = depth_next_as_scratch();
+  const Buffer& v = made(spare_);
+  cl_kernel k = kernel("flow_shallow_water_velocities");
+  set_args(k, cl_int{W_}, cl_int{H_}, depth, qx, qy, cell_.flow, u, v);
+  launch_rows(k, 0, H_);
+  return {&u, &v};
+}
+
+void OpenClBackend::muscl_stage(const Buffer& depth, const Buffer& qx, const Buffer& qy, Real dt,
+                                int combine, const Buffer& qx_out, const Buffer& qy_out) {
+  cl_kernel k = kernel("flow_shallow_water_muscl");
+  set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth, qx, qy, manning_, dx_, dy_, area_, dt,
+           cell_.flow, cl_int{combine}, flux_[0], flux_[1], flux_[2], flux_[3], qx_out, qy_out);
+  if (!whole_rows() || periodic_) {
+    launch_rows(k, 0, H_);
+    return;
+  }
+  // CPU devices: the stage's velocities first (flow_velocities), then rows 2 .. H - 3 by a
+  // kernel that reads them without clamping (it vectorises), the two first and two last rows by
+  // the general one; the same bits as the general kernel on every row
+  // (shallow_water_muscl_cell_interior; with periodic_x the ghost columns are active, and the
+  // general kernel runs every row)
+  const auto [u, v] = flow_velocities(depth, qx, qy);
+  cl_kernel in = kernel("flow_shallow_water_muscl_interior");
+  set_args(in, cl_int{W_}, cl_int{H_}, kind_, bed_, depth, qx, qy, *u, *v, manning_, dx_, dy_,
+           area_, dt, cell_.flow, cl_int{combine}, flux_[0], flux_[1], flux_[2], flux_[3], qx_out,
+           qy_out);
+  // each row by exactly one kernel (the second stage averages into what the rows hold)
+  const int top = std::min(2, H_), bottom = std::max(top, H_ - 2);
+  launch_rows(k, 0, top);
+  launch_rows(in, top, bottom);
+  launch_rows(k, bottom, H_);
+}
+
 void OpenClBackend::run_flow(Real dt) {
   if (params_.flow.scheme == FlowScheme::shallow_water) {
     // The outflows in place: the scheme reads none of the previous step's (the second order's
@@ -529,10 +566,7 @@ void OpenClBackend::run_flow(Real dt) {
       // second buffers, the depth it leaves, the second stage from there averaged into the
       // first's outflows and the unit discharges at the start of the step, which stay the
       // current ones
-      cl_kernel k = kernel("flow_shallow_water_muscl");
-      set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_,
-               dt, cell_.flow, cl_int{0}, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
-      launch_rows(k, 0, H_);
+      muscl_stage(depth_, qx, qy, dt, 0, qx_next, qy_next);
       // the halo of the first stage before the depth and the second stage read it
       exchange_buffers({&flux_[0], &flux_[1], &flux_[2], &flux_[3], &qx_next, &qy_next});
       cl_kernel s = kernel("flow_shallow_water_stage_depth");
@@ -540,27 +574,19 @@ void OpenClBackend::run_flow(Real dt) {
                area_, dt, stage_depth_);
       launch_rows(s, 0, H_);
       exchange_buffers({&stage_depth_});
-      set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, stage_depth_, qx_next, qy_next, manning_,
-               dx_, dy_, area_, dt, cell_.flow, cl_int{1}, flux_[0], flux_[1], flux_[2], flux_[3],
-               qx, qy);
-      launch_rows(k, 0, H_);
+      muscl_stage(stage_depth_, qx_next, qy_next, dt, 1, qx, qy);
       return;
     }
     cl_kernel k = kernel("flow_shallow_water");
     set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, manning_, dx_, dy_, area_, dt,
              cell_.flow, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
     if (whole_rows()) {
-      // CPU devices: the velocities first, into scratch buffers that hold nothing alive during
-      // the flow (as local inertial's faces), then the interior rows by a kernel that reads them
-      // without clamping (it vectorises), the first and last row by the general one; the same
-      // bits as the general kernel on every row (shallow_water_cell_interior)
-      const Buffer& u = depth_next_as_scratch();
-      const Buffer& v = made(spare_);
-      cl_kernel vel = kernel("flow_shallow_water_velocities");
-      set_args(vel, cl_int{W_}, cl_int{H_}, depth_, qx, qy, cell_.flow, u, v);
-      launch_rows(vel, 0, H_);
+      // CPU devices: the velocities first (flow_velocities), then the interior rows by a kernel
+      // that reads them without clamping (it vectorises), the first and last row by the general
+      // one; the same bits as the general kernel on every row (shallow_water_cell_interior)
+      const auto [u, v] = flow_velocities(depth_, qx, qy);
       cl_kernel in = kernel("flow_shallow_water_interior");
-      set_args(in, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, u, v, manning_, dx_, dy_,
+      set_args(in, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, qx, qy, *u, *v, manning_, dx_, dy_,
                area_, dt, cell_.flow, flux_[0], flux_[1], flux_[2], flux_[3], qx_next, qy_next);
       launch_rows(in, 1, H_ - 1);
       launch_rows(k, 0, 1);

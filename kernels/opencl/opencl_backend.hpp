@@ -192,6 +192,16 @@ class OpenClBackend final : public Backend {
   void run_boundary();
   void run_sources(const StepInputs& in);
   void run_flow(Real dt);
+  /// On CPU devices, for the shallow water's interior kernels: the velocities of `depth`, `qx`,
+  /// `qy` (flow_shallow_water_velocities, every row) into scratch buffers that hold nothing
+  /// alive during the flow (depth_next_ and the spare, as local inertial's faces); returns them
+  /// (eastward, northward).
+  std::pair<const Buffer*, const Buffer*> flow_velocities(const Buffer& depth, const Buffer& qx,
+                                                          const Buffer& qy);
+  /// A stage of the second-order shallow water (flow_shallow_water_muscl) from `depth`, `qx`,
+  /// `qy` into the outflows and `qx_out`, `qy_out` (`combine`: shallow_water_muscl_cell).
+  void muscl_stage(const Buffer& depth, const Buffer& qx, const Buffer& qy, Real dt, int combine,
+                   const Buffer& qx_out, const Buffer& qy_out);
   void run_water(Real dt, StepTally& tally);
   void run_erosion(Real dt, StepTally& tally);
   /// run_water then run_erosion in one launch (fused.cl): the same buffers, tallies and swaps.
@@ -301,7 +311,7 @@ class OpenClBackend final : public Backend {
   Buffer zero_field() { return filled_field(Real(0)); }
   /// `b` made on first use, for the buffers a run may never need (the bed's and the sediment's
   /// second buffers without erosion, thermal collapse or transport; the scratch of local
-  /// inertial's faces and of the first-order shallow water's velocities): a buffer of n_
+  /// inertial's faces and of the shallow water's velocities): a buffer of n_
   /// Reals, a copy of `like` where given (what the cells a kernel leaves untouched must hold),
   /// else zeros. Returns `b`.
   Buffer& made(Buffer& b, const Buffer* like = nullptr);
@@ -313,7 +323,7 @@ class OpenClBackend final : public Backend {
   /// sections' and the edges' sediment): made as a copy of the depth before any water update;
   /// Error(internal) where it holds scratch (depth_next_scratch_).
   const Buffer& depth_flow();
-  /// depth_next_ to hold scratch (the face pass's east faces, the first-order shallow water's
+  /// depth_next_ to hold scratch (the face pass's east faces, the shallow water's
   /// eastward velocities on CPU devices, the thermal shares) until the next water update: made
   /// on first use, and marked so that depth_flow refuses it.
   Buffer& depth_next_as_scratch();
@@ -429,7 +439,7 @@ class OpenClBackend final : public Backend {
   // The spare: the second buffer of the bed and of the sediment (erosion, thermal collapse and
   // the transport write their field's new values into it, and the two swap: second_for), and
   // the local-inertial face pass's south faces (discharge, m^3/s) until its cell pass, or on
-  // CPU devices the first-order shallow water's northward velocities (m/s) during its flow. One
+  // CPU devices the shallow water's northward velocities (m/s) during its flow. One
   // buffer for them all, as none of them is alive when another begins. bed_next_ is its name
   // for the field registry (the bed's twin); sediment_next_ is never made (field_registry.hpp
   // binds both names on both backends).
