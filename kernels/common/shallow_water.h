@@ -354,10 +354,10 @@ ERODEM_FN_INLINED void shallow_water_cell_uv(
 
 /* ---- second order (flow.order = 2): MUSCL reconstruction and Heun's method ---------------- */
 
-/* minmod(a, b): the one of a and b nearer 0 where they have the same sign, else 0 (b where they
- * are equally near). With the same sign, a is nearer 0 where a < b for positive a and a > b for
- * negative a: one comparison of a with b, where |a| < |b| took two absolute values that LLVM's
- * SLP pass packed into a vector of two (sw_limited_slope). */
+/* minmod(a, b): the one of a and b nearer 0 where they have the same sign, else 0 (either, the
+ * same value, where they are equally near). With the same sign, a is nearer 0 where a < b for
+ * positive a and a > b for negative a: one comparison of a with b, where |a| < |b| took two
+ * absolute values that LLVM's SLP pass packed into a vector of two (sw_limited_slope). */
 ERODEM_FN real sw_minmod(real a, real b) {
   const real m = (a > (real)0) == (a < b) ? a : b;
   return a * b > (real)0 ? m : (real)0;
@@ -648,8 +648,9 @@ ERODEM_FN void shallow_water_cell(int x, int y, int W, int H, GLOBAL const erode
 
 /* The velocities the shallow-water faces read, of padded cell (x, y): sw_velocity of its unit
  * discharges q_x, q_y (m^2/s) over its depth (m) with h_eps = dry_depth (m), into u, v (m/s),
- * every cell. For shallow_water_cell_interior, which then reads them instead of computing each
- * cell's five times (once as itself, once as each neighbour's neighbour); the same values. */
+ * every cell. For shallow_water_cell_interior and shallow_water_muscl_cell_interior, which then
+ * read them instead of computing each cell's five times (nine at the second order: once as
+ * itself, once as each neighbour's neighbour); the same values. */
 ERODEM_FN void shallow_water_flow_velocity_cell(int x, int y, int W, GLOBAL const real* depth,
                                                 GLOBAL const real* q_x, GLOBAL const real* q_y,
                                                 real dry_depth, GLOBAL real* u, GLOBAL real* v) {

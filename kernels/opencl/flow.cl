@@ -197,8 +197,10 @@ __kernel void flow_shallow_water_interior(
 }
 
 /* The shallow-water scheme's second order (flow.order = 2, shallow_water.h): a stage of Heun's
- * method with MUSCL faces, one work-item per padded cell (rows 0 .. H - 1); `combine` 0 for the
- * first stage, 1 for the second (averaged into what out_* and q_*_new hold). */
+ * method with MUSCL faces, one work-item per padded cell of any row (on CPU devices without
+ * periodic_x the two first and two last rows, flow_shallow_water_muscl_interior the others);
+ * `combine` 0 for the first stage, 1 for the second (averaged into what out_* and q_*_new
+ * hold). */
 __kernel void flow_shallow_water_muscl(
     int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
     __global const real* restrict depth, __global const real* restrict q_x,

@@ -431,8 +431,8 @@ class OpenClBackend final : public Backend {
   // The depth the water update started from, for conservative transport ("depth_flow"). From
   // the transport to the next water update nothing reads it, and it holds thermal collapse's
   // shares between its two passes ("thermal_share"), the local-inertial face pass's east
-  // faces (discharge, m^3/s) until its cell pass and, on CPU devices, the first-order shallow
-  // water's eastward velocities (m/s) during its flow: second_for restores its rows 0 and H - 1,
+  // faces (discharge, m^3/s) until its cell pass and, on CPU devices, the shallow water's
+  // eastward velocities (m/s) during its flow: second_for restores its rows 0 and H - 1,
   // which the water update does not write, before that update. Made on first use.
   Buffer depth_next_;
   bool depth_next_scratch_ = false;  // it holds faces, velocities or shares, not a depth
