@@ -250,6 +250,66 @@ TEST_P(Physics, BedrockLevelIsNeverCut) {
        std::vector<double>(b0.begin() + 60, b0.begin() + 120), std::vector<double>(60, rock)});
 }
 
+// ---- the capacity's ramp on thin water (erosion.min_depth) -----------------------------
+
+/// A flat channel of 40 x 3 cells of 1 m under a held speed of 1 m/s eastwards, its depth
+/// ramping from 1 mm (first column) to 20 cm (last), clear water: one step of Mei's erosion alone
+/// (run_processes), with erosion.min_depth = `min_depth`. Returns the bed's drop per cell (m).
+std::vector<double> eroded_on_a_depth_ramp(const Target& target, double min_depth) {
+  const int n = 40;
+  Params p = quiet_params(FlowScheme::local_inertial, 0.5);
+  p.erosion.enabled = true;
+  p.erosion.law = ErosionLaw::mei;
+  p.erosion.min_depth = min_depth;
+  auto sim = make_simulation(flat_terrain(n, 3, 1.0), p, target);
+  set_uniform_flow(sim, 0.1, 1.0);
+  std::vector<double> depth(sim.grid().cells());
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < n; ++c)
+      depth[static_cast<std::size_t>(r) * n + c] = 0.001 + (0.2 - 0.001) * c / (n - 1);
+  sim.backend().set_field(FieldId::water_depth, depth);
+  const auto b0 = sim.field(FieldId::bed);
+  run_processes(sim, {Process::erosion}, p.time.dt, 1);
+  const auto b = sim.field(FieldId::bed);
+  std::vector<double> drop(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) drop[i] = b0[i] - b[i];
+  return drop;
+}
+
+TEST_P(Physics, CapacityRampsToZeroBelowMinDepth) {
+  // Mei's capacity C = K_c max(sin a, sin_min) |v| g(d), g(d) = min(1, d / erosion.min_depth)
+  // (model.md section 3.5): from clear water (s = 0 < C) one step erodes min(1, K_s dt) C, so
+  // each cell's drop with min_depth = 0.1 m over its drop without the ramp (min_depth = 0) must
+  // be min(1, d / 0.1): 0.01 .. 1 along the channel. Bounds: rounding (float64 1e-12, float32
+  // 1e-5). A solver that ignores min_depth gives 1 everywhere (an error of 0.99 in the first
+  // column), one that ramps below d_min = velocity_min_depth instead gives 1 too, one that
+  // squares the ratio is off by up to 0.25; an idle one erodes nothing (the unramped run must
+  // erode: checked).
+  const double min_depth = 0.1;
+  const auto ramped = eroded_on_a_depth_ramp(target(), min_depth);
+  const auto full = eroded_on_a_depth_ramp(target(), 0.0);
+  const int n = 40;
+  double worst = 0, least_full = HUGE_VAL;
+  int below = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < n; ++c) {
+      const auto i = static_cast<std::size_t>(r) * n + c;
+      const double d = 0.001 + (0.2 - 0.001) * c / (n - 1);
+      const double expected = std::min(1.0, d / min_depth);
+      below += d < min_depth;
+      least_full = std::min(least_full, full[i]);
+      worst = std::max(worst, std::abs(ramped[i] / full[i] - expected));
+    }
+  std::printf(
+      "[min depth] %s: erosion.min_depth %.2f m, depths 0.001 .. 0.2 m (%d of %d cells below): "
+      "largest |ramped / unramped drop - min(1, d / min_depth)| %.2e (bound %.0e); smallest "
+      "unramped drop %.3e m (bound: > 0)\n",
+      target().label().c_str(), min_depth, below, 3 * n, worst, bound(1e-12, 1e-5), least_full);
+  EXPECT_GT(least_full, 0.0) << "the unramped run must erode every cell";
+  EXPECT_GT(below, n);  // both the ramp and the plateau are checked
+  EXPECT_LT(worst, bound(1e-12, 1e-5));
+}
+
 // ---- depth never negative; instability stops the run ----------------------------------
 
 TEST_P(Physics, DepthNeverNegativeWhileDraining) {
