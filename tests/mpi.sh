@@ -173,9 +173,9 @@ EOF
     sets=(--set flow.scheme=shallow_water --set flow.order=2 --set boundary.periodic_x=true)
     ;;
   shallow_water_edges | shallow_water_order1)
-    # an open east edge and a fixed-level south edge instead of periodic columns: on CPU devices
-    # the interior rows then run by the interior kernels (periodic_x keeps the second order on
-    # the general one)
+    # an open east edge and a fixed-level south edge instead of periodic columns (ghost columns
+    # that are not active cells, which the interior kernels read across the row ends on CPU
+    # devices)
     sets=(--set flow.scheme=shallow_water --set boundary.east=open --set boundary.south=fixed_level
       --set boundary.sea_level=20)
     if [ "$scenario" = shallow_water_edges ]; then

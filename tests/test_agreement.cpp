@@ -482,7 +482,8 @@ INSTANTIATE_TEST_SUITE_P(
 // On CPU devices (whole-row launches) the shallow water runs its interior rows by kernels that
 // read velocities computed once per cell and need no clamping: the first order rows 1 .. H - 2
 // by flow_shallow_water_interior, the second order rows 2 .. H - 3 by
-// flow_shallow_water_muscl_interior (each of Heun's stages; not with periodic east-west edges),
+// flow_shallow_water_muscl_interior (each of Heun's stages; with periodic east-west edges it
+// selects the cells beyond the seam that the general kernel wraps to),
 // the other rows by the general flow_shallow_water and flow_shallow_water_muscl. With rounded
 // launches (ERODEM_OPENCL_WG, as on GPUs) the general kernels run every row. The two must give
 // the same bits (shallow_water_cell_interior, shallow_water_muscl_cell_interior: near the first
@@ -490,15 +491,15 @@ INSTANTIATE_TEST_SUITE_P(
 // between two ghosts carries nothing, and a ghost's slopes are 0). A bumpy bed with a lake, an
 // island and rain, 80 steps of 0.2 s, with walls, with fixed levels east and west (ghost columns
 // that give water, and whose faces across the row ends the interior kernels compute), with
-// periodic east-west edges (whose ghost columns are active cells; at the second order the
-// general kernel runs every row there on both sides) and with open edges east and west: the depth,
+// periodic east-west edges (whose ghost columns are active cells, copies of the opposite
+// columns) and with open edges east and west: the depth,
 // both unit discharges and the four outflows of every DEM cell, bound 0 differing values. Not
 // vacuous: the water must have moved (a nonzero eastward unit discharge in most cells; an idle
 // solver on both sides would agree too), and swapping the east and west neighbours' eastward
 // velocities in the interior kernel made 7743, 6956, 7931 and 6973 of the 9583 values differ at the
-// first order (walls, fixed levels, periodic, open), 7776, 7168 and 7229 at the second (walls,
-// fixed levels, open); and running the second order's interior kernel with periodic edges too made
-// 5949 differ.
+// first order (walls, fixed levels, periodic, open), 7776, 7168, 7984 and 7229 at the second;
+// and without the selection at the seam (shallow_water_muscl_cell_interior) the periodic case
+// made 5949 differ.
 TEST(AgreementLaunch, ShallowWaterInteriorKernelsSameBitsAsGeneral) {
 #ifndef ERODEM_HAVE_OPENCL
   GTEST_SKIP() << "built without OpenCL";

@@ -585,8 +585,20 @@ ERODEM_FN_INLINED ERODEM_S(SwCellState)
   return c;
 }
 
+/* a where c, else b: each member selected. */
+ERODEM_FN_INLINED ERODEM_S(SwCellState)
+    sw_state_pick(int c, ERODEM_S(SwCellState) a, ERODEM_S(SwCellState) b) {
+  ERODEM_S(SwCellState) r;
+  r.k = c ? a.k : b.k;
+  r.h = c ? a.h : b.h;
+  r.z = c ? a.z : b.z;
+  r.u = c ? a.u : b.u;
+  r.v = c ? a.v : b.v;
+  return r;
+}
+
 /* shallow_water_muscl_cell_states for padded cell (x, y) of a row 2 <= y <= H - 3, any
- * 0 <= x <= W - 1, without boundary.periodic_x, with the velocities u, v of every cell
+ * 0 <= x <= W - 1, with the velocities u, v of every cell
  * (shallow_water_flow_velocity_cell): the cells at i -+ 1, i -+ 2, i -+ W, i -+ 2 W without
  * clamping, their kinds as they are, so the loads of a row are consecutive (PoCL vectorises the
  * loop over x on CPU devices). The same results as shallow_water_muscl_cell: near the first and
@@ -599,7 +611,12 @@ ERODEM_FN_INLINED ERODEM_S(SwCellState)
  * - a cell one column off across the row end meets a ghost (x = 0 or W - 1): a face between two
  *   ghosts carries nothing (sw_face), and a ghost's other results do not read it (its unit
  *   discharges are kept; it gives only through its faces with active cells).
- * With periodic_x the ghost columns are active: shallow_water_muscl_cell. */
+ * With periodic_x the ghost columns are active copies of the opposite DEM columns (every
+ * exchange copies them), which shallow_water_muscl_cell reads as they are too, but for the cell
+ * two columns west of column 1 and east of column W - 2: it wraps them around the seam to
+ * columns W - 3 and 2, and so does this function (loaded at those cells of the row, the same for
+ * every work-item of a row, so no gather, and selected there). In the ghost columns themselves
+ * the results differ, and the exchange after each stage overwrites them. */
 ERODEM_FN_INLINED void shallow_water_muscl_cell_interior(
     int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind, GLOBAL const real* bed,
     GLOBAL const real* depth, GLOBAL const real* q_x, GLOBAL const real* q_y, GLOBAL const real* u,
@@ -608,14 +625,20 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell_interior(
     GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
     GLOBAL real* q_y_new) {
   const int i = x + y * W;
+  const int seam_w = p.periodic_x & (x == 1), seam_e = p.periodic_x & (x == W - 2);
+  const ERODEM_S(SwCellState) w2 =
+      sw_state_pick(seam_w, sw_state_of(y * W + W - 3, kind, bed, depth, u, v),
+                    sw_state_of(i - 2, kind, bed, depth, u, v));
+  const ERODEM_S(SwCellState) e2 =
+      sw_state_pick(seam_e, sw_state_of(y * W + 2, kind, bed, depth, u, v),
+                    sw_state_of(i + 2, kind, bed, depth, u, v));
   shallow_water_muscl_cell_states(
       i, y, H, sw_state_of(i, kind, bed, depth, u, v), sw_state_of(i - 1, kind, bed, depth, u, v),
-      sw_state_of(i - 2, kind, bed, depth, u, v), sw_state_of(i + 1, kind, bed, depth, u, v),
-      sw_state_of(i + 2, kind, bed, depth, u, v), sw_state_of(i - W, kind, bed, depth, u, v),
-      sw_state_of(i - 2 * W, kind, bed, depth, u, v), sw_state_of(i + W, kind, bed, depth, u, v),
-      sw_state_of(i + 2 * W, kind, bed, depth, u, v), q_x, q_y, manning,
-      param_index(x, y, p.manning_pitch), dx, dy, area, dt, p, combine, out_left, out_right,
-      out_top, out_bottom, q_x_new, q_y_new);
+      w2, sw_state_of(i + 1, kind, bed, depth, u, v), e2,
+      sw_state_of(i - W, kind, bed, depth, u, v), sw_state_of(i - 2 * W, kind, bed, depth, u, v),
+      sw_state_of(i + W, kind, bed, depth, u, v), sw_state_of(i + 2 * W, kind, bed, depth, u, v),
+      q_x, q_y, manning, param_index(x, y, p.manning_pitch), dx, dy, area, dt, p, combine, out_left,
+      out_right, out_top, out_bottom, q_x_new, q_y_new);
 }
 
 /* shallow_water_cell_uv for padded cell (x, y) of any row 0 <= y < H: the neighbours' indices

@@ -197,8 +197,8 @@ __kernel void flow_shallow_water_interior(
 }
 
 /* The shallow-water scheme's second order (flow.order = 2, shallow_water.h): a stage of Heun's
- * method with MUSCL faces, one work-item per padded cell of any row (on CPU devices without
- * periodic_x the two first and two last rows, flow_shallow_water_muscl_interior the others);
+ * method with MUSCL faces, one work-item per padded cell of any row (on CPU devices the two
+ * first and two last rows, flow_shallow_water_muscl_interior the others);
  * `combine` 0 for the first stage, 1 for the second (averaged into what out_* and q_*_new
  * hold). */
 __kernel void flow_shallow_water_muscl(
@@ -219,9 +219,9 @@ __kernel void flow_shallow_water_muscl(
 /* A stage of the second order on rows 2 .. H - 3 (shallow_water_muscl_cell_interior) from the
  * velocities flow_shallow_water_velocities wrote for the stage's state: no clamping and no
  * velocity computed nine times, so PoCL vectorises it across work-items on CPU devices
- * (flow_shallow_water_muscl does not). The host runs it on CPU devices without
- * boundary.periodic_x, with flow_shallow_water_muscl on rows 0, 1, H - 2 and H - 1; elsewhere
- * flow_shallow_water_muscl on every row. */
+ * (flow_shallow_water_muscl does not). The host runs it on CPU devices, with
+ * flow_shallow_water_muscl on rows 0, 1, H - 2 and H - 1; elsewhere flow_shallow_water_muscl
+ * on every row. */
 __kernel void flow_shallow_water_muscl_interior(
     int W, int H, __global const uchar* restrict kind, __global const real* restrict bed,
     __global const real* restrict depth, __global const real* restrict q_x,

@@ -533,15 +533,15 @@ void OpenClBackend::muscl_stage(const Buffer& depth, const Buffer& qx, const Buf
   cl_kernel k = kernel("flow_shallow_water_muscl");
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth, qx, qy, manning_, dx_, dy_, area_, dt,
            cell_.flow, cl_int{combine}, flux_[0], flux_[1], flux_[2], flux_[3], qx_out, qy_out);
-  if (!whole_rows() || periodic_) {
+  if (!whole_rows()) {
     launch_rows(k, 0, H_);
     return;
   }
   // CPU devices: the stage's velocities first (flow_velocities), then rows 2 .. H - 3 by a
   // kernel that reads them without clamping (it vectorises), the two first and two last rows by
-  // the general one; the same bits as the general kernel on every row
-  // (shallow_water_muscl_cell_interior; with periodic_x the ghost columns are active, and the
-  // general kernel runs every row)
+  // the general one; the same bits as the general kernel on every row but in the ghost columns
+  // under periodic_x, which the exchange after each stage overwrites
+  // (shallow_water_muscl_cell_interior)
   const auto [u, v] = flow_velocities(depth, qx, qy);
   cl_kernel in = kernel("flow_shallow_water_muscl_interior");
   set_args(in, cl_int{W_}, cl_int{H_}, kind_, bed_, depth, qx, qy, *u, *v, manning_, dx_, dy_,
