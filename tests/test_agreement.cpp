@@ -492,14 +492,16 @@ INSTANTIATE_TEST_SUITE_P(
 // island and rain, 80 steps of 0.2 s, with walls, with fixed levels east and west (ghost columns
 // that give water, and whose faces across the row ends the interior kernels compute), with
 // periodic east-west edges (whose ghost columns are active cells, copies of the opposite
-// columns) and with open edges east and west: the depth,
-// both unit discharges and the four outflows of every DEM cell, bound 0 differing values. Not
-// vacuous: the water must have moved (a nonzero eastward unit discharge in most cells; an idle
-// solver on both sides would agree too), and swapping the east and west neighbours' eastward
-// velocities in the interior kernel made 7743, 6956, 7931 and 6973 of the 9583 values differ at the
-// first order (walls, fixed levels, periodic, open), 7776, 7168, 7984 and 7229 at the second;
-// and without the selection at the seam (shallow_water_muscl_cell_interior) the periodic case
-// made 5949 differ.
+// columns, which the interior kernels read where the general ones wrap), with open edges east
+// and west, and periodic again with Mei's erosion and thermal collapse (the bed changes, and its
+// ghost columns must follow): the depth, both unit discharges, the four outflows, the bed and
+// the sediment of every DEM cell, bound 0 differing values. Not vacuous: the water must have
+// moved (a nonzero eastward unit discharge in most cells; an idle solver on both sides would
+// agree too), the bed too where erosion is on (and only there), and swapping the east and west
+// neighbours' eastward velocities in the interior kernel made 7743, 6956, 7931, 6973 and 10619
+// of the 12321 values differ at the first order (walls, fixed levels, periodic, open, periodic
+// with erosion), 7776, 7168, 7984, 7229 and 10676 at the second; without the selection at the
+// seam (shallow_water_muscl_cell_interior) the periodic cases made 5949 and 8765 differ.
 TEST(AgreementLaunch, ShallowWaterInteriorKernelsSameBitsAsGeneral) {
 #ifndef ERODEM_HAVE_OPENCL
   GTEST_SKIP() << "built without OpenCL";
@@ -508,8 +510,9 @@ TEST(AgreementLaunch, ShallowWaterInteriorKernelsSameBitsAsGeneral) {
   const char* wg = std::getenv("ERODEM_OPENCL_WG");
   const std::string wg_before = wg ? wg : "";
   for (const int order : {1, 2}) {
-    // walls, fixed levels east and west, periodic, open east and west
-    for (const int edges : {0, 1, 2, 3}) {
+    // walls, fixed levels east and west, periodic, open east and west, periodic with erosion
+    // and thermal collapse (the bed changes: its ghost columns must follow)
+    for (const int edges : {0, 1, 2, 3, 4}) {
       Terrain t = bumpy_terrain(37, 10.0);
       t.water_depth.assign(t.grid.cells(), 0.0);
       for (std::size_t i = 0; i < t.bed.size(); ++i)
@@ -524,12 +527,19 @@ TEST(AgreementLaunch, ShallowWaterInteriorKernelsSameBitsAsGeneral) {
         p.boundary.sea_level = 9.5;
       }
       if (edges == 3) p.boundary.east = p.boundary.west = BoundaryKind::open;
-      p.boundary.periodic_x = edges == 2;
+      p.boundary.periodic_x = edges == 2 || edges == 4;
+      if (edges == 4) {
+        p.erosion.enabled = true;
+        p.erosion.law = ErosionLaw::mei;  // no threshold: the lake's slow water erodes too
+        p.thermal.enabled = true;
+        p.thermal.talus_angle = 20.0;
+      }
       const std::string label = std::string(order == 1 ? "first order, " : "second order, ") +
                                 (edges == 0   ? "walls"
                                  : edges == 1 ? "fixed levels east and west"
                                  : edges == 2 ? "periodic east-west"
-                                              : "open east and west");
+                                 : edges == 3 ? "open east and west"
+                                              : "periodic east-west, erosion and thermal");
       unsetenv("ERODEM_OPENCL_WG");
       Simulation rows(t, p, make_backend("opencl", t, p));
       setenv("ERODEM_OPENCL_WG", "64", 1);
@@ -544,28 +554,35 @@ TEST(AgreementLaunch, ShallowWaterInteriorKernelsSameBitsAsGeneral) {
       ASSERT_NE(b, nullptr);
       if (!a->whole_rows()) GTEST_SKIP() << "not a CPU device: no whole-row launches";
       ASSERT_FALSE(b->whole_rows());
+      const auto bed0 = rows.field(FieldId::bed);
       rows.step(80);
       rounded.step(80);
-      std::size_t values = 0, differ = 0, moving = 0;
-      for (const FieldId f :
-           {FieldId::water_depth, FieldId::momentum_x, FieldId::momentum_y, FieldId::flux_left,
-            FieldId::flux_right, FieldId::flux_top, FieldId::flux_bottom}) {
+      std::size_t values = 0, differ = 0, moving = 0, bed_moved = 0;
+      for (const FieldId f : {FieldId::water_depth, FieldId::momentum_x, FieldId::momentum_y,
+                              FieldId::flux_left, FieldId::flux_right, FieldId::flux_top,
+                              FieldId::flux_bottom, FieldId::bed, FieldId::sediment}) {
         const auto x = rows.field(f), y = rounded.field(f);
         ASSERT_EQ(x.size(), y.size());
         for (std::size_t i = 0; i < x.size(); ++i) {
           ++values;
           differ += std::memcmp(&x[i], &y[i], sizeof(double)) != 0;
           if (f == FieldId::momentum_x) moving += x[i] != 0.0;
+          if (f == FieldId::bed) bed_moved += x[i] != bed0[i];
         }
       }
       const std::size_t cells = t.grid.cells();
       std::printf(
           "[launch] shallow water, %s, 37^2, 80 steps: %zu of %zu values differ between the "
           "interior kernel (whole rows) and the general one (rounded launches) (bound 0); cells "
-          "with a nonzero eastward unit discharge %zu of %zu (bound: more than half)\n",
-          label.c_str(), differ, values, moving, cells);
+          "with a nonzero eastward unit discharge %zu of %zu (bound: more than half); cells whose "
+          "bed moved %zu (bound: more than half with erosion, else 0)\n",
+          label.c_str(), differ, values, moving, cells, bed_moved);
       EXPECT_EQ(differ, 0u) << label;
       EXPECT_GT(moving, cells / 2) << label;
+      if (edges == 4)
+        EXPECT_GT(bed_moved, cells / 2) << label;
+      else
+        EXPECT_EQ(bed_moved, 0u) << label;
     }
   }
 #endif

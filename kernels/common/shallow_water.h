@@ -625,7 +625,8 @@ ERODEM_FN_INLINED void shallow_water_muscl_cell_interior(
     GLOBAL real* out_right, GLOBAL real* out_top, GLOBAL real* out_bottom, GLOBAL real* q_x_new,
     GLOBAL real* q_y_new) {
   const int i = x + y * W;
-  const int seam_w = p.periodic_x & (x == 1), seam_e = p.periodic_x & (x == W - 2);
+  const int periodic = p.periodic_x != 0;
+  const int seam_w = periodic & (x == 1), seam_e = periodic & (x == W - 2);
   const ERODEM_S(SwCellState) w2 =
       sw_state_pick(seam_w, sw_state_of(y * W + W - 3, kind, bed, depth, u, v),
                     sw_state_of(i - 2, kind, bed, depth, u, v));
