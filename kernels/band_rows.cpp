@@ -17,7 +17,7 @@ BandRows band_rows(const Params& params, int ny) {
   b.own1 = b.rows - 1;
   const int ranks = parallel::size();
   if (ranks <= 1) return b;
-  b.halo = params.flow.scheme == FlowScheme::pipes ? 1 : 2;
+  b.halo = band_halo_rows(params);
   if (process_info(Process::transport).enabled(params) &&
       params.transport.scheme == TransportScheme::semi_lagrangian)
     throw Error(ExitCode::config,

@@ -18,7 +18,8 @@
 #    three gauges, an open east edge, a fixed-level south edge, two sections (one along a row,
 #    one down a column across every band) and outlets on both open edges (/sections too);
 #  - pipes: the pipe model with erosion and thermal, on a diamond-square terrain (each rank
-#    makes the lattices of its rows);
+#    makes the lattices of its rows), 400 m of relief and wet ground collapsing at 5 degrees
+#    (the wetness, which thermal collapse reads one row away, must reach the one halo row);
 #  - shallow_water: second-order shallow water (two stages a step, 2-row halo) with
 #    boundary.periodic_x (the periodic columns and the bands' rows together);
 #  - shallow_water_edges, shallow_water_order1: the shallow water of the second and of the first
@@ -28,7 +29,10 @@
 #    fields must be exchanged or may not be (process.hpp neighbour_read_fields): local
 #    inertial, Mei's erosion law with hardness noise, a snow pack that melts and slides,
 #    Green-Ampt infiltration, evaporation, wet thermal collapse, and terrain classes every 5
-#    steps whose tables set the Manning n and the talus angle;
+#    steps whose tables set the Manning n and the talus angle, on 400 m of relief with wet
+#    ground collapsing at 5 degrees (the wetness the bands compute on their halo rows);
+#  - thin_bands: pipes with erosion and thermal on a window of 5 rows with open north and south
+#    edges: bands of one row, whose ghost rows read the bed in their halo row;
 #  - restart: the erosion scenario run to step 20 on 3 ranks, continued from that file to
 #    step 40 on 2 ranks and on 4, and on one process from a file written by 4 ranks, each
 #    against the serial run of 40 steps;
@@ -159,12 +163,22 @@ name = "south"
 edge = "south"
 EOF
     ;;
-  pipes) sets=(--set flow.scheme=pipes --set boundary.east=open --set dem.synthetic=diamond_square) ;;
+  pipes)
+    # wet ground collapsing at 5 degrees: the wetness, which thermal collapse reads one row
+    # away, must be sent with a halo of one row (no cells sweep computes a halo row there)
+    sets=(--set flow.scheme=pipes --set boundary.east=open --set dem.synthetic=diamond_square
+      --set dem.relief=400 --set thermal.wet_talus_angle=5 --set thermal.wet_threshold=0.003
+      --set numerics.wetness_time=20)
+    ;;
   water_cycle)
+    # steep (400 m) and wet ground collapsing at 5 degrees within the 40 s, so that the
+    # wetness, which the bands compute on their halo rows instead of receiving it, matters at
+    # their edges (with evaporation skipping the halo rows, np 3 fails)
     sets=(--set erosion.law=mei --set erosion.hardness=noise --set erosion.noise_scale=100
       --set snow.enabled=true --set snow.initial=0.05 --set snow.air_temperature=3
       --set snow.slide_angle=20 --set snow.slide_rate=0.01 --set infiltration.enabled=true
-      --set evaporation.rate=1e-4 --set thermal.wet_talus_angle=20
+      --set evaporation.rate=1e-4 --set thermal.wet_talus_angle=5 --set thermal.wet_threshold=0.003
+      --set numerics.wetness_time=20 --set dem.relief=400
       --set terrain_classes.enabled=true --set terrain_classes.interval=5
       --set terrain_classes.grass.manning_n=0.04 --set terrain_classes.rock.talus_angle=40
       --set terrain_classes.mud.manning_n=0.05)
@@ -183,6 +197,17 @@ EOF
     else
       sets+=(--set flow.order=1)
     fi
+    ;;
+  thin_bands)
+    # pipes (a halo of one row) on a window of 5 rows: bands of one row at np 3 and 4, whose
+    # open north and south ghost rows read the bed two rows inside, in the halo row beyond
+    # their own (the bed after thermal collapse must be sent: exact_in_band, the boundary's
+    # reach; with it skipped np 3 and 4 differ)
+    "$erodem" generate --kind valley --size 40 --seed 7 --relief 300 thin_valley.tif >/dev/null
+    sed -i '/^synthetic = /,/^cell_size = /c\path = "thin_valley.tif"\nwindow = [0, 10, 40, 5]' \
+      scenario.toml
+    sets=(--set flow.scheme=pipes --set boundary.north=open --set boundary.south=open
+      --set boundary.east=open)
     ;;
   row_tail)
     # the valley's [dem] lines (synthetic .. cell_size) replaced by a window across a wider one
@@ -267,8 +292,8 @@ EOF
   refusals | interrupt) ;;
   *)
     echo "unknown scenario '$scenario' (erosion, pipes, shallow_water, shallow_water_edges," \
-      "shallow_water_order1, water_cycle, row_tail, dem_rows, dem_rows_coarse, restart, refusals," \
-      "interrupt)"
+      "shallow_water_order1, water_cycle, thin_bands, row_tail, dem_rows, dem_rows_coarse, restart," \
+      "refusals, interrupt)"
     exit 2
     ;;
 esac

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "erodem/backends.hpp"
@@ -365,6 +367,95 @@ TEST(Periodic, HaloExchangesOnlyWhatIsReadAtANeighbour) {
   const auto with_section = neighbour_read_fields(w);
   EXPECT_TRUE(has(with_section, "sediment"));
   EXPECT_TRUE(has(with_section, "depth_flow"));
+}
+
+// What an MPI band need not receive (process.hpp exact_in_band): fields of whose halo rows no
+// later read needs more than the band computes itself. The lists pin the data flow's result
+// for the default configuration and its variants, so that a change of the process table that
+// sends more or fewer fields shows here; whether the skipped fields' reads see the neighbour's
+// values is tests/mpi.sh's part (every Mpi* scenario the serial run's bits at N = 1..4;
+// docs/mpi.md "Halo rows computed exactly" has the mutations that fail it).
+TEST(Periodic, BandsSkipTheExchangesNoReadNeeds) {
+  using List = std::vector<std::string>;
+  // sweep name -> {fields sent to the neighbouring bands, fields skipped}, after each sweep
+  auto lists = [](const Params& p, int halo) {
+    std::map<std::string, std::pair<List, List>> out;
+    const auto tails = sweeps_tails(p, true, halo);
+    for (const Process proc : step_sequence(p)) {
+      const SweepsTail& t = tails.at(static_cast<std::size_t>(proc));
+      for (std::size_t k = 0; k < t.sweeps.size(); ++k) {
+        const List unsent = halo > 0 ? t.unsent.at(k) : List{};
+        List sent;
+        for (const auto& f : t.exchange[k])
+          if (std::find(unsent.begin(), unsent.end(), f) == unsent.end()) sent.push_back(f);
+        out[t.sweeps[k].name] = {sent, unsent};
+      }
+    }
+    return out;
+  };
+  Params p;  // local inertial (a halo of 2 rows), the physical erosion law, transport, thermal
+  p.flow.scheme = FlowScheme::local_inertial;
+  p.erosion.enabled = true;
+  p.thermal.enabled = true;
+  auto l = lists(p, 2);
+  // The ghost columns are filled on every row of the band, from their own row; the bed and the
+  // depth are sent once, before the faces read them two rows away, and the sediment's halo no
+  // read needs before erosion writes it.
+  EXPECT_EQ(l["boundary_fill"], std::make_pair(List{"bed", "water_depth"}, List{"sediment"}));
+  EXPECT_EQ(l["flow_local_inertial"].first,
+            (List{"flux_left", "flux_right", "flux_top", "flux_bottom"}));
+  // The depth the water update leaves is read next by the boundary (its own row) and by
+  // erosion and evaporation (their own cell), until the boundary's exchange; the depth it
+  // started from (depth_flow, exact on the halo row next to the own rows as that depth was) by
+  // the transport one row away.
+  EXPECT_EQ(l["water_update"], std::make_pair(List{}, List{"water_depth", "depth_flow"}));
+  // Erosion computes its halo row from a sediment the transport left exact on no halo row
+  // (the transport reads depth_flow one row away, exact on one): the transport and thermal
+  // collapse, which read one row away, need the bed and the sediment sent.
+  EXPECT_EQ(l["erosion_physical"], std::make_pair(List{"bed", "sediment"}, List{}));
+  EXPECT_EQ(l["transport_conservative"], std::make_pair(List{}, List{"sediment"}));
+  EXPECT_EQ(l["thermal_apply"], std::make_pair(List{}, List{"bed"}));
+  // the wetness is computed on the halo row next to the own rows (rows 1 .. H - 2), and thermal
+  // collapse reads it one row away
+  EXPECT_EQ(l["evaporation"], std::make_pair(List{}, List{"wetness"}));
+  std::size_t sent = 0, skipped = 0;
+  for (const auto& [name, s] : l) {
+    sent += s.first.size();
+    skipped += s.second.size();
+  }
+  std::printf(
+      "[band exchange] local inertial + erosion + thermal, halo 2: %zu fields sent a "
+      "step, %zu skipped (and thermal's shares between its passes)\n",
+      sent, skipped);
+  EXPECT_EQ(sent, 8u);
+  EXPECT_EQ(skipped, 6u);
+
+  // outside a band (boundary.periodic_x alone): nothing skipped
+  for (const auto& [name, s] : lists(p, 0)) EXPECT_TRUE(s.second.empty()) << name;
+
+  // a section's faces read the far cell's outflows, sediment and flow depth one row away
+  // before the water update and the transport, as those do themselves: the same lists
+  Params with_section = p;
+  with_section.section.push_back({"across", {{{0.0, 5.0}}, {{100.0, 5.0}}}});
+  EXPECT_EQ(lists(with_section, 2), l);
+
+  // pipes, a halo of 1 row: no cells sweep computes a halo row, so the wetness is sent, and
+  // the bed after thermal collapse (a band of one row: an open ghost row reads its halo row)
+  Params pipes = p;
+  pipes.flow.scheme = FlowScheme::pipes;
+  auto lp = lists(pipes, 1);
+  EXPECT_EQ(lp["evaporation"], std::make_pair(List{"wetness"}, List{}));
+  EXPECT_EQ(lp["thermal_apply"], std::make_pair(List{"bed"}, List{}));
+  EXPECT_EQ(lp["boundary_fill"], std::make_pair(List{"bed", "water_depth"}, List{"sediment"}));
+
+  // terrain classes (a process a step may skip) read the bed at the neighbours first in the
+  // step: thermal collapse, the bed's last writer in the step before, sends it
+  Params classes = p;
+  classes.terrain_classes.enabled = true;
+  classes.evaporation.rate = 1e-4;
+  auto lc = lists(classes, 2);
+  EXPECT_EQ(lc["thermal_apply"], std::make_pair(List{"bed"}, List{}));
+  EXPECT_EQ(lc["terrain_class"].first, List{"manning_n"});
 }
 
 // ---- lat/lon grids ----------------------------------------------------------------------

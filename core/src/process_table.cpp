@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "common/terrain_class.h"
@@ -56,11 +57,17 @@ SweepInfo generic_sweep(const char* name, std::vector<FieldUse> uses,
 
 std::vector<SweepInfo> boundary_sweeps(const Params& p) {
   // boundary_fill_cell (boundary.h): the ghosts take the bed and depth their edge gives them
-  // (the edge cell's and the one inside it: neighbours of the ghost)
-  std::vector<SweepInfo> s{{"boundary_fill",
-                            Domain::halo,
-                            {{"kind", N}, {"bed", UN}, {"water_depth", UN}, {"sediment", U}},
-                            {"boundary_fill"}}};
+  // (the edge cell's and the one inside it: neighbours of the ghost). The ghost columns read
+  // along their own row (a band fills them on its halo rows too, exact_in_band); a ghost row
+  // of an open edge reads the bed two rows inside, beyond a band's own rows only where they
+  // are fewer than 2, as the halo allows with pipes: then its first halo row (exact_in_band
+  // takes the ghost columns' own row for what the sweep leaves on the halo rows).
+  const int ghost_row_reach = std::max(0, 2 - band_halo_rows(p));
+  std::vector<SweepInfo> s{
+      {"boundary_fill",
+       Domain::halo,
+       {{"kind", N, 0}, {"bed", UN, ghost_row_reach}, {"water_depth", UN, 0}, {"sediment", U}},
+       {"boundary_fill"}}};
   if (!p.boundary.stage.empty())
     // boundary_level_sweep_cell (boundary.h): the cells held at the level inside the grid
     // follow the stage hydrograph
@@ -131,16 +138,17 @@ std::vector<SweepInfo> flow_sweeps(const Params& p) {
 std::vector<SweepInfo> water_sweeps(const Params& p) {
   // water_update_cell (water.h): the depth from the outflows in and out, the velocity from the
   // faces' discharges over their flow depths (bed and depth of the neighbours); the depth it
-  // started from stays in the second buffer for conservative transport ("depth_flow")
+  // started from stays in the second buffer for conservative transport ("depth_flow"). It
+  // reads the four neighbours: one row away.
   std::vector<SweepInfo> s{{"water_update",
                             Domain::cells,
-                            {{"kind", N},
-                             {"bed", N},
-                             {"water_depth", UN},  // the faces' flow depths
-                             {"flux_left", N},
-                             {"flux_right", N},
-                             {"flux_top", N},
-                             {"flux_bottom", N},
+                            {{"kind", N, 1},
+                             {"bed", N, 1},
+                             {"water_depth", UN, 1},  // the faces' flow depths
+                             {"flux_left", N, 1},
+                             {"flux_right", N, 1},
+                             {"flux_top", N, 1},
+                             {"flux_bottom", N, 1},
                              {"velocity_x", Wr},
                              {"velocity_y", Wr}},
                             {"water_update", "edge_tallies"},
@@ -160,14 +168,14 @@ std::vector<SweepInfo> water_sweeps(const Params& p) {
 }
 
 std::vector<SweepInfo> erosion_sweeps(const Params& p) {
-  // both read the bed (and the kinds) of the four neighbours for the bed's slope
+  // both read the bed (and the kinds) of the four neighbours for the bed's slope: one row away
   if (p.erosion.law == ErosionLaw::physical)
     // sediment_cell (erosion.h): the bed shear stress and the bed's slope, the surface layer's
     // closure, the exact exchange over the step, Exner with the layer's porosity
     return {{"erosion_physical",
              Domain::cells,
-             {{"kind", N},
-              {"bed", UN},  // the bed's slope
+             {{"kind", N, 1},
+              {"bed", UN, 1},  // the bed's slope
               {"bed_residual", U},
               {"sediment", U},
               {"soil_thickness", U},
@@ -181,8 +189,8 @@ std::vector<SweepInfo> erosion_sweeps(const Params& p) {
   // between the bed pair and the sediment
   return {{"erosion",
            Domain::cells,
-           {{"kind", N},
-            {"bed", UN},  // the bed's slope
+           {{"kind", N, 1},
+            {"bed", UN, 1},  // the bed's slope
             {"bed_residual", U},
             {"sediment", U},
             {"water_depth", R},
@@ -195,16 +203,16 @@ std::vector<SweepInfo> erosion_sweeps(const Params& p) {
 std::vector<SweepInfo> transport_sweeps(const Params& p) {
   if (p.transport.scheme == TransportScheme::conservative)
     // transport_conservative_cell (transport.h): sediment moves with the outflows at the
-    // concentration of the depth the flow saw
+    // concentration of the depth the flow saw, from the four neighbours (one row away)
     return {{"transport_conservative",
              Domain::cells,
-             {{"kind", N},
-              {"sediment", UN},
-              {"depth_flow", N},
-              {"flux_left", N},
-              {"flux_right", N},
-              {"flux_top", N},
-              {"flux_bottom", N}},
+             {{"kind", N, 1},
+              {"sediment", UN, 1},
+              {"depth_flow", N, 1},
+              {"flux_left", N, 1},
+              {"flux_right", N, 1},
+              {"flux_top", N, 1},
+              {"flux_bottom", N, 1}},
              {"transport_conservative", "edge_tallies"}}};
   // transport_semi_lagrangian_cell (transport.h): back-traced along the velocity
   return {{"transport_semi_lagrangian",
@@ -216,19 +224,22 @@ std::vector<SweepInfo> transport_sweeps(const Params& p) {
 std::vector<SweepInfo> thermal_sweeps(const Params& p) {
   // thermal_share_cell then thermal_apply_cell (thermal.h): what each cell gives, then what
   // it keeps and takes from its neighbours; each cell's dry talus slope from its class's table
-  // where the terrain classes give talus angles
-  std::vector<SweepInfo> s{
-      {"thermal_share",
-       Domain::cells,
-       {{"kind", N}, {"bed", N}, {"wetness", R}, {"thermal_share", Wr}},
-       {"thermal_share"}},
-      {"thermal_apply",
-       Domain::cells,
-       {{"kind", N}, {"bed", UN}, {"bed_residual", U}, {"wetness", N}, {"thermal_share", N}},
-       {"thermal_apply"}}};
+  // where the terrain classes give talus angles; both read the four neighbours (one row away)
+  std::vector<SweepInfo> s{{"thermal_share",
+                            Domain::cells,
+                            {{"kind", N, 1}, {"bed", N, 1}, {"wetness", R}, {"thermal_share", Wr}},
+                            {"thermal_share"}},
+                           {"thermal_apply",
+                            Domain::cells,
+                            {{"kind", N, 1},
+                             {"bed", UN, 1},
+                             {"bed_residual", U},
+                             {"wetness", N, 1},
+                             {"thermal_share", N, 1}},
+                            {"thermal_apply"}}};
   if (class_tables(p).talus) {
     s[0].uses.push_back({"talus_slope", R});
-    s[1].uses.push_back({"talus_slope", N});
+    s[1].uses.push_back({"talus_slope", N, 1});
   }
   return s;
 }
@@ -645,7 +656,11 @@ std::vector<std::string> halo_fields(const SweepInfo& sweep,
   return out;
 }
 
-std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo) {
+int band_halo_rows(const Params& params) {
+  return params.flow.scheme == FlowScheme::pipes ? 1 : 2;
+}
+
+std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo, int band_halo) {
   const std::vector<std::string> needed =
       halo ? neighbour_read_fields(params) : std::vector<std::string>();
   std::vector<SweepsTail> tails;
@@ -667,7 +682,173 @@ std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo) {
         if (std::find(done.begin(), done.end(), f) == done.end()) t.exchange[k].push_back(f);
     }
   }
+  if (halo && band_halo > 0) exact_in_band(params, band_halo, tails);
   return tails;
+}
+
+namespace {
+
+/// The fields a process's own loops exchange after its non-generic sweep k, before the next:
+/// those it writes that a later one of them reads at a neighbour and leaves as it is
+/// (sweeps_tails: thermal's shares).
+std::vector<std::string> loop_exchanged(const std::vector<SweepInfo>& sweeps, std::size_t k) {
+  std::vector<std::string> done;
+  if (sweeps[k].generic) return done;
+  const std::vector<std::string> written = halo_fields(sweeps[k]);
+  for (std::size_t j = k + 1; j < sweeps.size(); ++j)
+    if (!sweeps[j].generic)
+      for (const FieldUse& u : sweeps[j].uses)
+        if (reads_neighbours(u.access) && !writes(u.access) &&
+            std::find(written.begin(), written.end(), u.field) != written.end())
+          done.emplace_back(u.field);
+  return done;
+}
+
+/// The rows beyond its own cell's that a use reads, in a band of `h` halo rows.
+int reach_rows(const FieldUse& u, int h) {
+  if (!reads_neighbours(u.access)) return 0;
+  return u.rows < 0 ? h : std::min(u.rows, h);
+}
+
+bool grid_input(const std::string& f) {
+  return f == "kind" || f == "dx" || f == "dy" || f == "area";
+}
+
+/// Whether a step may skip the process (Simulation::step runs the terrain classes every
+/// terrain_classes.interval steps only).
+bool may_skip(Process p) {
+  return p == Process::terrain_class;
+}
+
+}  // namespace
+
+void exact_in_band(const Params& params, int h, std::vector<SweepsTail>& tails) {
+  // the sweeps in the order the backends run them (run_sweeps_tail): each process's own loops
+  // in order, then their exchanges, then its generic sweeps with theirs
+  struct At {
+    std::size_t p, k;
+    bool exchanges_after;  // the exchanges of (p, k) come right after it (else: `flush`)
+    bool flush;            // the process's own loops end here: their exchanges follow
+  };
+  std::vector<At> order;
+  for (const Process proc : step_sequence(params)) {
+    const auto p = static_cast<std::size_t>(proc);
+    const auto& sweeps = tails.at(p).sweeps;
+    std::size_t last_own = sweeps.size();
+    for (std::size_t k = 0; k < sweeps.size(); ++k)
+      if (!sweeps[k].generic) last_own = k;
+    for (std::size_t k = 0; k < sweeps.size(); ++k)
+      if (!sweeps[k].generic) order.push_back({p, k, false, k == last_own});
+    for (std::size_t k = 0; k < sweeps.size(); ++k)
+      if (sweeps[k].generic) order.push_back({p, k, true, false});
+  }
+  // marks[i]: the fields exchanged after order[i]
+  std::vector<std::set<std::string>> marks(order.size());
+  std::map<std::string, std::vector<std::size_t>> writers;  // of each field, in step order
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const SweepInfo& s = tails[order[i].p].sweeps[order[i].k];
+    for (const std::string& f : halo_fields(s)) writers[f].push_back(i);
+  }
+  auto skips = [&](std::size_t i) { return may_skip(static_cast<Process>(order[i].p)); };
+  // the faces of sections and outlets (neighbour_read_fields) read the cell beyond each face,
+  // one row away: the outflows before the water update, and the sediment, the flow depth and
+  // the outflows before the transport (Backend::run's measure_water_faces,
+  // measure_sediment_faces)
+  const bool faces = !params.section.empty() || !params.outlet.empty();
+  const std::vector<std::string> outflows{"flux_left", "flux_right", "flux_top", "flux_bottom"};
+
+  std::map<std::string, int> start;  // e at the start of a step; h where absent
+  auto get = [h](const std::map<std::string, int>& e, const std::string& f) {
+    const auto it = e.find(f);
+    return grid_input(f) || it == e.end() ? h : it->second;
+  };
+  for (int round = 0;; ++round) {
+    if (round > 64)
+      throw Error(ExitCode::internal, "exact_in_band: the halo rows' data flow does not settle");
+    std::map<std::string, int> e = start;
+    std::size_t marked = 0;
+    for (const auto& m : marks) marked += m.size();
+    // a read `r` rows away, before order[i], of a field exact on fewer: the last sweep to write
+    // it exchanges it (the step before's, where none of this step has yet), and the one before
+    // that where the step may skip it, up to one it never skips
+    auto need = [&](const std::string& f, int r, std::size_t i) {
+      if (grid_input(f) || get(e, f) >= r) return;
+      const std::vector<std::size_t>& w = writers.at(f);
+      const auto first_after = std::lower_bound(w.begin(), w.end(), i) - w.begin();
+      for (std::size_t n = 1; n <= w.size(); ++n) {
+        const std::size_t j = w[(first_after + w.size() - n) % w.size()];
+        // an own loop's exchange comes after the process's last own loop: not before a later
+        // one of them (the loop would have to exchange it itself, as thermal's shares)
+        if (j < i && order[j].p == order[i].p && !order[j].exchanges_after &&
+            !order[i].exchanges_after)
+          throw Error(ExitCode::internal,
+                      fmt::format("exact_in_band: sweep '{}' reads '{}' {} rows away, which an "
+                                  "earlier loop of its process writes and does not exchange",
+                                  tails[order[i].p].sweeps[order[i].k].name, f, r));
+        marks[j].insert(f);
+        if (!skips(j)) break;
+      }
+      e[f] = h;
+    };
+    std::vector<std::size_t> own_loops;  // the process's own sweeps run so far
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const auto& sweeps = tails[order[i].p].sweeps;
+      const SweepInfo& s = sweeps[order[i].k];
+      const auto proc = static_cast<Process>(order[i].p);
+      if (faces && order[i].k == 0 && proc == Process::water)
+        for (const std::string& f : outflows) need(f, std::min(1, h), i);
+      if (faces && order[i].k == 0 && proc == Process::transport) {
+        for (const std::string& f : outflows) need(f, std::min(1, h), i);
+        need("sediment", std::min(1, h), i);
+        need("depth_flow", std::min(1, h), i);
+      }
+      int m = s.domain == Domain::cells ? h - 1 : h;
+      for (const FieldUse& u : s.uses) {
+        if (u.access == Access::write) continue;
+        const int r = reach_rows(u, h);
+        need(u.field, r, i);
+        // the ghost cells on a band's halo rows are its ghost columns, which read along their
+        // own row (a ghost row, which reads the rows inside, is never a halo row)
+        m = std::min(m, get(e, u.field) - (s.domain == Domain::halo ? 0 : r));
+      }
+      m = std::max(m, 0);
+      for (const std::string& f : halo_fields(s))
+        // a cells sweep writes every row of its band; the others some cells only, both copies
+        // of each alike; a sweep the step may skip leaves what was there, or its own
+        e[f] = s.domain == Domain::cells && !skips(i) ? m : std::min(get(e, f), m);
+      if (order[i].exchanges_after) {
+        for (const std::string& f : marks[i]) e[f] = h;
+        continue;
+      }
+      for (const std::string& f : loop_exchanged(sweeps, order[i].k)) e[f] = h;
+      own_loops.push_back(i);
+      if (order[i].flush) {
+        for (const std::size_t j : own_loops)
+          for (const std::string& f : marks[j]) e[f] = h;
+        own_loops.clear();
+      }
+    }
+    std::size_t marked_now = 0;
+    for (const auto& mk : marks) marked_now += mk.size();
+    bool same = marked_now == marked;
+    for (auto& [f, v] : e) {
+      const int next = std::min(get(start, f), v);
+      if (next != get(start, f)) same = false;
+      start[f] = next;
+    }
+    if (same) break;
+  }
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    SweepsTail& t = tails[order[i].p];
+    t.unsent.resize(t.sweeps.size());
+    auto& exchange = t.exchange[order[i].k];
+    auto& unsent = t.unsent[order[i].k];
+    unsent.clear();
+    for (const std::string& f : marks[i])  // never outside the list: add it, to be safe
+      if (std::find(exchange.begin(), exchange.end(), f) == exchange.end()) exchange.push_back(f);
+    for (const std::string& f : exchange)
+      if (!marks[i].count(f)) unsent.push_back(f);
+  }
 }
 
 namespace {

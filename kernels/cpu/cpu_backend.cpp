@@ -38,7 +38,7 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
   H_ = band_.rows;
   PaddedState s = build_padded_state(terrain, params, band_.row0, band_.row0 + H_);
   periodic_ = s.periodic_x;
-  tails_ = sweeps_tails(params, periodic_ || band_.banded);
+  tails_ = sweeps_tails(params, periodic_ || band_.banded, band_.banded ? band_.halo : 0);
   stats_in_pass_ = step_sequence(params).back() == Process::evaporation;
   changes_material_ = material_changers(params);
   material_rows_.resize(static_cast<std::size_t>(H_ - 2));
@@ -209,7 +209,9 @@ void CpuBackend<Real>::run(Process p) {
   run_sweeps_tail(
       tails_.at(static_cast<std::size_t>(p)),
       [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
-      [&](const std::vector<std::string>& names) { exchange_halo(names); });
+      [&](const std::vector<std::string>& names, const std::vector<std::string>& unsent) {
+        exchange_halo(names, unsent);
+      });
 }
 
 template <class Real>
@@ -243,9 +245,10 @@ void CpuBackend<Real>::run_fused(const std::vector<Process>& part) {
 }
 
 template <class Real>
-void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
+void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names,
+                                     const std::vector<std::string>& unsent) {
   if (!periodic_ && !band_.banded) return;
-  std::vector<Real*> fields;
+  std::vector<Real*> fields, sent;
   for (const std::string& name : names) {
     Field* f = name == "depth_flow"      ? &depth_next_
                : name == "thermal_share" ? &thermal_share_
@@ -255,14 +258,16 @@ void CpuBackend<Real>::exchange_halo(const std::vector<std::string>& names) {
                   fmt::format("halo exchange: field '{}' has no storage", name));
     if (uniform(*f)) continue;  // a uniform parameter: every row holds its one row
     fields.push_back(f->data());
+    if (std::find(unsent.begin(), unsent.end(), name) == unsent.end()) sent.push_back(f->data());
   }
-  exchange_fields(fields);
+  exchange_fields(fields, sent);
 }
 
 template <class Real>
-void CpuBackend<Real>::exchange_fields(const std::vector<Real*>& fields) {
+void CpuBackend<Real>::exchange_fields(const std::vector<Real*>& copied,
+                                       const std::vector<Real*>& fields) {
   if (periodic_)
-    for (Real* f : fields) copy_periodic_columns(f, W_, H_);
+    for (Real* f : copied) copy_periodic_columns(f, W_, H_);
   if (!band_.banded || fields.empty()) return;
   // whole padded rows (the ghost columns and the corners with them): my first band_.halo own
   // rows to the band above, my last to the band below; theirs into my halo rows. Every field's

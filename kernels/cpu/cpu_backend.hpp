@@ -111,12 +111,16 @@ class CpuBackend final : public Backend {
   /// The halo exchange (process.hpp halo_fields): with boundary.periodic_x, copies the named
   /// fields (of the field table, or the intermediates "depth_flow", "thermal_share") into the
   /// ghost columns that repeat the opposite DEM columns; in a band of an MPI run, receives
-  /// the halo rows from the neighbouring ranks (exchange_fields); nothing otherwise.
-  void exchange_halo(const std::vector<std::string>& names);
+  /// the halo rows from the neighbouring ranks (exchange_fields), but those of `unsent`, whose
+  /// halo rows no later read needs from them (SweepsTail::unsent); nothing otherwise.
+  void exchange_halo(const std::vector<std::string>& names,
+                     const std::vector<std::string>& unsent = {});
   /// The halo exchange of padded fields (W_ x H_ each): their periodic ghost columns, then (a
   /// band of an MPI run) their band_.halo rows on either side from the neighbouring ranks, all
   /// the fields in one message each way.
-  void exchange_fields(const std::vector<Real*>& fields);
+  void exchange_fields(const std::vector<Real*>& fields) { exchange_fields(fields, fields); }
+  /// The same, the periodic ghost columns of `copied` and the halo rows of `sent`.
+  void exchange_fields(const std::vector<Real*>& copied, const std::vector<Real*>& sent);
 
  private:
   using Kind = cell::erodem_kind_t;

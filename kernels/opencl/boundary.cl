@@ -3,16 +3,16 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "boundary.h"
 
-/* One work-item per halo cell, corners excluded: ids [0, W-2) the north row, then the south
- * row, the west column and the east column (the cells the CPU loops visit). The north and
- * south rows only where they are the grid's ghost rows (`north`, `south`): in a band of an MPI
- * run they may be halo rows, which the neighbouring band gives. */
+/* One work-item per halo cell: ids [0, W-2) the north row, then the south row, then the west
+ * column and the east column, H each (the cells the CPU loops visit). The north and south rows
+ * only where they are the grid's ghost rows (`north`, `south`), whose corners keep theirs: in a
+ * band of an MPI run they may be halo rows, whose ghost columns it fills. */
 __kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
                             __global real* restrict bed, __global real* restrict depth,
                             __global real* restrict sediment, BoundaryParams p, int north,
                             int south) {
   const int id = (int)get_global_id(0);
-  const int nxi = W - 2, nyi = H - 2;
+  const int nxi = W - 2;
   int x, y;
   if (id < nxi) {
     if (!north) return;
@@ -22,12 +22,12 @@ __kernel void boundary_fill(int W, int H, __global const uchar* restrict kind,
     if (!south) return;
     x = 1 + id - nxi;
     y = H - 1;
-  } else if (id < 2 * nxi + nyi) {
-    x = 0;
-    y = 1 + id - 2 * nxi;
-  } else if (id < 2 * (nxi + nyi)) {
-    x = W - 1;
-    y = 1 + id - 2 * nxi - nyi;
+  } else if (id < 2 * (nxi + H)) {
+    x = id < 2 * nxi + H ? 0 : W - 1;
+    y = id - 2 * nxi - (x == 0 ? 0 : H);
+    /* the ghost columns on every row but the grid's ghost rows (their corners keep theirs): on
+     * a band's halo rows too, as its neighbour fills them (process_table.cpp exact_in_band) */
+    if ((y == 0 && north) || (y == H - 1 && south)) return;
   } else {
     return;
   }

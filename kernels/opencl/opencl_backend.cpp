@@ -74,7 +74,7 @@ OpenClBackend::OpenClBackend(const Terrain& terrain, const Params& params,
                                             nx_, ny_));
   PaddedState state = build_padded_state(terrain, params, band_.row0, band_.row0 + H_);
   periodic_ = state.periodic_x;
-  tails_ = sweeps_tails(params, periodic_ || band_.banded);
+  tails_ = sweeps_tails(params, periodic_ || band_.banded, band_.banded ? band_.halo : 0);
   changes_material_ = material_changers(params);
   cell_.flow.periodic_x = periodic_ ? 1 : 0;
 
@@ -277,7 +277,9 @@ void OpenClBackend::run(Process p) {
   run_sweeps_tail(
       tails_.at(static_cast<std::size_t>(p)),
       [&](const SweepInfo& s) { run_generic(s, p, dt, tally); },
-      [&](const std::vector<std::string>& names) { exchange_halo(names); });
+      [&](const std::vector<std::string>& names, const std::vector<std::string>& unsent) {
+        exchange_halo(names, unsent);
+      });
 }
 
 std::vector<std::vector<Process>> OpenClBackend::fused_parts(
@@ -312,12 +314,15 @@ void OpenClBackend::run_fused(const std::vector<Process>& part) {
     run_sweeps_tail(
         tails_.at(static_cast<std::size_t>(p)),
         [&](const SweepInfo& s) { run_generic(s, p, dt, step_tally_); },
-        [&](const std::vector<std::string>& names) { exchange_halo(names); });
+        [&](const std::vector<std::string>& names, const std::vector<std::string>& unsent) {
+          exchange_halo(names, unsent);
+        });
 }
 
-void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
+void OpenClBackend::exchange_halo(const std::vector<std::string>& names,
+                                  const std::vector<std::string>& unsent) {
   if (!periodic_ && !band_.banded) return;
-  std::vector<const Buffer*> buffers;
+  std::vector<const Buffer*> buffers, sent;
   for (const std::string& name : names) {
     const Buffer* b = name == "depth_flow"      ? &depth_next_
                       : name == "thermal_share" ? &depth_next_
@@ -328,15 +333,17 @@ void OpenClBackend::exchange_halo(const std::vector<std::string>& names) {
     if (!b)
       throw Error(ExitCode::internal, fmt::format("halo exchange: field '{}' has no buffer", name));
     buffers.push_back(b);
+    if (std::find(unsent.begin(), unsent.end(), name) == unsent.end()) sent.push_back(b);
   }
-  exchange_buffers(buffers);
+  exchange_buffers(buffers, sent);
 }
 
-void OpenClBackend::exchange_buffers(const std::vector<const Buffer*>& buffers) {
+void OpenClBackend::exchange_buffers(const std::vector<const Buffer*>& copied,
+                                     const std::vector<const Buffer*>& sent) {
+  for (const Buffer* b : copied) copy_periodic_columns(*b);  // none for a one-row parameter
   std::vector<const Buffer*> held;  // one row: the same value beyond the seam and in every band
-  for (const Buffer* b : buffers)
+  for (const Buffer* b : sent)
     if (!uniform(*b)) held.push_back(b);
-  for (const Buffer* b : held) copy_periodic_columns(*b);
   if (!band_.banded || held.empty()) return;
   // whole padded rows (the ghost columns and the corners with them): my first band_.halo own
   // rows to the band above, my last to the band below; theirs into my halo rows. Every
@@ -446,11 +453,11 @@ void OpenClBackend::measure_faces(bool sediment) {
 
 void OpenClBackend::run_boundary() {
   cl_kernel k = kernel("boundary_fill");
-  // the first and last padded rows where they are the grid's ghost rows (in a band of an MPI
-  // run they may be halo rows, which the neighbouring band gives)
+  // the first and last padded rows where they are the grid's ghost rows; in a band of an MPI
+  // run they may be halo rows instead, whose ghost columns it fills as on the other rows
   const cl_int north = band_.holds_north_ghost(), south = band_.holds_south_ghost(ny_);
   set_args(k, cl_int{W_}, cl_int{H_}, kind_, bed_, depth_, sediment_, cell_.boundary, north, south);
-  const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_ - 2);
+  const std::size_t global = 2 * static_cast<std::size_t>(W_ - 2 + H_);
   check(clEnqueueNDRangeKernel(queue_.get(), k, 1, nullptr, &global, nullptr, 0, nullptr,
                                profile_event(k)),
         "clEnqueueNDRangeKernel(boundary_fill)");

@@ -221,14 +221,21 @@ class OpenClBackend final : public Backend {
   /// DEM rows; the process's tallies deferred (launch.cpp).
   void run_generic(const SweepInfo& sweep, Process process, Real dt, StepTally& tally);
   /// The halo exchange (process.hpp halo_fields) of the named fields (of the field table, or
-  /// the intermediates "depth_flow", "thermal_share"): exchange_buffers on their buffers.
-  void exchange_halo(const std::vector<std::string>& names);
+  /// the intermediates "depth_flow", "thermal_share"): exchange_buffers on their buffers, but
+  /// no halo rows of `unsent` (as the CPU reference's exchange_halo).
+  void exchange_halo(const std::vector<std::string>& names,
+                     const std::vector<std::string>& unsent = {});
   /// The halo exchange of padded buffers (W_ x H_ each; a parameter held as one row needs
   /// none): with boundary.periodic_x their ghost columns (halo_periodic_x, boundary.cl), then
   /// in a band of an MPI run their band_.halo rows on either side from the neighbouring
   /// ranks, every buffer's rows in one message each way, as the CPU reference's
   /// exchange_fields; nothing otherwise.
-  void exchange_buffers(const std::vector<const Buffer*>& buffers);
+  void exchange_buffers(const std::vector<const Buffer*>& buffers) {
+    exchange_buffers(buffers, buffers);
+  }
+  /// The same, the periodic ghost columns of `copied` and the halo rows of `sent`.
+  void exchange_buffers(const std::vector<const Buffer*>& copied,
+                        const std::vector<const Buffer*>& sent);
   /// halo_periodic_x on `b` with boundary.periodic_x (no exchange between ranks).
   void copy_periodic_columns(const Buffer& b);
 

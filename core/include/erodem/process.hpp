@@ -53,6 +53,12 @@ enum class Domain : std::uint8_t { cells, halo, points };
 struct FieldUse {
   const char* field;
   Access access;
+  /// How many rows beyond its own cell's a read at neighbours (read_neighbours,
+  /// update_neighbours) reaches: -1 (the default) as far as any sweep of the step may, the
+  /// MPI band's halo; 0 along its own row only. Which exchanges a band may skip
+  /// (exact_in_band) follows from it; a value below the cell function's true reach would leave
+  /// halo rows that differ from the neighbouring band's in the run (tests/mpi.sh).
+  int rows = -1;
 };
 
 /// One pass over the grid: the unit of execution. A sweep may compose the cell functions of
@@ -203,27 +209,63 @@ struct SweepsTail {
   /// process's own loops, what a later one of them reads at a neighbour and leaves as it is
   /// (the loop has exchanged that already: thermal's shares before it applies them)
   std::vector<std::vector<std::string>> exchange;
+  /// unsent[k]: the fields of exchange[k] that an MPI band does not receive from its
+  /// neighbours after sweep k, as no later read needs more of their halo rows than the band
+  /// computes itself (exact_in_band); the periodic copy of the ghost columns still takes them.
+  /// Empty outside a band.
+  std::vector<std::vector<std::string>> unsent;
 };
+
+/// The rows of halo an MPI band holds on either side of its own rows (kernels/band_rows.hpp):
+/// 2 with local inertial and the shallow water, whose faces read the cells and faces two rows
+/// away, 1 with pipes, whose sweeps read the four neighbours only.
+int band_halo_rows(const Params& params);
 
 /// The SweepsTail of every process (indexed by Process) for a run of `params`: `halo` whether
 /// the halo is shared (boundary.periodic_x, MPI bands); the exchanges hold only what
-/// neighbour_read_fields(params) holds.
-std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo);
+/// neighbour_read_fields(params) holds. `band_halo`: the halo rows of an MPI band (0: no
+/// band), for SweepsTail::unsent.
+std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo, int band_halo = 0);
+
+/// Which exchanges an MPI band of `h` halo rows may skip (docs/mpi.md "Halo rows computed
+/// exactly"): the fields of tails[p].exchange[k] (sweeps_tails) that no later read needs from
+/// the neighbouring band, by a data-flow pass over the step's sweeps in the order the backends
+/// run them (a process's own loops, then their exchanges, then its generic sweeps, each with its
+/// exchange). It counts, for every field, how many halo rows next to the own rows hold the
+/// neighbouring band's values (e, 0 .. h): an exchange makes it h; a cells sweep computes the
+/// rows 1 .. H - 2 of its band, so what it writes is exact on min(h - 1, e_f - r_f) rows, over
+/// every field f it reads r_f rows away (FieldUse::rows); a sweep over the point cells leaves
+/// the others as they were and keeps min(e, e_f - r_f), and one over the ghost cells (the
+/// boundary's, whose ghost columns on every row of the band read along their row) min(e, e_f).
+/// A read r rows away needs e >= r: where it is less, the last sweep to write the field
+/// exchanges it. The start of a step takes the end of the step before, from h everywhere (the
+/// initial and restarted state hold every halo row), repeated until nothing changes; the faces
+/// of sections and outlets read the cell beyond them one row away before the water update and
+/// the transport (Backend::run). A read before an earlier own loop of its process has
+/// exchanged what it needs throws Error(internal). The result: tails[p].unsent[k], the fields
+/// of exchange[k] that no read needs from the neighbour (they may be exact on fewer rows than
+/// h: none reads further), the others sent as before.
+void exact_in_band(const Params& params, int h, std::vector<SweepsTail>& tails);
 
 /// The tail of Backend::run(p) in both backends, the one place of the halo exchange: after the
 /// process's own loops (which exchange in between where a pass reads what an earlier one of
 /// theirs wrote), the exchange of their sweeps' fields; then each generic sweep
 /// (`run_generic(sweep)`) and its exchange (`exchange(fields)`), as `tail` (sweeps_tails)
-/// lists them.
+/// lists them: `exchange(fields, unsent)` with `unsent` the fields of those that an MPI band
+/// does not send (SweepsTail::unsent).
 template <class RunGeneric, class Exchange>
 void run_sweeps_tail(const SweepsTail& tail, const RunGeneric& run_generic,
                      const Exchange& exchange) {
+  static const std::vector<std::string> none;
+  auto unsent = [&](std::size_t k) -> const std::vector<std::string>& {
+    return k < tail.unsent.size() ? tail.unsent[k] : none;
+  };
   for (std::size_t k = 0; k < tail.sweeps.size(); ++k)
-    if (!tail.sweeps[k].generic && !tail.exchange[k].empty()) exchange(tail.exchange[k]);
+    if (!tail.sweeps[k].generic && !tail.exchange[k].empty()) exchange(tail.exchange[k], unsent(k));
   for (std::size_t k = 0; k < tail.sweeps.size(); ++k)
     if (tail.sweeps[k].generic) {
       run_generic(tail.sweeps[k]);
-      if (!tail.exchange[k].empty()) exchange(tail.exchange[k]);
+      if (!tail.exchange[k].empty()) exchange(tail.exchange[k], unsent(k));
     }
 }
 
