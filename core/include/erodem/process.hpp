@@ -227,24 +227,25 @@ int band_halo_rows(const Params& params);
 /// band), for SweepsTail::unsent.
 std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo, int band_halo = 0);
 
-/// Which exchanges an MPI band of `h` halo rows may skip (docs/mpi.md "Halo rows computed
-/// exactly"): the fields of tails[p].exchange[k] (sweeps_tails) that no later read needs from
-/// the neighbouring band, by a data-flow pass over the step's sweeps in the order the backends
-/// run them (a process's own loops, then their exchanges, then its generic sweeps, each with its
-/// exchange). It counts, for every field, how many halo rows next to the own rows hold the
-/// neighbouring band's values (e, 0 .. h): an exchange makes it h; a cells sweep computes the
-/// rows 1 .. H - 2 of its band, so what it writes is exact on min(h - 1, e_f - r_f) rows, over
-/// every field f it reads r_f rows away (FieldUse::rows); a sweep over the point cells leaves
+/// Which exchanges an MPI band of `h` halo rows (band_halo_rows(params), which the boundary's
+/// reach assumes) may skip (docs/mpi.md "Halo rows computed exactly"): the fields of
+/// tails[p].exchange[k] (sweeps_tails) that no later read needs from the neighbouring band, by a
+/// data-flow pass over the step's sweeps in the order the backends run them (a process's own loops,
+/// then their exchanges, then its generic sweeps, each with its exchange). It counts, for every
+/// field, how many halo rows next to the own rows hold the neighbouring band's values (e, 0 .. h):
+/// an exchange makes it h; a cells sweep computes the rows 1 .. H - 2 of its band (the flow also
+/// the outermost, clamped: not counted), so what it writes is exact on min(h - 1, e_f - r_f) rows,
+/// over every field f it reads r_f rows away (FieldUse::rows); a sweep over the point cells leaves
 /// the others as they were and keeps min(e, e_f - r_f), and one over the ghost cells (the
-/// boundary's, whose ghost columns on every row of the band read along their row) min(e, e_f).
-/// A read r rows away needs e >= r: where it is less, the last sweep to write the field
-/// exchanges it. The start of a step takes the end of the step before, from h everywhere (the
-/// initial and restarted state hold every halo row), repeated until nothing changes; the faces
-/// of sections and outlets read the cell beyond them one row away before the water update and
-/// the transport (Backend::run). A read before an earlier own loop of its process has
-/// exchanged what it needs throws Error(internal). The result: tails[p].unsent[k], the fields
-/// of exchange[k] that no read needs from the neighbour (they may be exact on fewer rows than
-/// h: none reads further), the others sent as before.
+/// boundary's, whose ghost columns on every row of the band read along their row) min(e, e_f). A
+/// read r rows away needs e >= r: where it is less, the last sweep to write the field exchanges it.
+/// The start of a step takes the end of the step before, from h everywhere (the initial and
+/// restarted state hold every halo row), repeated until nothing changes; the faces of sections and
+/// outlets read the cell beyond them one row away before the water update and the transport
+/// (Backend::run). A read before an earlier own loop of its process has exchanged what it needs
+/// throws Error(internal). The result: tails[p].unsent[k], the fields of exchange[k] that no read
+/// needs from the neighbour (they may be exact on fewer rows than h: none reads further), the
+/// others sent as before.
 void exact_in_band(const Params& params, int h, std::vector<SweepsTail>& tails);
 
 /// The tail of Backend::run(p) in both backends, the one place of the halo exchange: after the
