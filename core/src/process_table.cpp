@@ -616,10 +616,15 @@ void check_sweeps(const std::vector<std::pair<Process, SweepInfo>>& sweeps) {
 
 namespace {
 
+/// Whether `f` is a grid input no sweep writes (the kinds, the per-row sizes).
+bool grid_input(const std::string& f) {
+  return f == "kind" || f == "dx" || f == "dy" || f == "area";
+}
+
 /// Adds `field` to `out` once, but not the grid inputs that no sweep writes (the kinds and
 /// the per-row sizes): the lists of the halo exchange.
 void add_halo_field(std::vector<std::string>& out, const std::string& field) {
-  if (field == "kind" || field == "dx" || field == "dy" || field == "area") return;
+  if (grid_input(field)) return;
   if (std::find(out.begin(), out.end(), field) == out.end()) out.push_back(field);
 }
 
@@ -660,32 +665,6 @@ int band_halo_rows(const Params& params) {
   return params.flow.scheme == FlowScheme::pipes ? 1 : 2;
 }
 
-std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo, int band_halo) {
-  const std::vector<std::string> needed =
-      halo ? neighbour_read_fields(params) : std::vector<std::string>();
-  std::vector<SweepsTail> tails;
-  for (const ProcessInfo& info : process_table()) {
-    const auto p = static_cast<std::size_t>(info.id);
-    if (tails.size() <= p) tails.resize(p + 1);
-    SweepsTail& t = tails[p];
-    t.sweeps = info.sweeps(params);
-    t.exchange.assign(t.sweeps.size(), {});
-    if (!halo) continue;
-    for (std::size_t k = 0; k < t.sweeps.size(); ++k) {
-      std::vector<std::string> done;
-      if (!t.sweeps[k].generic)
-        for (std::size_t j = k + 1; j < t.sweeps.size(); ++j)
-          if (!t.sweeps[j].generic)
-            for (const FieldUse& u : t.sweeps[j].uses)
-              if (reads_neighbours(u.access) && !writes(u.access)) done.emplace_back(u.field);
-      for (const std::string& f : halo_fields(t.sweeps[k], needed))
-        if (std::find(done.begin(), done.end(), f) == done.end()) t.exchange[k].push_back(f);
-    }
-  }
-  if (halo && band_halo > 0) exact_in_band(params, band_halo, tails);
-  return tails;
-}
-
 namespace {
 
 /// The fields a process's own loops exchange after its non-generic sweep k, before the next:
@@ -704,14 +683,35 @@ std::vector<std::string> loop_exchanged(const std::vector<SweepInfo>& sweeps, st
   return done;
 }
 
+}  // namespace
+
+std::vector<SweepsTail> sweeps_tails(const Params& params, bool halo, int band_halo) {
+  const std::vector<std::string> needed =
+      halo ? neighbour_read_fields(params) : std::vector<std::string>();
+  std::vector<SweepsTail> tails;
+  for (const ProcessInfo& info : process_table()) {
+    const auto p = static_cast<std::size_t>(info.id);
+    if (tails.size() <= p) tails.resize(p + 1);
+    SweepsTail& t = tails[p];
+    t.sweeps = info.sweeps(params);
+    t.exchange.assign(t.sweeps.size(), {});
+    if (!halo) continue;
+    for (std::size_t k = 0; k < t.sweeps.size(); ++k) {
+      const std::vector<std::string> done = loop_exchanged(t.sweeps, k);
+      for (const std::string& f : halo_fields(t.sweeps[k], needed))
+        if (std::find(done.begin(), done.end(), f) == done.end()) t.exchange[k].push_back(f);
+    }
+  }
+  if (halo && band_halo > 0) exact_in_band(params, band_halo, tails);
+  return tails;
+}
+
+namespace {
+
 /// The rows beyond its own cell's that a use reads, in a band of `h` halo rows.
 int reach_rows(const FieldUse& u, int h) {
   if (!reads_neighbours(u.access)) return 0;
   return u.rows < 0 ? h : std::min(u.rows, h);
-}
-
-bool grid_input(const std::string& f) {
-  return f == "kind" || f == "dx" || f == "dy" || f == "area";
 }
 
 /// Whether a step may skip the process (Simulation::step runs the terrain classes every
