@@ -12,6 +12,11 @@ inertial and pipes, float32 (and local inertial in float64, Landlab's precision)
 virtual environment. The measurements alternate (erodem, Landlab, erodem, ...) so that the
 machine's drift falls on both, and each figure is the median of `--repeats`.
 
+Beside them runs a plain two-kernel pipe model (`pipes_plain.cpp` here, built with the system's
+g++ into `build/pipes_plain`): the yardstick of issue 20's pipes target, on the same terrain,
+depth, rain and step, with walls, as it is and with the velocities and the per-step volume sum
+that erodem's step also computes (`--velocities --sums`).
+
 Landlab's `overland_flow(dt)` takes sub-steps of min(alpha dx / sqrt(g h_max), dt): with
 alpha = 0.7 and dx = 10 m, dt = 0.5 s is one sub-step while h_max < 19.9 m, which the worker
 checks (it counts the sub-steps through the elapsed-time bookkeeping and refuses otherwise).
@@ -105,6 +110,23 @@ def ensure_venv(venv):
     return py
 
 
+def ensure_plain(path):
+    """Builds pipes_plain.cpp into `path` (again where the source is newer); returns `path`."""
+    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "pipes_plain.cpp")
+    if not os.path.exists(path) or os.path.getmtime(path) < os.path.getmtime(src):
+        # erodem's value-safe kernel flags (kernels/CMakeLists.txt); the host's instructions
+        run(["g++", "-std=c++17", "-O3", "-march=native", "-fopenmp", "-fno-math-errno",
+             "-fno-trapping-math", "-ffp-contract=off", "-o", path, src])
+    return path
+
+
+def plain_rate(plain, f32, size, threads, steps, extra):
+    cmd = [plain, f32, str(size), str(size), str(CELL), str(steps), "--depth", str(DEPTH),
+           "--rain", "%.17g" % RAIN, "--dt", str(DT), "--repeats", "1"] + extra
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    return json.loads(run(cmd, env=env).stdout)["cell_steps_per_second"]
+
+
 def make_terrain(erodem, size, folder):
     """The fBm GeoTIFF of `size`^2 cells and its elevations as a .npy (through erodem's reader)."""
     tif = os.path.join(folder, "fbm_%d.tif" % size)
@@ -116,7 +138,9 @@ def make_terrain(erodem, size, folder):
     z = np.asarray(ed.read_dem(tif).elevation, dtype=np.float64)
     npy = os.path.join(folder, "fbm_%d.npy" % size)
     np.save(npy, z)
-    return tif, npy
+    f32 = os.path.join(folder, "fbm_%d.f32" % size)  # for pipes_plain
+    z.astype(np.float32).tofile(f32)
+    return tif, npy, f32
 
 
 def erodem_rate(erodem, tif, threads, steps, extra):
@@ -144,14 +168,19 @@ def main():
     ap.add_argument("--table", default=os.path.join(ROOT, "build", "landlab_compare.md"))
     ap.add_argument("--plot", default=os.path.join(ROOT, "build", "landlab_compare.png"))
     ap.add_argument("--json", default=os.path.join(ROOT, "build", "landlab_compare.json"))
+    ap.add_argument("--plain", default=os.path.join(ROOT, "build", "pipes_plain"),
+                    help="where pipes_plain.cpp is built")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")]
     py = ensure_venv(a.venv)
+    plain = ensure_plain(a.plain)
     runs = {  # name -> (how, extra --set)
         "erodem local inertial f32": ("erodem", []),
         "erodem pipes f32": ("erodem", ["flow.scheme=pipes"]),
         "erodem local inertial f64": ("erodem", ["numerics.precision=float64"]),
         "landlab OverlandFlow f64": ("landlab", None),
+        "plain pipes f32": ("plain", []),
+        "plain pipes f32 + velocities + sums": ("plain", ["--velocities", "--sums"]),
     }
     results = {name: {} for name in runs}
     with tempfile.TemporaryDirectory() as tmp:
@@ -159,13 +188,15 @@ def main():
         with open(worker, "w") as f:
             f.write(WORKER)
         for n in sizes:
-            tif, npy = make_terrain(a.erodem, n, tmp)
+            tif, npy, f32 = make_terrain(a.erodem, n, tmp)
             steps = max(3, min(50, int(2e8 / (n * n))))
             samples = {name: [] for name in runs}
             for _ in range(a.repeats):
                 for name, (how, extra) in runs.items():
                     if how == "erodem":
                         samples[name].append(erodem_rate(a.erodem, tif, a.threads, steps, extra))
+                    elif how == "plain":
+                        samples[name].append(plain_rate(plain, f32, n, a.threads, steps, extra))
                     elif n <= a.landlab_max:
                         out = json.loads(run([py, worker, npy, str(DT), str(DEPTH), str(RAIN),
                                               str(MANNING), str(CELL), str(a.seconds)]).stdout)
@@ -177,17 +208,21 @@ def main():
                                              if n in v), file=sys.stderr)
             os.remove(tif)
             os.remove(npy)
-    lines = ["| grid | " + " | ".join(runs) + " | local inertial / Landlab |",
-             "|---" * (len(runs) + 2) + "|"]
+            os.remove(f32)
+    lines = ["| grid | " + " | ".join(runs) + " | local inertial / Landlab | erodem pipes / plain "
+             "pipes |", "|---" * (len(runs) + 3) + "|"]
     for n in sizes:
         ll = results["landlab OverlandFlow f64"].get(n)
         li = results["erodem local inertial f32"].get(n)
+        ep, pp = results["erodem pipes f32"].get(n), results["plain pipes f32"].get(n)
         cells = ["%.3g" % results[k][n] if n in results[k] else "—" for k in runs]
         ratio = "%.1f×" % (li / ll) if ll and li else "—"
-        lines.append("| %d² | %s | %s |" % (n, " | ".join(cells), ratio))
+        pipes = "%.2f" % (ep / pp) if ep and pp else "—"
+        lines.append("| %d² | %s | %s | %s |" % (n, " | ".join(cells), ratio, pipes))
     table = "\n".join(lines)
     header = ("cell-steps/s, median of %d alternating runs; erodem CPU reference on %d threads "
-              "(full step, water only), Landlab %s on 1 thread (numpy)\n\n"
+              "(full step, water only), Landlab %s on 1 thread (numpy), the plain pipes "
+              "(pipes_plain.cpp) on the same threads\n\n"
               % (a.repeats, a.threads, "2.11"))
     print(header + table)
     with open(a.table, "w") as f:
