@@ -639,17 +639,31 @@ std::vector<std::string> halo_fields(const SweepInfo& sweep) {
   return out;
 }
 
+namespace {
+
+/// The fields the faces of sections and outlets (sections.h) read in the cell beyond each face,
+/// one row away, just before process `p` runs (Backend::run): the outflows before the water
+/// update (measure_water_faces); the outflows, the sediment and the flow depth before the
+/// transport (measure_sediment_faces); none before any other process.
+const std::vector<std::string>& section_face_reads(Process p) {
+  static const std::vector<std::string> water{"flux_left", "flux_right", "flux_top", "flux_bottom"};
+  static const std::vector<std::string> transport{"flux_left",   "flux_right", "flux_top",
+                                                  "flux_bottom", "sediment",   "depth_flow"};
+  static const std::vector<std::string> none;
+  return p == Process::water ? water : p == Process::transport ? transport : none;
+}
+
+}  // namespace
+
 std::vector<std::string> neighbour_read_fields(const Params& params) {
   std::vector<std::string> out;
   auto add = [&](const std::string& f) { add_halo_field(out, f); };
   for (const auto& [p, s] : step_sweeps(params))
     for (const auto& u : s.uses)
       if (reads_neighbours(u.access)) add(u.field);
-  // the faces of sections and outlets (Backend::end_step, sections.h) read the far cell
   if (!params.section.empty() || !params.outlet.empty())
-    for (const char* f :
-         {"flux_left", "flux_right", "flux_top", "flux_bottom", "sediment", "depth_flow"})
-      add(f);
+    for (const Process p : {Process::water, Process::transport})
+      for (const std::string& f : section_face_reads(p)) add(f);
   return out;
 }
 
@@ -750,12 +764,9 @@ void exact_in_band(const Params& params, int h, std::vector<SweepsTail>& tails) 
     for (const std::string& f : halo_fields(s)) writers[f].push_back(i);
   }
   auto skips = [&](std::size_t i) { return may_skip(static_cast<Process>(order[i].p)); };
-  // the faces of sections and outlets (neighbour_read_fields) read the cell beyond each face,
-  // one row away: the outflows before the water update, and the sediment, the flow depth and
-  // the outflows before the transport (Backend::run's measure_water_faces,
-  // measure_sediment_faces)
+  // the faces of sections and outlets read the cell beyond each face, one row away, before the
+  // water update and the transport (section_face_reads)
   const bool faces = !params.section.empty() || !params.outlet.empty();
-  const std::vector<std::string> outflows{"flux_left", "flux_right", "flux_top", "flux_bottom"};
 
   std::map<std::string, int> start;  // e at the start of a step; h where absent
   auto get = [h](const std::map<std::string, int>& e, const std::string& f) {
@@ -795,13 +806,8 @@ void exact_in_band(const Params& params, int h, std::vector<SweepsTail>& tails) 
       const auto& sweeps = tails[order[i].p].sweeps;
       const SweepInfo& s = sweeps[order[i].k];
       const auto proc = static_cast<Process>(order[i].p);
-      if (faces && order[i].k == 0 && proc == Process::water)
-        for (const std::string& f : outflows) need(f, std::min(1, h), i);
-      if (faces && order[i].k == 0 && proc == Process::transport) {
-        for (const std::string& f : outflows) need(f, std::min(1, h), i);
-        need("sediment", std::min(1, h), i);
-        need("depth_flow", std::min(1, h), i);
-      }
+      if (faces && order[i].k == 0)
+        for (const std::string& f : section_face_reads(proc)) need(f, std::min(1, h), i);
       int m = s.domain == Domain::cells ? h - 1 : h;
       for (const FieldUse& u : s.uses) {
         if (u.access == Access::write) continue;
