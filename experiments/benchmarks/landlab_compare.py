@@ -24,8 +24,9 @@ checks (it counts the sub-steps through the elapsed-time bookkeeping and refuses
 Usage (from the repository root, after building build/cli/erodem and build/python):
   python3 experiments/benchmarks/landlab_compare.py                 # 256 .. 8192, table + plot
   python3 experiments/benchmarks/landlab_compare.py --sizes 1024 --repeats 5
-The first run makes the virtual environment (build/landlab-venv: landlab 2.11 and, for it on
-Python 3.11, requireit < 0.9, from PyPI). Writes a Markdown table to stdout and to
+It needs g++ with OpenMP for the plain model (Debian's build-essential, which
+scripts/setup.sh installs). The first run makes the virtual environment (build/landlab-venv:
+landlab 2.11 and, for it on Python 3.11, requireit < 0.9, from PyPI). Writes a Markdown table to stdout and to
 `--table`, and a plot of cell-steps/s against the grid size to `--plot`.
 """
 import argparse
@@ -121,8 +122,9 @@ def ensure_plain(path):
 
 
 def plain_rate(plain, f32, size, threads, steps, extra):
+    """pipes_plain's median of three timed windows of `steps` steps, as erodem bench's."""
     cmd = [plain, f32, str(size), str(size), str(CELL), str(steps), "--depth", str(DEPTH),
-           "--rain", "%.17g" % RAIN, "--dt", str(DT), "--repeats", "1"] + extra
+           "--rain", "%.17g" % RAIN, "--dt", str(DT), "--repeats", "3"] + extra
     env = dict(os.environ, OMP_NUM_THREADS=str(threads))
     return json.loads(run(cmd, env=env).stdout)["cell_steps_per_second"]
 
@@ -174,7 +176,7 @@ def main():
     sizes = [int(s) for s in a.sizes.split(",")]
     py = ensure_venv(a.venv)
     plain = ensure_plain(a.plain)
-    runs = {  # name -> (how, extra --set)
+    runs = {  # name -> (how, erodem's extra --set values or pipes_plain's extra options)
         "erodem local inertial f32": ("erodem", []),
         "erodem pipes f32": ("erodem", ["flow.scheme=pipes"]),
         "erodem local inertial f64": ("erodem", ["numerics.precision=float64"]),
@@ -245,7 +247,8 @@ def main():
         ax.loglog([n * n for n in ns], [r[n] for n in ns], "o-", label=name)
     ax.set_xlabel("cells")
     ax.set_ylabel("cell-steps per second")
-    ax.set_title("Water only, fixed dt, all cells wet (%d threads for erodem)" % a.threads)
+    ax.set_title("Water only, fixed dt, all cells wet (%d threads for erodem and the plain pipes)"
+                 % a.threads)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -103,7 +103,9 @@ void flow(const Scenario& s, State& st) {
       const float gr = floor0(fr[i] + k * (eta - (bed[i + 1] + d[i + 1])));
       const float gt = floor0(ft[i] + k * (eta - (bed[i - W] + d[i - W])));
       const float gb = floor0(fb[i] + k * (eta - (bed[i + W] + d[i + W])));
-      const float demand = (gl + gr + gt + gb) * dt, held = d[i] * area;
+      // a depth a rounding below 0 holds nothing (without the floor, held < 0 gave a negative
+      // K, or 0 * -inf = NaN where no pipe carries water)
+      const float demand = (gl + gr + gt + gb) * dt, held = floor0(d[i]) * area;
       // the division on a select, not under a branch: a division under a condition keeps the
       // loop from vectorising (GCC will not if-convert what may trap)
       const bool limited = demand > held;
@@ -207,22 +209,37 @@ double number(const char* text, const char* name) {
   return v;
 }
 
+/// A whole number in [lo, hi], or the usage.
+int whole(const char* text, const char* name, long lo, long hi) {
+  char* end = nullptr;
+  const long v = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || v < lo || v > hi)
+    usage((std::string(name) + ": expected a whole number from " + std::to_string(lo) + " to " +
+           std::to_string(hi))
+              .c_str());
+  return static_cast<int>(v);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 6) usage("too few arguments");
   Scenario s;
   const std::string path = argv[1];
-  s.nx = static_cast<int>(number(argv[2], "NX"));
-  s.ny = static_cast<int>(number(argv[3], "NY"));
+  s.nx = whole(argv[2], "NX", 3, 46000);  // padded, (NX + 2) (NY + 2) indexes as an int
+  s.ny = whole(argv[3], "NY", 3, 46000);
   s.cell = static_cast<float>(number(argv[4], "CELL"));
-  const int steps = static_cast<int>(number(argv[5], "STEPS"));
+  const int steps = whole(argv[5], "STEPS", 1, 1000000);
   int repeats = 3;
   for (int a = 6; a < argc; ++a) {
     const std::string o = argv[a];
     const auto value = [&](const char* name) {
       if (a + 1 >= argc) usage((o + ": needs a value").c_str());
       return number(argv[++a], name);
+    };
+    const auto count = [&](const char* name) {
+      if (a + 1 >= argc) usage((o + ": needs a value").c_str());
+      return whole(argv[++a], name, 1, 1000);
     };
     if (o == "--depth")
       s.depth = static_cast<float>(value("--depth"));
@@ -231,7 +248,7 @@ int main(int argc, char** argv) {
     else if (o == "--dt")
       s.dt = static_cast<float>(value("--dt"));
     else if (o == "--repeats")
-      repeats = static_cast<int>(value("--repeats"));
+      repeats = count("--repeats");
     else if (o == "--velocities")
       s.velocities = true;
     else if (o == "--sums")
@@ -239,13 +256,19 @@ int main(int argc, char** argv) {
     else
       usage((o + ": unknown option").c_str());
   }
-  if (s.nx < 3 || s.ny < 3 || steps < 1 || repeats < 1 || !(s.cell > 0) || !(s.dt > 0))
-    usage("NX, NY >= 3, STEPS, --repeats >= 1, CELL and --dt > 0");
+  if (!(s.cell > 0) || !(s.dt > 0) || !(s.depth >= 0) || !(s.rain >= 0))
+    usage("CELL and --dt > 0, --depth and --rain >= 0");
   std::vector<float> elevation(static_cast<std::size_t>(s.nx) * s.ny);
-  std::ifstream in(path, std::ios::binary);
-  if (!in.read(reinterpret_cast<char*>(elevation.data()),
-               static_cast<std::streamsize>(elevation.size() * sizeof(float))))
-    usage((path + ": cannot read NX * NY float32 values").c_str());
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const auto bytes = static_cast<std::streamoff>(elevation.size() * sizeof(float));
+  if (!in || in.tellg() != bytes)
+    usage((path + ": expected exactly NX * NY float32 values (" + std::to_string(bytes) + " bytes)")
+              .c_str());
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(elevation.data()), bytes))
+    usage((path + ": cannot read its NX * NY float32 values").c_str());
+  for (const float z : elevation)
+    if (!std::isfinite(z)) usage((path + ": an elevation is not a finite number").c_str());
 
   std::vector<double> rates;
   double volume_error = 0.0, last_volume = 0.0;  // the last step's sums (--sums)
