@@ -26,8 +26,8 @@ Usage (from the repository root, after building build/cli/erodem and build/pytho
   python3 experiments/benchmarks/landlab_compare.py --sizes 1024 --repeats 5
 It needs g++ with OpenMP for the plain model (Debian's build-essential, which
 scripts/setup.sh installs). The first run makes the virtual environment (build/landlab-venv:
-landlab 2.11 and, for it on Python 3.11, requireit < 0.9, from PyPI). Writes a Markdown table to stdout and to
-`--table`, and a plot of cell-steps/s against the grid size to `--plot`.
+landlab 2.11 and, for it on Python 3.11, requireit < 0.9, from PyPI). Writes a Markdown table
+to stdout and to `--table`, and a plot of cell-steps/s against the grid size to `--plot`.
 """
 import argparse
 import json
