@@ -7,11 +7,13 @@ leaves scalar runs several times slower and no result shows it: on 2026-11-28 th
 update's loop had been scalar for a day (a conditional load GCC could not if-convert: 15.4 ms
 against 4.2 ms at 1024², docs/performance.md "The water update's loop vectorises again").
 
-This compiles each CPU source of every instruction-set build (erodem_cpu_v2, _v3, _v4: SSE4.2,
-AVX2, AVX-512, of which cpu/dispatch.cpp runs the best the CPU has) again with its own
-command from compile_commands.json and GCC's vectoriser report
-(-fopt-info-vec-all), and fails for every marked loop the report calls "couldn't vectorize
-loop" in any of its instantiations, or never "loop vectorized". Printed: each loop and what
+This reads GCC's vectoriser report (-fopt-info-vec-all) of each CPU source of every
+instruction-set build (erodem_cpu_v2, _v3, _v4: SSE4.2, AVX2, AVX-512, of which
+cpu/dispatch.cpp runs the best the CPU has): the Release build writes it beside its objects
+(kernels/vec/, kernels/CMakeLists.txt); without it, the source is compiled again with its own
+command from compile_commands.json and the report option. It fails for every marked loop the
+report calls "couldn't vectorize loop" in any of its instantiations, or never "loop
+vectorized". Printed: each loop and what
 the report says. Known exceptions (below) are reported, not failed. (Until 2026-11-28 07:30 the
 x86-64-v2 build left thermal collapse's two loops scalar: the class talus slope's load was
 conditional, and SSE4.2 has no masked loads.)
@@ -58,8 +60,18 @@ def marked_loops(path):
 
 
 def report(entry, tmp):
-    """GCC's vectoriser report for one compile_commands entry, as a list of lines."""
+    """GCC's vectoriser report for one compile_commands entry, as a list of lines: the one the
+    build wrote (its command names it: kernels/CMakeLists.txt), or, where the command names none
+    or the file is missing (a build by ccache, say), a compile of the source again."""
     args = shlex.split(entry["command"])
+    built = [a.split("=", 1)[1] for a in args if a.startswith("-fopt-info-vec-all=")]
+    if built:
+        path = built[0]
+        if not os.path.isabs(path):
+            path = os.path.join(entry["directory"], path)
+        if os.path.exists(path):
+            return open(path, encoding="utf-8").read().split("\n"), True
+        args = [a for a in args if not a.startswith("-fopt-info-vec-all=")]
     # one report per source and instruction-set build (they compile in parallel)
     level = re.search(r"erodem_cpu_(v[234])\.dir", entry["command"]).group(1)
     out = os.path.join(tmp, f"{os.path.basename(entry['file'])}.{level}.vec")
@@ -77,7 +89,7 @@ def report(entry, tmp):
         cleaned.append(a)
     cleaned += ["-o", os.devnull, "-fopt-info-vec-all=" + out]
     subprocess.run(cleaned, cwd=entry["directory"], check=True)
-    return open(out, encoding="utf-8").read().split("\n")
+    return open(out, encoding="utf-8").read().split("\n"), False
 
 
 def main():
@@ -109,7 +121,10 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         with ThreadPoolExecutor(max_workers=os.cpu_count() or 2) as pool:
             reports = list(pool.map(lambda e: report(e, tmp), entries))
-        for entry, rep in zip(entries, reports):
+        from_build = sum(built for _, built in reports)
+        print(f"vectoriser reports: {from_build} of {len(reports)} written by the build, "
+              f"{len(reports) - from_build} compiled here")
+        for entry, (rep, _) in zip(entries, reports):
             name = os.path.basename(entry["file"])
             level = isa.search(entry["command"]).group(1)
             for line_no, text in marked_loops(entry["file"]):

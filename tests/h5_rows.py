@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""erodem — the datasets of one group of two result files, row by row (tests/mpi.sh).
+"""erodem — the datasets of groups of two result files, row by row (tests/mpi.sh).
 
-Usage: h5_rows.py REFERENCE RESULT GROUP [--ledger] [--continued]
+Usage: h5_rows.py REFERENCE RESULT GROUP... [--ledger] [--continued]
 
-Every dataset under GROUP in REFERENCE must be in RESULT, with its shape, and the other way
+For each GROUP (one process for all: Python and h5py take most of a second to start), every
+dataset under GROUP in REFERENCE must be in RESULT, with its shape, and the other way
 round. With --continued (RESULT is a run continued from a restart file, which writes only the
 steps and snapshots from there on) a dataset of RESULT may hold fewer rows along the first
 (unlimited) dimension, the other dimensions equal: its rows are compared with REFERENCE's last
@@ -16,14 +17,15 @@ the row before them, within a relative 1e-12 of the largest magnitude among the 
 rows compared and the one before (the two sums add the same steps' volumes in a different
 order). The per-step discharges beside them are compared exactly.
 
-Otherwise the values must be equal: NaN to NaN, an infinity to the same infinity. With --ledger (OpenCL, where each MPI rank sums its own
-rows' tallies on the device and the ranks' sums are added in rank order): the ledger's
+Otherwise the values must be equal: NaN to NaN, an infinity to the same infinity. With --ledger
+(OpenCL, where each MPI rank sums its own rows' tallies on the device and the ranks' sums are
+added in rank order), in the groups /diagnostics and /restart only: the ledger's
 tallies and volumes (ledger_*, *_volume) within a relative 1e-12 (0 where the reference is 0),
 the relative closure errors within 1e-12, the other closure errors within 1e-9 m^3; a tally
 that missed or doubled a band's halo rows is off by a few per cent.
 
-Prints a line per dataset that differs, with its largest difference, and a summary line;
-exits 1 on any difference, 2 on a file or group that cannot be read.
+Prints a line per dataset that differs, with its largest difference, and a summary line per
+group; exits 1 on any difference, 2 on a file or group that cannot be read.
 """
 import fnmatch
 import sys
@@ -31,6 +33,9 @@ import sys
 import h5py
 import numpy as np
 
+
+# The groups that hold the ledger (--ledger applies there only: /sections' volumes stay exact).
+LEDGER_GROUPS = {"diagnostics", "restart"}
 
 # The cumulative datasets that count from a restart on (docs/results.md, "Sections").
 RESTARTED_SUMS = {"sections/volume", "sections/sediment_volume"}
@@ -80,23 +85,20 @@ def differs(a, b, kind, bound):
     return f"largest difference {np.max(diff):.3e} ({kind} bound {bound:g})"
 
 
-def main(argv):
-    options = set(argv[4:])
-    if len(argv) < 4 or not options <= {"--ledger", "--continued"}:
-        print(__doc__.split("\n\n")[1], file=sys.stderr)
-        return 2
-    ref_path, out_path, group = argv[1], argv[2], argv[3]
-    ledger, continued = "--ledger" in options, "--continued" in options
+def compare_group(ref_file, out_file, group, ledger, continued):
+    """The datasets under `group` of the two open files, compared as above: the number that
+    differ (a line printed for each, and a summary line), or None where the group cannot be
+    read."""
     try:
-        ref_file, out_file = h5py.File(ref_path, "r"), h5py.File(out_path, "r")
         ref, out = datasets(ref_file[group]), datasets(out_file[group])
-    except (OSError, KeyError) as e:
-        print(f"h5_rows: {group} of {ref_path} or {out_path}: {e}", file=sys.stderr)
-        return 2
+    except KeyError as e:
+        print(f"h5_rows: {group} of {ref_file.filename} or {out_file.filename}: {e}",
+              file=sys.stderr)
+        return None
     bad, tails = 0, 0
     for name in sorted(set(ref) | set(out)):
         if name not in ref or name not in out:
-            print(f"{group}/{name}: only in {ref_path if name in ref else out_path}")
+            print(f"{group}/{name}: only in {ref_file.filename if name in ref else out_file.filename}")
             bad += 1
             continue
         a, b = ref[name][()], out[name][()]
@@ -123,6 +125,28 @@ def main(argv):
             bad += 1
     print(f"{group}: {len(ref)} datasets, {tails} of them by the reference's last rows, "
           f"{bad} differ")
+    return bad
+
+
+def main(argv):
+    groups = [a for a in argv[3:] if not a.startswith("--")]
+    options = set(a for a in argv[3:] if a.startswith("--"))
+    if len(argv) < 4 or not groups or not options <= {"--ledger", "--continued"}:
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    ref_path, out_path = argv[1], argv[2]
+    try:
+        ref_file, out_file = h5py.File(ref_path, "r"), h5py.File(out_path, "r")
+    except OSError as e:
+        print(f"h5_rows: {ref_path} or {out_path}: {e}", file=sys.stderr)
+        return 2
+    bad = 0
+    for group in groups:
+        ledger = "--ledger" in options and group.strip("/") in LEDGER_GROUPS
+        found = compare_group(ref_file, out_file, group, ledger, "--continued" in options)
+        if found is None:
+            return 2
+        bad += found
     return 1 if bad else 0
 
 
