@@ -91,7 +91,7 @@ def compare_group(ref_file, out_file, group, ledger, continued):
     read."""
     try:
         ref, out = datasets(ref_file[group]), datasets(out_file[group])
-    except KeyError as e:
+    except (OSError, KeyError) as e:
         print(f"h5_rows: {group} of {ref_file.filename} or {out_file.filename}: {e}",
               file=sys.stderr)
         return None

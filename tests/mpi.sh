@@ -65,9 +65,8 @@
 # (CpuBackend::exchange_field returning before parallel::exchange), every scenario fails at
 # N = 2: `erodem compare` reports rel_L2 of 1e-3 .. 1 on water_depth and the others (see
 # docs/mpi.md for the figures).
-# BACKEND (the third argument, `cpu` by default): `opencl` runs the scenarios erosion, pipes,
-# the three of the shallow water, water_cycle, row_tail and restart on the OpenCL backend (PoCL here, each rank its own
-# context) against the serial OpenCL run, bit for bit as on the CPU, twice: with the launches
+# BACKEND (the third argument, `cpu` by default): `opencl` runs every scenario but refusals and
+# interrupt on the OpenCL backend (PoCL here, each rank its own context) against the serial OpenCL run, bit for bit as on the CPU, twice: with the launches
 # of whole rows PoCL gets by default (N = 1, 2, 3, 4), and with ERODEM_OPENCL_WG=64
 # (work-groups that do not divide a row, and the statistics' tree reduction: the launches GPUs
 # get; N = 3). The bad inputs of dem_rows and dem_rows_coarse, which stop before a backend is

@@ -31,9 +31,9 @@
 # the pipes. With a one-row Manning n of W values (not W + 1) the second run reports 2,240
 # invalid reads (the face pass reads column x + 1 of the last column too).
 # Usage: oclgrind.sh path/to/erodem [STEPS [SIZE]]: the scenario above by default (200 steps of
-# 48 x 48, about 5 minutes of CPU time per run); ctest runs its fast version, 40 steps of
-# 32 x 32 with the same processes and the cooling at the same fraction of the run (about a
-# minute per run), so the suite stays within its 30 minutes.
+# 48 x 48, about 5 minutes of CPU time per run); ctest runs its fast version, 20 steps of
+# 32 x 32 with the same processes and the cooling at the same fraction of the run (about 25 s
+# per run on an idle machine), so the suite stays within its 30 minutes.
 set -euo pipefail
 erodem=$1
 steps=${2:-200}
