@@ -147,6 +147,33 @@ ERODEM_FN void flow_pipes_cell_interior(
   out_bottom[i] = fb;
 }
 
+/* flow_pipes_cell_interior for a cell that is active, as are its four neighbours: the same
+ * outflows from the same numbers, with the kinds given as the constant ERODEM_CELL_ACTIVE instead
+ * of loaded, so a compiler drops the kinds' loads and the gives_water masks (every pipe gives,
+ * and the limit applies). For loops over runs of such cells (CpuBackend::flow_blocks: rows whose
+ * cells and whose neighbour rows' cells are all active); it reads no kind. */
+ERODEM_FN void flow_pipes_cell_all_active(int x, int y, int W, GLOBAL const real* bed,
+                                          GLOBAL const real* depth, real length_x, real length_top,
+                                          real length_bottom, real cell_area,
+                                          GLOBAL const real* f_left, GLOBAL const real* f_right,
+                                          GLOBAL const real* f_top, GLOBAL const real* f_bottom,
+                                          GLOBAL real* out_left, GLOBAL real* out_right,
+                                          GLOBAL real* out_top, GLOBAL real* out_bottom, real dt,
+                                          real gravity, real pipe_area) {
+  const int i = x + y * W;
+  const int a = ERODEM_CELL_ACTIVE;
+  real fl, fr, ft, fb;
+  flow_pipes_outflows(a, a, a, a, a, bed[i] + depth[i], bed[i - 1] + depth[i - 1],
+                      bed[i + 1] + depth[i + 1], bed[i - W] + depth[i - W],
+                      bed[i + W] + depth[i + W], f_left[i], f_right[i], f_top[i], f_bottom[i],
+                      length_x, length_top, length_bottom, depth[i], cell_area, dt, gravity,
+                      pipe_area, &fl, &fr, &ft, &fb);
+  out_left[i] = fl;
+  out_right[i] = fr;
+  out_top[i] = ft;
+  out_bottom[i] = fb;
+}
+
 /* Pipes scheme for any padded cell (rows 0 and H - 1 clamp their indices; beyond the raster
  * are walls); pipe_length (m) as for pipe_lengths. */
 ERODEM_FN void flow_pipes_cell(int x, int y, int W, int H, GLOBAL const erodem_kind_t* kind,

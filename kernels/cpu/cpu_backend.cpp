@@ -96,6 +96,12 @@ CpuBackend<Real>::CpuBackend(const Terrain& terrain, const Params& params)
     edge_row_[static_cast<std::size_t>(y) + 1] = static_cast<int>(edge_x_.size());
   }
   edge_row_[static_cast<std::size_t>(H_)] = static_cast<int>(edge_x_.size());
+  row_active_.assign(static_cast<std::size_t>(H_), 0);
+  for (int y = 0; y < H_; ++y) {
+    const Kind* k = kind_.data() + static_cast<std::size_t>(y) * W_;
+    row_active_[static_cast<std::size_t>(y)] =
+        std::all_of(k + 1, k + W_ - 1, [](Kind c) { return c == ERODEM_CELL_ACTIVE; });
+  }
   const std::size_t cells = n;
   fields_.bind(*this, [cells] { return Field(cells); });
   run_boundary();

@@ -385,6 +385,21 @@ class CpuBackend final : public Backend {
   // domain's faces: their columns, row by row (edge_x_[edge_row_[y] .. edge_row_[y + 1]) for
   // padded row y). The kinds never change.
   std::vector<int> edge_x_, edge_row_;
+  // 1 where the cells 1 .. W - 2 of padded row y are all active (row_active_[y]; the kinds
+  // never change): their loops may take the kinds as constants (flow.cpp, performance.md "Rows
+  // of active cells"). rows_active(y0, y1): so are those of rows y0 .. y1, all inside the
+  // raster. all_active_around(y): rows y - 1 .. y + 1, so each cell 2 .. W - 3 of row y and its
+  // four neighbours are active.
+  std::vector<unsigned char> row_active_;
+  bool rows_active(int y0, int y1) const {
+    if (y0 < 0 || y1 > H_ - 1) return false;
+    for (int y = y0; y <= y1; ++y)
+      if (!row_active_[static_cast<std::size_t>(y)]) return false;
+    return true;
+  }
+  bool all_active_around(int y) const {
+    return rows_active(y - 1, y + 1);
+  }
   std::vector<std::vector<double>> row_sums_;  // per tally of a generic sweep (sweeps.cpp)
   std::vector<std::pair<int, std::size_t>> point_rows_;  // run_flow_water: (row, inflow index)
   // The fused pass with evaporation, when it ends the step (stats_in_pass_), takes the

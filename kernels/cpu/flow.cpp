@@ -46,6 +46,23 @@ struct InertialParams {
   int manning_pitch = 0;    // values per row of the Manning n array (param_index, compat.h)
 };
 
+/// The kinds a row loop reads at column x: a row of ints (RowKinds<false>), or the constant
+/// ERODEM_CELL_ACTIVE (RowKinds<true>) for a run of columns whose cells the loop knows to be
+/// active (CpuBackend::rows_active). The same values, so the same bits; with the constant the
+/// compiler drops the kinds' loads and the masks they feed (performance.md "Rows of active
+/// cells").
+template <bool kActive>
+struct RowKinds;
+template <>
+struct RowKinds<false> {
+  const int* __restrict k;
+  int operator[](int x) const { return k[x]; }
+};
+template <>
+struct RowKinds<true> {
+  int operator[](int) const { return ERODEM_CELL_ACTIVE; }
+};
+
 /// Unit discharges (m^2/s) of the faces south of padded row j (0 <= j <= H - 2), all x.
 template <class Real>
 void unit_discharge_y_row(int j, int W, const Real* __restrict f_top,
@@ -57,16 +74,17 @@ void unit_discharge_y_row(int j, int W, const Real* __restrict f_top,
   for (int x = 0; x < W; ++x) q[x] = cell::face_unit_discharge(fb[x], ft[x], width);
 }
 
-/// Discharges (m^3/s) of the faces south of padded row j (0 <= j <= H - 2), all x, from the
-/// unit discharges of the faces south of rows j - 1, j and j + 1 (q_up, q, q_down; q_up or
-/// q_down unused where that row of faces does not exist).
-template <class Real>
-void face_y_row(int j, int W, int H, const int* __restrict k_up, const int* __restrict k_a,
-                const int* __restrict k_b, const int* __restrict k_down, const Real* __restrict bed,
-                const Real* __restrict depth, const Real* __restrict manning,
-                const Real* __restrict dx, const Real* __restrict dy, const Real* __restrict q_up,
-                const Real* __restrict q, const Real* __restrict q_down,
-                const InertialParams<Real>& p, Real* __restrict out) {
+/// Discharges (m^3/s) of the faces south of padded row j (0 <= j <= H - 2), columns x0 .. x1 - 1,
+/// from the unit discharges of the faces south of rows j - 1, j and j + 1 (q_up, q, q_down; q_up
+/// or q_down unused where that row of faces does not exist); the kinds of rows j - 1 .. j + 2
+/// (RowKinds).
+template <class Kinds, class Real>
+void face_y_row(int j, int W, int H, int x0, int x1, Kinds k_up, Kinds k_a, Kinds k_b, Kinds k_down,
+                const Real* __restrict bed, const Real* __restrict depth,
+                const Real* __restrict manning, const Real* __restrict dx,
+                const Real* __restrict dy, const Real* __restrict q_up, const Real* __restrict q,
+                const Real* __restrict q_down, const InertialParams<Real>& p,
+                Real* __restrict out) {
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(j) * W;
   const int has_up = j >= 1, has_down = j + 2 <= H - 1;
   // Beyond the raster: walls (k_up, k_down are rows of walls there) and q stands in.
@@ -80,7 +98,7 @@ void face_y_row(int j, int W, int H, const int* __restrict k_up, const int* __re
   const Real width = cell::face_y_width(dx, j), dist = cell::centre_distance_y(dy, j);
   const Real dt = p.dt, g = p.gravity, theta = p.theta, dry = p.dry_depth;
   ERODEM_IVDEP
-  for (int x = 0; x < W; ++x)
+  for (int x = x0; x < x1; ++x)
     out[x] =
         cell::local_inertial_face(cell::face_open(k_a[x], k_b[x]), k_up[x] != ERODEM_CELL_WALL,
                                   k_down[x] != ERODEM_CELL_WALL, q[x], qu[x], qd[x], d_a[x], d_b[x],
@@ -90,7 +108,7 @@ void face_y_row(int j, int W, int H, const int* __restrict k_up, const int* __re
 /// Discharges (m^3/s) of the faces east of the cells x = 0 .. W - 2 of padded row y; `q` is
 /// scratch for their unit discharges. out[W - 1] = 0 (no face).
 template <class Real>
-void face_x_row(int y, int W, const int* __restrict k, const Real* __restrict bed,
+void face_x_row(int y, int W, const int* __restrict k, bool active, const Real* __restrict bed,
                 const Real* __restrict depth, const Real* __restrict manning,
                 const Real* __restrict dx, const Real* __restrict dy, const Real* __restrict f_left,
                 const Real* __restrict f_right, const InertialParams<Real>& p, Real* __restrict q,
@@ -111,10 +129,23 @@ void face_x_row(int y, int W, const int* __restrict k, const Real* __restrict be
   };
   // W >= 3: the padded raster has at least one DEM column.
   out[0] = face(0, 0, k[2] != ERODEM_CELL_WALL, q[0], q[1]);
-  ERODEM_IVDEP
-  for (int x = 1; x < W - 2; ++x)
-    out[x] =
-        face(x, k[x - 1] != ERODEM_CELL_WALL, k[x + 2] != ERODEM_CELL_WALL, q[x - 1], q[x + 1]);
+  // faces x0 .. x1 - 1 between cells 1 .. W - 2 (kinds: RowKinds)
+  auto faces = [&](auto kinds, int x0, int x1) {
+    ERODEM_IVDEP
+    for (int x = x0; x < x1; ++x)
+      out[x] = cell::local_inertial_face(
+          cell::face_open(kinds[x], kinds[x + 1]), kinds[x - 1] != ERODEM_CELL_WALL,
+          kinds[x + 2] != ERODEM_CELL_WALL, q[x], q[x - 1], q[x + 1], d[x], d[x + 1], b[x],
+          b[x + 1], n[x], n[x + 1], width, dist, dt, g, theta, dry);
+  };
+  if (active) {  // cells 1 .. W - 2 active: faces 2 .. W - 4 read the kinds of active cells only
+    const int a0 = std::min(2, W - 2), a1 = std::max(a0, W - 3);
+    faces(RowKinds<false>{k}, 1, a0);
+    faces(RowKinds<true>{}, a0, a1);
+    faces(RowKinds<false>{k}, a1, W - 2);
+  } else {
+    faces(RowKinds<false>{k}, 1, W - 2);
+  }
   out[W - 2] = face(W - 2, k[W - 3] != ERODEM_CELL_WALL, 0, q[W - 3], q[W - 2]);
   out[W - 1] = Real(0);
   if (p.periodic_x) {
@@ -134,7 +165,7 @@ void face_x_row(int y, int W, const int* __restrict k, const Real* __restrict be
 /// and below (walls beyond the raster).
 template <class Real>
 void split_row(int y, int W, const int* __restrict k, const int* __restrict k_top,
-               const int* __restrict k_bottom, const Real* __restrict depth,
+               const int* __restrict k_bottom, bool active, const Real* __restrict depth,
                const Real* __restrict area, const Real* __restrict face_x,
                const Real* __restrict face_top, const Real* __restrict face_bottom, Real dt,
                Real* __restrict out_left, Real* __restrict out_right, Real* __restrict out_top,
@@ -149,16 +180,30 @@ void split_row(int y, int W, const int* __restrict k, const int* __restrict k_to
                                      ot + x, ob + x);
   };
   cell_at(0, ERODEM_CELL_WALL, k[1], Real(0), face_x[0]);
-  ERODEM_IVDEP
-  for (int x = 1; x < W - 1; ++x) {
-    Real l, r, t, bt;
-    cell::local_inertial_split<Real>(k[x], k[x - 1], k[x + 1], k_top[x], k_bottom[x], face_x[x - 1],
-                                     face_x[x], face_top[x], face_bottom[x], d[x], a, dt, &l, &r,
-                                     &t, &bt);
-    ol[x] = l;
-    orr[x] = r;
-    ot[x] = t;
-    ob[x] = bt;
+  // cells x0 .. x1 - 1 of 1 .. W - 2, the kinds of the row and the rows above and below
+  // (RowKinds)
+  auto cells = [&](auto kinds, auto kinds_top, auto kinds_bottom, int x0, int x1) {
+    ERODEM_IVDEP
+    for (int x = x0; x < x1; ++x) {
+      Real l, r, t, bt;
+      cell::local_inertial_split<Real>(kinds[x], kinds[x - 1], kinds[x + 1], kinds_top[x],
+                                       kinds_bottom[x], face_x[x - 1], face_x[x], face_top[x],
+                                       face_bottom[x], d[x], a, dt, &l, &r, &t, &bt);
+      ol[x] = l;
+      orr[x] = r;
+      ot[x] = t;
+      ob[x] = bt;
+    }
+  };
+  const RowKinds<false> here{k}, above{k_top}, below{k_bottom};
+  if (active) {  // rows y - 1 .. y + 1 active in 1 .. W - 2: cells 2 .. W - 3 and beside them
+    const int a0 = std::min(2, W - 1), a1 = std::max(a0, W - 2);
+    const RowKinds<true> all;
+    cells(here, above, below, 1, a0);
+    cells(all, all, all, a0, a1);
+    cells(here, above, below, a1, W - 1);
+  } else {
+    cells(here, above, below, 1, W - 1);
   }
   cell_at(W - 1, k[W - 2], ERODEM_CELL_WALL, face_x[W - 2], Real(0));
 }
@@ -545,10 +590,27 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
           Real lx, lt, lb;
           cell::pipe_lengths(y, y - 1, y + 1, dx, dy, l_pipe, &lx, &lt, &lb);
           const Real cell_area = area[y];
-          ERODEM_IVDEP
-          for (int x = 0; x < W; ++x)
-            cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
-                                           fb, ol, orr, ot, ob, step, gravity, a_pipe);
+          if (all_active_around(y)) {
+            // Columns 2 .. W - 3 and their four neighbours are active: the same outflows with
+            // the kinds as constants (performance.md "Rows of active cells"); the two columns
+            // at each end as any interior cell.
+            const int x1 = W >= 4 ? W - 2 : 2;
+            for (int x = 0; x < std::min(2, W); ++x)
+              cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
+                                             fb, ol, orr, ot, ob, step, gravity, a_pipe);
+            ERODEM_IVDEP
+            for (int x = 2; x < x1; ++x)
+              cell::flow_pipes_cell_all_active(x, y, W, b, d, lx, lt, lb, cell_area, fl, fr, ft, fb,
+                                               ol, orr, ot, ob, step, gravity, a_pipe);
+            for (int x = std::max(2, x1); x < W; ++x)
+              cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
+                                             fb, ol, orr, ot, ob, step, gravity, a_pipe);
+          } else {
+            ERODEM_IVDEP
+            for (int x = 0; x < W; ++x)
+              cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
+                                             fb, ol, orr, ot, ob, step, gravity, a_pipe);
+          }
         } else {
           for (int x = 0; x < W; ++x)
             cell::flow_pipes_cell(x, y, W, H, kind, b, d, dx, dy, area, fl, fr, ft, fb, ol, orr, ot,
@@ -612,9 +674,20 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
     if (y0 < y1) {
       auto faces_y = [&](int j) {
         if (j < 0 || j > H - 2) return;
-        face_y_row(j, W, H, kind_row(j - 1), kind_row(j), kind_row(j + 1), kind_row(j + 2), b, d,
-                   manning, dx, dy, j >= 1 ? q_row(j - 1) : q_row(j), q_row(j),
-                   j + 1 <= H - 2 ? q_row(j + 1) : q_row(j), p, face_row(j));
+        const RowKinds<false> up{kind_row(j - 1)}, a{kind_row(j)}, b_{kind_row(j + 1)},
+            down{kind_row(j + 2)};
+        const Real *qu = j >= 1 ? q_row(j - 1) : q_row(j), *qj = q_row(j),
+                   *qd = j + 1 <= H - 2 ? q_row(j + 1) : q_row(j);
+        Real* out = face_row(j);
+        if (rows_active(j - 1, j + 2)) {  // columns 1 .. W - 2 of rows j - 1 .. j + 2 active
+          const RowKinds<true> all;
+          face_y_row(j, W, H, 0, 1, up, a, b_, down, b, d, manning, dx, dy, qu, qj, qd, p, out);
+          face_y_row(j, W, H, 1, W - 1, all, all, all, all, b, d, manning, dx, dy, qu, qj, qd, p,
+                     out);
+          face_y_row(j, W, H, W - 1, W, up, a, b_, down, b, d, manning, dx, dy, qu, qj, qd, p, out);
+        } else {
+          face_y_row(j, W, H, 0, W, up, a, b_, down, b, d, manning, dx, dy, qu, qj, qd, p, out);
+        }
       };
       faces_y(y0 - 1);
       for (int y = y0; y < y1; ++y) {
@@ -624,11 +697,12 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
           unit_q(y + 1);
         }
         faces_y(y);
-        face_x_row(y, W, kind_row(y), b, d, manning, dx, dy, fl, fr, p, q_x.data(), face_x.data());
+        face_x_row(y, W, kind_row(y), rows_active(y, y), b, d, manning, dx, dy, fl, fr, p,
+                   q_x.data(), face_x.data());
         const Real* top = y >= 1 ? face_row(y - 1) : zeros.data();
         const Real* bottom = y <= H - 2 ? face_row(y) : zeros.data();
-        split_row(y, W, kind_row(y), kind_row(y - 1), kind_row(y + 1), d, area, face_x.data(), top,
-                  bottom, dt, ol, orr, ot, ob);
+        split_row(y, W, kind_row(y), kind_row(y - 1), kind_row(y + 1), all_active_around(y), d,
+                  area, face_x.data(), top, bottom, dt, ol, orr, ot, ob);
         after_row(y, y0, y1);
       }
     }
