@@ -44,16 +44,23 @@ Terrain valley() {
   return t;
 }
 
-/// The valley's run: rain, an inflow along three cells, a section across the valley, open
-/// edges, erosion + conservative transport + thermal collapse + evaporation.
-Params valley_params(FlowScheme flow, Precision precision, int threads, bool fused, bool erosion) {
+/// `steps` fixed steps of the flow scheme (0.05 s for the pipes, 0.2 s for local inertial),
+/// Manning n 0.03, rain of 1e-4 m/s.
+Params rain_params(FlowScheme flow, int steps) {
   Params p;
   p.flow.scheme = flow;
   p.flow.manning_n.value = 0.03;
   p.time.adaptive = false;
   p.time.dt = flow == FlowScheme::pipes ? 0.05 : 0.2;
-  p.time.duration = 40 * p.time.dt;
+  p.time.duration = steps * p.time.dt;
   p.rain.rate = 1e-4;  // m/s
+  return p;
+}
+
+/// The valley's run: rain, an inflow along three cells, a section across the valley, open
+/// edges, erosion + conservative transport + thermal collapse + evaporation.
+Params valley_params(FlowScheme flow, Precision precision, int threads, bool fused, bool erosion) {
+  Params p = rain_params(flow, 40);
   InflowSpec in;
   const double y = (kNy - 5 - 0.5) * kCell;  // row 5
   in.vertices = {{10.5 * kCell, y}, {12.5 * kCell, y}};
@@ -94,6 +101,28 @@ void PrintTo(const FusedCase& c, std::ostream* os) {
 }
 
 class Fused : public testing::TestWithParam<FusedCase> {};
+
+/// Puts an environment variable back as the test found it (set to its old value, or unset).
+class RestoreEnv {
+ public:
+  explicit RestoreEnv(const char* name) : name_(name) {
+    const char* v = std::getenv(name);
+    had_ = v != nullptr;
+    old_ = v ? v : "";
+  }
+  RestoreEnv(const RestoreEnv&) = delete;
+  RestoreEnv& operator=(const RestoreEnv&) = delete;
+  ~RestoreEnv() {
+    if (had_)
+      setenv(name_.c_str(), old_.c_str(), 1);
+    else
+      unsetenv(name_.c_str());
+  }
+
+ private:
+  std::string name_, old_;
+  bool had_ = false;
+};
 
 /// The number of values of `a` and `b` whose bits differ.
 std::size_t differing(const std::vector<double>& a, const std::vector<double>& b) {
@@ -258,17 +287,7 @@ TEST(FusedOpenCl, WaterUpdateAndErosionInOneKernelGiveTheSameBits) {
 TEST(OpenClReads, PinnedStagingGivesTheSameBits) {
   if (!opencl_available()) GTEST_SKIP() << "no OpenCL device";
   const Target target{"opencl", Precision::float32};
-  struct Restore {  // the variable as the test found it
-    const char* v = std::getenv("ERODEM_OPENCL_PINNED");
-    std::string old = v ? v : "";
-    bool had = v != nullptr;
-    ~Restore() {
-      if (had)
-        setenv("ERODEM_OPENCL_PINNED", old.c_str(), 1);
-      else
-        unsetenv("ERODEM_OPENCL_PINNED");
-    }
-  } restore;
+  const RestoreEnv restore("ERODEM_OPENCL_PINNED");
   // probes on three cells (one on the section's row), read in the step's batch too
   const std::vector<std::int64_t> cells = {5 * kNx + 11, 14 * kNx + 7, (kNy - 2) * kNx + 3};
   const std::vector<FieldId> fields = {FieldId::water_depth, FieldId::velocity_x, FieldId::bed};
@@ -362,12 +381,13 @@ TEST(InPlace, EveryBlockSizeGivesTheBitsOfOneThread) {
 
 // The CPU pipes loop runs the rows whose cells and neighbour rows are all active through
 // flow_pipes_cell_all_active, the kinds as constants (flow.cpp flow_blocks). It must give the
-// bits of flow_pipes_cell_interior reading the same kinds from memory: three rows of 67 active
-// cells (every column but the ends in the loop), 20,000 random states each, float and double:
-// surfaces from a few metres up to 4000 m, depths 0, films or metres (a third of them dry),
-// old outflows 0 or up to 50 m^3/s (so that the outflow limit binds in some cells and not in
-// others), pipe lengths and areas of a geographic row, dt from 1e-3 to 1 s. Bound: 0 differing
-// outflows. A pipe dropped or a limit not applied in the constant form changes most of them.
+// bits of flow_pipes_cell_interior reading the same kinds from memory: three rows of 69 active
+// cells (the 67 of the middle row between the ends), 20,000 random states each, float and
+// double: surfaces from a few metres up to 4000 m, depths 0, films or metres (a third of them
+// dry), old outflows 0 or up to 50 m^3/s (so that the outflow limit binds in some cells and not
+// in others), pipe lengths and areas of a geographic row, dt from 1e-3 to 1 s. Bound: 0
+// differing outflows. The cell's kind taken as fixed-level (the limit not applied) makes half
+// of them differ.
 template <class Real>
 void expect_all_active_pipes_give_interior_bits(const char* type) {
   constexpr int W = 69, n = 3 * W;
@@ -404,18 +424,25 @@ void expect_all_active_pipes_give_interior_bits(const char* type) {
                                        out_b[0].data(), out_b[1].data(), out_b[2].data(),
                                        out_b[3].data(), dt, g, a_pipe);
       const int i = x + W;
-      Real total = 0;
       for (int k = 0; k < 4; ++k) {
         differ += std::memcmp(&out_a[k][i], &out_b[k][i], sizeof(Real)) != 0;
-        total += out_a[k][i];
         ++checked;
       }
-      limited += total * dt >= depth[i] * area && total > 0;
+      // whether the limit binds: the outflows before it (a fixed-level cell's, which it does
+      // not limit) ask for more than the cell holds (outflow_limit's own test)
+      Real u[4];
+      const auto eta = [&](int j) { return bed[j] + depth[j]; };
+      cell::flow_pipes_outflows<Real>(ERODEM_CELL_FIXED, ERODEM_CELL_ACTIVE, ERODEM_CELL_ACTIVE,
+                                      ERODEM_CELL_ACTIVE, ERODEM_CELL_ACTIVE, eta(i), eta(i - 1),
+                                      eta(i + 1), eta(i - W), eta(i + W), f[0][i], f[1][i], f[2][i],
+                                      f[3][i], lx, lt, lb, depth[i], area, dt, g, a_pipe, &u[0],
+                                      &u[1], &u[2], &u[3]);
+      limited += (u[0] + u[1] + u[2] + u[3]) * dt > depth[i] * area;
     }
   }
   std::printf(
       "[pipes all active] %s: %zu of %zu outflows differ from flow_pipes_cell_interior (bound 0); "
-      "%zu of %zu cells limited to what they hold\n",
+      "the limit binds in %zu of %zu cells\n",
       type, differ, checked, limited, checked / 4);
   EXPECT_EQ(differ, 0u) << type;
   EXPECT_GT(limited, checked / 40) << type;  // the limit binds in a share of the cells
@@ -425,6 +452,84 @@ void expect_all_active_pipes_give_interior_bits(const char* type) {
 TEST(PipesAllActive, KindsAsConstantsGiveTheBitsOfTheInteriorCell) {
   expect_all_active_pipes_give_interior_bits<float>("float");
   expect_all_active_pipes_give_interior_bits<double>("double");
+}
+
+/// A field of nx x ny cells of 5 m: a tilted, wavy slope with a pond in its middle rows, open
+/// edges unless periodic (east and west joined), nodata at the given cells.
+Terrain slope(int nx, int ny, const std::vector<std::pair<int, int>>& nodata) {
+  Terrain t = flat_terrain(nx, ny, kCell);
+  t.water_depth.assign(t.grid.cells(), 0.0);
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const auto i = static_cast<std::size_t>(r) * nx + c;
+      t.bed[i] = 2.0 + 0.05 * r + 0.3 * std::sin(0.9 * c + 0.4 * r) + 0.02 * c;
+      if (r > ny / 3 && r < 2 * ny / 3) t.water_depth[i] = std::max(0.0, 2.5 - t.bed[i]);
+    }
+  if (!nodata.empty()) {
+    t.mask.assign(t.grid.cells(), 1);
+    for (const auto& [r, c] : nodata) t.mask[static_cast<std::size_t>(r) * nx + c] = 0;
+  }
+  return t;
+}
+
+// The CPU flow loops take the kinds as constants in rows whose cells and neighbour rows are all
+// active (CpuBackend::row_active_, flow.cpp; performance.md "Rows of active cells");
+// ERODEM_CPU_ACTIVE_ROWS=0 turns that off, so every loop reads the kinds. The two must give the
+// same bits: pipes and local inertial, fused and not, erosion + transport + thermal collapse on,
+// 30 steps of rain, open north and south edges, on grids 1 to 6 cells wide between walls
+// (padded widths 3 to 8, where the ranges of constant kinds are empty or one cell), and 37
+// wide with nodata cells (rows beside them take the general loops), with periodic east and
+// west edges (active ghost columns) and between walls. Bound: 0 values of any field and 0
+// ledger entries differ. Checked by hand: the pipes' range of constant kinds one column wider
+// (to W - 2, beside the east ghost) and the east faces' (to W - 3) make every case between
+// walls at least 2 (pipes) or 3 (local inertial) cells wide fail, 160 to 571 values differ.
+TEST(ActiveRows, KindsAsConstantsGiveTheBitsOfTheGeneralLoops) {
+  const Target target{"cpu", Precision::float32};
+  const RestoreEnv restore("ERODEM_CPU_ACTIVE_ROWS");
+  enum class Edges { open, walls, periodic };  // east and west; north and south open
+  struct Grid {
+    int nx, ny;
+    std::vector<std::pair<int, int>> nodata;
+    Edges edges;
+  };
+  std::vector<Grid> grids;
+  for (int nx = 1; nx <= 6; ++nx) grids.push_back({nx, 12, {}, Edges::walls});
+  grids.push_back({37, 29, {{9, 20}, {10, 21}, {20, 3}, {27, 30}}, Edges::open});
+  grids.push_back({37, 29, {}, Edges::periodic});
+  grids.push_back({37, 29, {}, Edges::walls});
+  for (const FlowScheme flow : {FlowScheme::local_inertial, FlowScheme::pipes})
+    for (const bool fused : {false, true})
+      for (const Grid& g : grids) {
+        Params p = rain_params(flow, 30);
+        p.erosion.enabled = p.thermal.enabled = true;
+        p.erosion.law = ErosionLaw::mei;
+        p.thermal.talus_angle = 20.0;
+        p.evaporation.rate = 1e-7;
+        p.boundary.north = p.boundary.south = BoundaryKind::open;
+        p.boundary.east = p.boundary.west = g.edges == Edges::periodic ? BoundaryKind::periodic
+                                            : g.edges == Edges::walls  ? BoundaryKind::closed
+                                                                       : BoundaryKind::open;
+        p.numerics.threads = 2;
+        p.numerics.fused_sweeps = fused;
+        setenv("ERODEM_CPU_ACTIVE_ROWS", "1", 1);
+        auto constant = make_simulation(slope(g.nx, g.ny, g.nodata), p, target);
+        setenv("ERODEM_CPU_ACTIVE_ROWS", "0", 1);
+        auto loaded = make_simulation(slope(g.nx, g.ny, g.nodata), p, target);
+        constant.run();
+        loaded.run();
+        ASSERT_EQ(constant.steps_done(), 30);
+        const auto [total, ledger] = compare_runs(constant, loaded);
+        EXPECT_GT(constant.ledger().boundary_out, 0.0) << "no outflow";
+        std::printf(
+            "[active rows] %s%s, %d x %d%s%s: kinds as constants against loaded: %zu field "
+            "values differ, %zu ledger entries (bound 0)\n",
+            flow == FlowScheme::pipes ? "pipes" : "local inertial", fused ? ", fused" : "", g.nx,
+            g.ny, g.nodata.empty() ? "" : ", nodata",
+            g.edges == Edges::periodic ? ", periodic"
+            : g.edges == Edges::walls  ? ", walls"
+                                       : "",
+            total, ledger);
+      }
 }
 
 // Both backends keep each row's material and sediment volumes while no process that can

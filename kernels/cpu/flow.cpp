@@ -594,15 +594,15 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
             // Columns 2 .. W - 3 and their four neighbours are active: the same outflows with
             // the kinds as constants (performance.md "Rows of active cells"); the two columns
             // at each end as any interior cell.
-            const int x1 = W >= 4 ? W - 2 : 2;
-            for (int x = 0; x < std::min(2, W); ++x)
+            const int x1 = std::max(2, W - 2);  // W >= 3
+            for (int x = 0; x < 2; ++x)
               cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
                                              fb, ol, orr, ot, ob, step, gravity, a_pipe);
             ERODEM_IVDEP
             for (int x = 2; x < x1; ++x)
               cell::flow_pipes_cell_all_active(x, y, W, b, d, lx, lt, lb, cell_area, fl, fr, ft, fb,
                                                ol, orr, ot, ob, step, gravity, a_pipe);
-            for (int x = std::max(2, x1); x < W; ++x)
+            for (int x = x1; x < W; ++x)
               cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
                                              fb, ol, orr, ot, ob, step, gravity, a_pipe);
           } else {
@@ -674,19 +674,22 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
     if (y0 < y1) {
       auto faces_y = [&](int j) {
         if (j < 0 || j > H - 2) return;
-        const RowKinds<false> up{kind_row(j - 1)}, a{kind_row(j)}, b_{kind_row(j + 1)},
-            down{kind_row(j + 2)};
+        const RowKinds<false> k_up{kind_row(j - 1)}, k_a{kind_row(j)}, k_b{kind_row(j + 1)},
+            k_down{kind_row(j + 2)};
         const Real *qu = j >= 1 ? q_row(j - 1) : q_row(j), *qj = q_row(j),
                    *qd = j + 1 <= H - 2 ? q_row(j + 1) : q_row(j);
         Real* out = face_row(j);
         if (rows_active(j - 1, j + 2)) {  // columns 1 .. W - 2 of rows j - 1 .. j + 2 active
           const RowKinds<true> all;
-          face_y_row(j, W, H, 0, 1, up, a, b_, down, b, d, manning, dx, dy, qu, qj, qd, p, out);
+          face_y_row(j, W, H, 0, 1, k_up, k_a, k_b, k_down, b, d, manning, dx, dy, qu, qj, qd, p,
+                     out);
           face_y_row(j, W, H, 1, W - 1, all, all, all, all, b, d, manning, dx, dy, qu, qj, qd, p,
                      out);
-          face_y_row(j, W, H, W - 1, W, up, a, b_, down, b, d, manning, dx, dy, qu, qj, qd, p, out);
+          face_y_row(j, W, H, W - 1, W, k_up, k_a, k_b, k_down, b, d, manning, dx, dy, qu, qj, qd,
+                     p, out);
         } else {
-          face_y_row(j, W, H, 0, W, up, a, b_, down, b, d, manning, dx, dy, qu, qj, qd, p, out);
+          face_y_row(j, W, H, 0, W, k_up, k_a, k_b, k_down, b, d, manning, dx, dy, qu, qj, qd, p,
+                     out);
         }
       };
       faces_y(y0 - 1);
