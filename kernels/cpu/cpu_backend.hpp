@@ -386,7 +386,8 @@ class CpuBackend final : public Backend {
   // padded row y). The kinds never change.
   std::vector<int> edge_x_, edge_row_;
   // 1 where the cells 1 .. W - 2 of padded row y are all active (row_active_[y]; the kinds
-  // never change): their loops may take the kinds as constants (flow.cpp, performance.md "Rows
+  // never change; all 0 under ERODEM_CPU_ACTIVE_ROWS=0): their loops may take the kinds as
+  // constants (flow.cpp, performance.md "Rows
   // of active cells"). rows_active(y0, y1): so are those of rows y0 .. y1, all inside the
   // raster. all_active_around(y): rows y - 1 .. y + 1, so each cell 2 .. W - 3 of row y and its
   // four neighbours are active.
