@@ -387,10 +387,10 @@ class CpuBackend final : public Backend {
   std::vector<int> edge_x_, edge_row_;
   // 1 where the cells 1 .. W - 2 of padded row y are all active (row_active_[y]; the kinds
   // never change; all 0 under ERODEM_CPU_ACTIVE_ROWS=0): their loops may take the kinds as
-  // constants (flow.cpp, performance.md "Rows
-  // of active cells"). rows_active(y0, y1): so are those of rows y0 .. y1, all inside the
-  // raster. all_active_around(y): rows y - 1 .. y + 1, so each cell 2 .. W - 3 of row y and its
-  // four neighbours are active.
+  // constants (flow.cpp runs_of_active_kinds, performance.md "Rows of active cells").
+  // rows_active(y0, y1): so are those of rows y0 .. y1, all inside the raster.
+  // all_active_around(y): rows y - 1 .. y + 1, so each cell 2 .. W - 3 of row y and its four
+  // neighbours are active.
   std::vector<unsigned char> row_active_;
   bool rows_active(int y0, int y1) const {
     if (y0 < 0 || y1 > H_ - 1) return false;

@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <array>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -60,8 +61,27 @@ struct RowKinds<false> {
 };
 template <>
 struct RowKinds<true> {
+  explicit RowKinds(const int*) {}  // the row it stands for, unread
   int operator[](int) const { return ERODEM_CELL_ACTIVE; }
 };
+
+/// Runs loop(constant, x0, x1) over the columns lo .. hi - 1 of a row in at most three runs:
+/// with `constant` std::true_type over a0 .. a1 - 1 (clamped to lo .. hi), whose cells read only
+/// kinds that are ERODEM_CELL_ACTIVE when `active` (so the loop may take them as constants:
+/// RowKinds<true>), and std::false_type (the kinds read) over the rest, or over all of it when
+/// not `active`. Each loop's caller says which columns and rows make it `active`.
+template <class Loop>
+void runs_of_active_kinds(bool active, int lo, int a0, int a1, int hi, const Loop& loop) {
+  if (!active) {
+    loop(std::false_type{}, lo, hi);
+    return;
+  }
+  a0 = std::clamp(a0, lo, hi);
+  a1 = std::clamp(a1, a0, hi);
+  loop(std::false_type{}, lo, a0);
+  loop(std::true_type{}, a0, a1);
+  loop(std::false_type{}, a1, hi);
+}
 
 /// Unit discharges (m^2/s) of the faces south of padded row j (0 <= j <= H - 2), all x.
 template <class Real>
@@ -129,23 +149,17 @@ void face_x_row(int y, int W, const int* __restrict k, bool active, const Real* 
   };
   // W >= 3: the padded raster has at least one DEM column.
   out[0] = face(0, 0, k[2] != ERODEM_CELL_WALL, q[0], q[1]);
-  // faces x0 .. x1 - 1 between cells 1 .. W - 2 (kinds: RowKinds)
-  auto faces = [&](auto kinds, int x0, int x1) {
+  // the faces between cells 1 .. W - 2; where those cells are active, faces 2 .. W - 4 read the
+  // kinds of active cells only
+  runs_of_active_kinds(active, 1, 2, W - 3, W - 2, [&](auto constant, int x0, int x1) {
+    const RowKinds<decltype(constant)::value> kinds{k};
     ERODEM_IVDEP
     for (int x = x0; x < x1; ++x)
       out[x] = cell::local_inertial_face(
           cell::face_open(kinds[x], kinds[x + 1]), kinds[x - 1] != ERODEM_CELL_WALL,
           kinds[x + 2] != ERODEM_CELL_WALL, q[x], q[x - 1], q[x + 1], d[x], d[x + 1], b[x],
           b[x + 1], n[x], n[x + 1], width, dist, dt, g, theta, dry);
-  };
-  if (active) {  // cells 1 .. W - 2 active: faces 2 .. W - 4 read the kinds of active cells only
-    const int a0 = std::min(2, W - 2), a1 = std::max(a0, W - 3);
-    faces(RowKinds<false>{k}, 1, a0);
-    faces(RowKinds<true>{}, a0, a1);
-    faces(RowKinds<false>{k}, a1, W - 2);
-  } else {
-    faces(RowKinds<false>{k}, 1, W - 2);
-  }
+  });
   out[W - 2] = face(W - 2, k[W - 3] != ERODEM_CELL_WALL, 0, q[W - 3], q[W - 2]);
   out[W - 1] = Real(0);
   if (p.periodic_x) {
@@ -180,9 +194,11 @@ void split_row(int y, int W, const int* __restrict k, const int* __restrict k_to
                                      ot + x, ob + x);
   };
   cell_at(0, ERODEM_CELL_WALL, k[1], Real(0), face_x[0]);
-  // cells x0 .. x1 - 1 of 1 .. W - 2, the kinds of the row and the rows above and below
-  // (RowKinds)
-  auto cells = [&](auto kinds, auto kinds_top, auto kinds_bottom, int x0, int x1) {
+  // cells 1 .. W - 2, the kinds of the row and the rows above and below; where the cells
+  // 1 .. W - 2 of all three rows are active, cells 2 .. W - 3 read those of active cells only
+  runs_of_active_kinds(active, 1, 2, W - 2, W - 1, [&](auto constant, int x0, int x1) {
+    using Kinds = RowKinds<decltype(constant)::value>;
+    const Kinds kinds{k}, kinds_top{k_top}, kinds_bottom{k_bottom};
     ERODEM_IVDEP
     for (int x = x0; x < x1; ++x) {
       Real l, r, t, bt;
@@ -194,17 +210,7 @@ void split_row(int y, int W, const int* __restrict k, const int* __restrict k_to
       ot[x] = t;
       ob[x] = bt;
     }
-  };
-  const RowKinds<false> here{k}, above{k_top}, below{k_bottom};
-  if (active) {  // rows y - 1 .. y + 1 active in 1 .. W - 2: cells 2 .. W - 3 and beside them
-    const int a0 = std::min(2, W - 1), a1 = std::max(a0, W - 2);
-    const RowKinds<true> all;
-    cells(here, above, below, 1, a0);
-    cells(all, all, all, a0, a1);
-    cells(here, above, below, a1, W - 1);
-  } else {
-    cells(here, above, below, 1, W - 1);
-  }
+  });
   cell_at(W - 1, k[W - 2], ERODEM_CELL_WALL, face_x[W - 2], Real(0));
 }
 
@@ -590,27 +596,22 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
           Real lx, lt, lb;
           cell::pipe_lengths(y, y - 1, y + 1, dx, dy, l_pipe, &lx, &lt, &lb);
           const Real cell_area = area[y];
-          if (all_active_around(y)) {
-            // Columns 2 .. W - 3 and their four neighbours are active: the same outflows with
-            // the kinds as constants (performance.md "Rows of active cells"); the two columns
-            // at each end as any interior cell.
-            const int x1 = std::max(2, W - 2);  // W >= 3
-            for (int x = 0; x < 2; ++x)
-              cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
-                                             fb, ol, orr, ot, ob, step, gravity, a_pipe);
-            ERODEM_IVDEP
-            for (int x = 2; x < x1; ++x)
-              cell::flow_pipes_cell_all_active(x, y, W, b, d, lx, lt, lb, cell_area, fl, fr, ft, fb,
-                                               ol, orr, ot, ob, step, gravity, a_pipe);
-            for (int x = x1; x < W; ++x)
-              cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
-                                             fb, ol, orr, ot, ob, step, gravity, a_pipe);
-          } else {
-            ERODEM_IVDEP
-            for (int x = 0; x < W; ++x)
-              cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl, fr, ft,
-                                             fb, ol, orr, ot, ob, step, gravity, a_pipe);
-          }
+          // Where rows y - 1 .. y + 1 are active, columns 2 .. W - 3 and their four neighbours
+          // are: the same outflows with the kinds as constants (performance.md "Rows of active
+          // cells"); the two columns at each end as any interior cell.
+          runs_of_active_kinds(
+              all_active_around(y), 0, 2, W - 2, W, [&](auto constant, int x0, int x1) {
+                ERODEM_IVDEP
+                for (int x = x0; x < x1; ++x)
+                  if constexpr (decltype(constant)::value)
+                    cell::flow_pipes_cell_all_active(x, y, W, b, d, lx, lt, lb, cell_area, fl, fr,
+                                                     ft, fb, ol, orr, ot, ob, step, gravity,
+                                                     a_pipe);
+                  else
+                    cell::flow_pipes_cell_interior(x, y, W, kind, b, d, lx, lt, lb, cell_area, fl,
+                                                   fr, ft, fb, ol, orr, ot, ob, step, gravity,
+                                                   a_pipe);
+              });
         } else {
           for (int x = 0; x < W; ++x)
             cell::flow_pipes_cell(x, y, W, H, kind, b, d, dx, dy, area, fl, fr, ft, fb, ol, orr, ot,
@@ -674,23 +675,18 @@ void CpuBackend<Real>::flow_blocks(Real dt, const AfterRow& after_row) {
     if (y0 < y1) {
       auto faces_y = [&](int j) {
         if (j < 0 || j > H - 2) return;
-        const RowKinds<false> k_up{kind_row(j - 1)}, k_a{kind_row(j)}, k_b{kind_row(j + 1)},
-            k_down{kind_row(j + 2)};
+        const int *up = kind_row(j - 1), *a = kind_row(j), *b_row = kind_row(j + 1),
+                  *down = kind_row(j + 2);
         const Real *qu = j >= 1 ? q_row(j - 1) : q_row(j), *qj = q_row(j),
                    *qd = j + 1 <= H - 2 ? q_row(j + 1) : q_row(j);
-        Real* out = face_row(j);
-        if (rows_active(j - 1, j + 2)) {  // columns 1 .. W - 2 of rows j - 1 .. j + 2 active
-          const RowKinds<true> all;
-          face_y_row(j, W, H, 0, 1, k_up, k_a, k_b, k_down, b, d, manning, dx, dy, qu, qj, qd, p,
-                     out);
-          face_y_row(j, W, H, 1, W - 1, all, all, all, all, b, d, manning, dx, dy, qu, qj, qd, p,
-                     out);
-          face_y_row(j, W, H, W - 1, W, k_up, k_a, k_b, k_down, b, d, manning, dx, dy, qu, qj, qd,
-                     p, out);
-        } else {
-          face_y_row(j, W, H, 0, W, k_up, k_a, k_b, k_down, b, d, manning, dx, dy, qu, qj, qd, p,
-                     out);
-        }
+        // where columns 1 .. W - 2 of rows j - 1 .. j + 2 are active, its faces there read the
+        // kinds of active cells only
+        runs_of_active_kinds(
+            rows_active(j - 1, j + 2), 0, 1, W - 1, W, [&](auto constant, int x0, int x1) {
+              using Kinds = RowKinds<decltype(constant)::value>;
+              face_y_row(j, W, H, x0, x1, Kinds{up}, Kinds{a}, Kinds{b_row}, Kinds{down}, b, d,
+                         manning, dx, dy, qu, qj, qd, p, face_row(j));
+            });
       };
       faces_y(y0 - 1);
       for (int y = y0; y < y1; ++y) {
